@@ -17,4 +17,11 @@ except PackageNotFoundError:  # running from a source tree without install
 # --- optim ---
 # --- fms ---
 # --- sysid ---
+from .sysid import ARX as ARX
+from .sysid import IdentifiedModel as IdentifiedModel
+from .sysid import IOData as IOData
+from .sysid import PaperCost as PaperCost
+from .sysid import arx_least_squares as arx_least_squares
+from .sysid import identify as identify
+
 # --- report ---

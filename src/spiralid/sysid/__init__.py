@@ -2,4 +2,17 @@
 estimation and validation."""
 
 # --- core (data, arx, cost, identify) ---
+from .arx import ARX as ARX
+from .arx import arx_least_squares as arx_least_squares
+from .cost import PaperCost as PaperCost
+from .data import IOData as IOData
+from .identify import IdentifiedModel as IdentifiedModel
+from .identify import default_bounds as default_bounds
+from .identify import identify as identify
+from .polynomials import fold_reflection as fold_reflection
+from .polynomials import is_stable_polynomial as is_stable_polynomial
+from .polynomials import random_stable_polynomial as random_stable_polynomial
+from .polynomials import step_down as step_down
+from .polynomials import step_up as step_up
+
 # --- validation (validate, plots) ---

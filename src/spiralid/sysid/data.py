@@ -1,0 +1,331 @@
+"""Input-output records: validated signals, sample time, loading, split, detrend."""
+
+from __future__ import annotations
+
+import csv
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["IOData"]
+
+
+def _signal(x, name: str) -> np.ndarray:
+    """A finite 1-D float signal from a list, (N,) or (N, 1) array."""
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"`{name}` must be a numeric 1-D signal; got {exc}") from None
+    if arr.ndim == 2 and arr.shape[1] == 1:
+        arr = arr[:, 0]
+    if arr.ndim != 1:
+        raise ValueError(
+            f"`{name}` must be a 1-D signal of shape (N,) or (N, 1); "
+            f"got shape {arr.shape}"
+        )
+    if arr.size == 0:
+        raise ValueError(f"`{name}` must not be empty; got 0 samples")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"`{name}` must be finite; got {arr[i]!r} at sample {i} "
+            f"({int(bad.sum())} non-finite samples in all)"
+        )
+    arr = np.ascontiguousarray(arr)
+    arr.flags.writeable = False
+    return arr
+
+
+def _check_ts(ts) -> float:
+    try:
+        val = float(ts)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`ts` must be a positive finite number (seconds); got {ts!r}"
+        ) from None
+    if not (np.isfinite(val) and val > 0):
+        raise ValueError(f"`ts` must be a positive finite number (seconds); got {ts!r}")
+    return val
+
+
+@dataclass(frozen=True, eq=False)
+class IOData:
+    """A single-input single-output record sampled every `ts` seconds.
+
+    Parameters
+    ----------
+    u, y : array_like, shape (N,) or (N, 1)
+        Input and output samples; must be finite and of equal length.
+    ts : float
+        Sample time in seconds (> 0).
+    input_name, output_name : str
+        Labels used in tables and plots.
+    u_offset, y_offset : float
+        Offsets already removed from the signals (set by :meth:`detrend`);
+        add them back to recover the raw signals.
+
+    Examples
+    --------
+    >>> d = IOData([0.0, 1.0, 0.0, -1.0], [0.0, 0.0, 0.5, 0.2], ts=0.1)
+    >>> d.n, d.t[-1].round(3)
+    (4, np.float64(0.3))
+    >>> est, val = d.split(0.5)
+    >>> est.n, val.n
+    (2, 2)
+    """
+
+    u: np.ndarray
+    y: np.ndarray
+    ts: float
+    input_name: str = "u"
+    output_name: str = "y"
+    u_offset: float = field(default=0.0)
+    y_offset: float = field(default=0.0)
+
+    def __post_init__(self) -> None:
+        u = _signal(self.u, "u")
+        y = _signal(self.y, "y")
+        if u.size != y.size:
+            raise ValueError(
+                f"`u` and `y` must have the same length; got {u.size} and {y.size}"
+            )
+        object.__setattr__(self, "u", u)
+        object.__setattr__(self, "y", y)
+        object.__setattr__(self, "ts", _check_ts(self.ts))
+        object.__setattr__(self, "input_name", str(self.input_name))
+        object.__setattr__(self, "output_name", str(self.output_name))
+        object.__setattr__(self, "u_offset", float(self.u_offset))
+        object.__setattr__(self, "y_offset", float(self.y_offset))
+
+    @property
+    def n(self) -> int:
+        """Number of samples."""
+        return int(self.u.size)
+
+    def __len__(self) -> int:
+        return self.n
+
+    @property
+    def t(self) -> np.ndarray:
+        """Sample instants ``0, ts, 2 ts, ...`` in seconds."""
+        return np.arange(self.n) * self.ts
+
+    def __repr__(self) -> str:
+        return (
+            f"IOData(n={self.n}, ts={self.ts!r}, input_name={self.input_name!r}, "
+            f"output_name={self.output_name!r})"
+        )
+
+    def _replace(self, u, y, **kw) -> IOData:
+        args = dict(
+            ts=self.ts,
+            input_name=self.input_name,
+            output_name=self.output_name,
+            u_offset=self.u_offset,
+            y_offset=self.y_offset,
+        )
+        args.update(kw)
+        return IOData(u, y, **args)
+
+    def __getitem__(self, index: slice) -> IOData:
+        """A contiguous part, ``data[a:b]`` (slices with step 1 only)."""
+        if not isinstance(index, slice) or index.step not in (None, 1):
+            raise ValueError(
+                f"`index` must be a slice with step 1, e.g. data[10:50]; got {index!r}"
+            )
+        return self._replace(self.u[index], self.y[index])
+
+    def split(self, fraction: float = 2 / 3) -> tuple[IOData, IOData]:
+        """Split into contiguous (estimation, validation) parts.
+
+        The paper (Section "Model validation") estimates on the first two
+        thirds and validates on the rest. The estimation part has
+        ``round(fraction * n)`` samples.
+
+        Parameters
+        ----------
+        fraction : float
+            Share of samples in the estimation part, in (0, 1).
+        """
+        try:
+            frac = float(fraction)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"`fraction` must be a number in (0, 1); got {fraction!r}"
+            ) from None
+        if not (0.0 < frac < 1.0):
+            raise ValueError(f"`fraction` must be in (0, 1); got {fraction!r}")
+        k = round(frac * self.n)
+        if k < 1 or k > self.n - 1:
+            raise ValueError(
+                f"`fraction` leaves an empty part of a record of {self.n} samples; "
+                f"got {fraction!r}"
+            )
+        return self[:k], self[k:]
+
+    def detrend(self) -> IOData:
+        """Remove the means of input and output, remembering them as offsets.
+
+        Returns
+        -------
+        IOData
+            Zero-mean signals; ``u_offset`` / ``y_offset`` accumulate the
+            removed means so ``data.y + data.y_offset`` is the raw output.
+        """
+        mu, my = float(self.u.mean()), float(self.y.mean())
+        return self._replace(
+            self.u - mu,
+            self.y - my,
+            u_offset=self.u_offset + mu,
+            y_offset=self.y_offset + my,
+        )
+
+    # -- loading ---------------------------------------------------------------
+
+    @classmethod
+    def from_csv(
+        cls,
+        path: str | os.PathLike,
+        input: str | int = "u",
+        output: str | int = "y",
+        ts: float = 1.0,
+        delimiter: str = ",",
+    ) -> IOData:
+        """Read two columns of a delimited text file.
+
+        Parameters
+        ----------
+        path : path-like
+            The file. A first line that is not all numbers is read as a header.
+        input, output : str or int
+            Column names (needs a header) or 0-based column indices.
+        ts : float
+            Sample time in seconds (the file does not carry one).
+        delimiter : str
+            Field separator.
+        """
+        with open(path, newline="") as fh:
+            rows = [r for r in csv.reader(fh, delimiter=delimiter) if r]
+        if not rows:
+            raise ValueError(
+                f"`path` must name a non-empty file; {str(path)!r} is empty"
+            )
+        header = None
+        if not all(_is_number(c) for c in rows[0]):
+            header = [c.strip() for c in rows[0]]
+            rows = rows[1:]
+        ncol = len(header) if header is not None else len(rows[0])
+
+        def column(key, argname):
+            if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
+                if not 0 <= key < ncol:
+                    raise ValueError(
+                        f"`{argname}` column index must be in [0, {ncol - 1}]; "
+                        f"got {key!r}"
+                    )
+                return int(key), (header[key] if header else f"column {key}")
+            if header is None:
+                raise ValueError(
+                    f"`{argname}` must be a column index: {str(path)!r} has no header "
+                    f"line; got {key!r}"
+                )
+            if key not in header:
+                raise ValueError(
+                    f"`{argname}` must be one of the columns {header}; got {key!r}"
+                )
+            return header.index(key), str(key)
+
+        iu, name_u = column(input, "input")
+        iy, name_y = column(output, "output")
+        first_row = 2 if header is not None else 1
+
+        def values(j, name):
+            out = np.empty(len(rows))
+            for r, row in enumerate(rows):
+                cell = row[j].strip() if j < len(row) else ""
+                try:
+                    out[r] = float(cell)
+                except ValueError:
+                    raise ValueError(
+                        f"`path` column {name!r} must be numeric; got {cell!r} on line "
+                        f"{r + first_row} of {str(path)!r}"
+                    ) from None
+            return out
+
+        return cls(values(iu, name_u), values(iy, name_y), ts, name_u, name_y)
+
+    @classmethod
+    def from_npz(
+        cls,
+        path: str | os.PathLike,
+        input: str = "u",
+        output: str = "y",
+        ts: float | None = None,
+    ) -> IOData:
+        """Read arrays from a NumPy ``.npz`` archive (never unpickles objects).
+
+        ``ts=None`` reads the sample time from a scalar array named ``ts``.
+        """
+        with np.load(path, allow_pickle=False) as z:
+            return cls._from_mapping(dict(z.items()), input, output, ts, path)
+
+    @classmethod
+    def from_mat(
+        cls,
+        path: str | os.PathLike,
+        input: str = "u",
+        output: str = "y",
+        ts: float | None = None,
+    ) -> IOData:
+        """Read variables from a MATLAB ``.mat`` file (``scipy.io.loadmat``).
+
+        ``ts=None`` reads the sample time from a scalar variable named ``ts``.
+        """
+        from scipy.io import loadmat
+
+        mat = {k: v for k, v in loadmat(path).items() if not k.startswith("__")}
+        return cls._from_mapping(mat, input, output, ts, path)
+
+    @classmethod
+    def _from_mapping(cls, mapping, input, output, ts, path) -> IOData:
+        names = sorted(mapping)
+        for key, arg in ((input, "input"), (output, "output")):
+            if key not in mapping:
+                raise ValueError(
+                    f"`{arg}` must be one of the variables {names}; got {key!r}"
+                )
+        if ts is None:
+            if "ts" not in mapping:
+                raise ValueError(
+                    f"`ts` must be given: {str(path)!r} has no variable 'ts' "
+                    f"(variables: {names})"
+                )
+            ts = np.asarray(mapping["ts"], dtype=float).ravel()
+            if ts.size != 1:
+                raise ValueError(
+                    f"`ts` variable must be a scalar; got shape {ts.shape}"
+                )
+            ts = float(ts[0])
+
+        def arr(key):
+            a = np.asarray(mapping[key])
+            if a.dtype.kind not in "fiub":
+                raise ValueError(
+                    f"variable {key!r} must be numeric; got dtype {a.dtype} "
+                    f"in {str(path)!r}"
+                )
+            a = a.astype(float)
+            # MATLAB stores vectors as (1, N) or (N, 1).
+            return a.ravel() if a.ndim == 2 and 1 in a.shape else a
+
+        return cls(arr(input), arr(output), ts, str(input), str(output))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True

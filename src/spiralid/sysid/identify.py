@@ -1,0 +1,515 @@
+"""identify(): data + ARX structure + method -> IdentifiedModel.
+
+Methods
+-------
+``"sda"``, ``"ebsda"``, ``"lasda"``
+    The spiral optimisers of :func:`spiralid.optim.minimize` over the
+    paper's cost :class:`~spiralid.sysid.PaperCost` (eq. (2)-(3)).
+``"ls"``
+    Least squares, the exact minimiser of the one-step error.
+``"oe"``
+    Output error: ``scipy.optimize.least_squares`` (trust-region
+    reflective) on the free-run simulation error, started from least
+    squares, kept stable by searching the denominator as reflection
+    coefficients in ``[-kmax, kmax]`` (unstable poles of the start are first
+    reflected into the unit circle, ``z -> 1 / conj(z)``).
+
+Search space of the spiral methods (DESIGN.md items 12-13)
+------------------------------------------------------------
+``parametrization="coefficients"`` (paper-faithful): the optimiser moves
+the raw coefficients ``[a, b]`` and unstable candidates pay the penalty;
+the initial denominators are drawn uniformly in reflection coefficients
+and mapped by the step-up recursion, so every initial point is stable
+("feasible"). ``parametrization="reflection"``: the optimiser moves
+``[k_1..k_na, b]``; each ``k`` is folded into ``(-1, 1)``
+(:func:`~spiralid.sysid.polynomials.fold_reflection`) and mapped by step-up,
+so every candidate is stable and the penalty never fires.
+
+Default bounds: ``|a_i| <= binom(na, i)`` (every stable monic polynomial of
+degree na lies in that box, so it loses no stable model), ``k_i`` in
+``[-1, 1]``, and ``|b_j| <= s`` with
+``s = 2 max(max_j |b_j^LS|, rms(y) / rms(u))`` scaled from the data.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from math import comb
+from typing import Any
+
+import numpy as np
+from scipy import optimize, signal
+
+from .arx import ARX, arx_least_squares
+from .cost import PaperCost
+from .data import IOData
+from .polynomials import fold_reflection, step_down, step_up
+
+__all__ = ["IdentifiedModel", "default_bounds", "identify"]
+
+_SPIRAL = ("sda", "ebsda", "lasda")
+_METHODS = ("ls", "oe", *_SPIRAL)
+_PARAMETRIZATIONS = ("coefficients", "reflection")
+_KMAX = 1.0 - 1e-6
+
+
+@dataclass(eq=False)
+class IdentifiedModel:
+    """An estimated ARX model with how it was obtained.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (p,)
+        ``[a_1..a_na, b_0..b_(nb-1)]``.
+    arx : ARX
+        The structure.
+    ts : float
+        Sample time in seconds.
+    method, predictor, parametrization : str
+        How it was estimated (``predictor`` is the one the cost uses).
+    gain : float
+        The cost's gain ``w``.
+    penalty : float
+        The cost's stability penalty.
+    cost : float
+        The paper's cost, eq. (2)-(3), of ``theta`` on the estimation data.
+    result : object or None
+        The optimiser's result (``SpiralResult`` for spiral methods,
+        ``scipy.optimize.OptimizeResult`` for ``"oe"``); ``None`` for ``"ls"``
+        and after :meth:`from_dict`.
+    refine_result : object or None
+        The local polish's result when ``refine=True``.
+    history : ndarray or None
+        Best cost after each iteration of the spiral search.
+    timings : dict
+        Wall times in seconds: ``"search"``, ``"refine"``, ``"total"``.
+    bounds : ndarray or None, shape (p, 2)
+        The search box of a spiral method (in the searched parameters).
+    """
+
+    theta: np.ndarray
+    arx: ARX
+    ts: float
+    method: str
+    predictor: str = "simulation"
+    parametrization: str = "coefficients"
+    gain: float = float("nan")
+    penalty: float = 1e6
+    cost: float = float("nan")
+    result: Any = None
+    refine_result: Any = None
+    history: np.ndarray | None = None
+    timings: dict = field(default_factory=dict)
+    bounds: np.ndarray | None = None
+    input_name: str = "u"
+    output_name: str = "y"
+
+    def __post_init__(self) -> None:
+        self.theta = np.asarray(self.theta, dtype=float).copy()
+        if self.theta.shape != (self.arx.n_params,):
+            raise ValueError(
+                f"`theta` must have shape ({self.arx.n_params},) for {self.arx}; "
+                f"got {self.theta.shape}"
+            )
+
+    # -- model behaviour ---------------------------------------------------------
+
+    def simulate(self, u) -> np.ndarray:
+        """Free-run output from zero initial conditions (``IOData`` gives its u)."""
+        return self.arx.simulate(self.theta, u)
+
+    def predict(self, data: IOData) -> np.ndarray:
+        """One-step-ahead prediction on `data`."""
+        return self.arx.predict(self.theta, data)
+
+    @property
+    def polynomials(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(num, den)`` in ``z^-1``, equal lengths (see ``ARX.polynomials``)."""
+        return self.arx.polynomials(self.theta)
+
+    @property
+    def poles(self) -> np.ndarray:
+        return self.arx.poles(self.theta)
+
+    @property
+    def zeros(self) -> np.ndarray:
+        return self.arx.zeros(self.theta)
+
+    @property
+    def is_stable(self) -> bool:
+        return bool(self.arx.is_stable(self.theta))
+
+    def tf_string(self, digits: int = 4) -> str:
+        """Transfer function in z as eq. (9)-(10) print it."""
+        return self.arx.tf_string(self.theta, digits=digits)
+
+    def to_dlti(self) -> signal.dlti:
+        """The model as a ``scipy.signal.dlti`` transfer function with ``dt = ts``."""
+        num, den = self.polynomials
+        return signal.dlti(num, den, dt=self.ts)
+
+    # -- serialisation -----------------------------------------------------------
+
+    def to_dict(self) -> dict:
+        """A JSON-safe summary (the optimiser result is reduced to its history)."""
+        res = self.result
+        summary = None
+        if res is not None:
+            summary = {
+                k: _jsonable(getattr(res, k))
+                for k in ("fun", "nit", "nfev", "success", "message")
+                if hasattr(res, k)
+            }
+        return {
+            "theta": [float(v) for v in self.theta],
+            "na": self.arx.na,
+            "nb": self.arx.nb,
+            "nk": self.arx.nk,
+            "ts": float(self.ts),
+            "method": self.method,
+            "predictor": self.predictor,
+            "parametrization": self.parametrization,
+            "gain": float(self.gain),
+            "penalty": float(self.penalty),
+            "cost": float(self.cost),
+            "history": None
+            if self.history is None
+            else [float(v) for v in self.history],
+            "timings": {k: float(v) for k, v in self.timings.items()},
+            "bounds": None if self.bounds is None else np.asarray(self.bounds).tolist(),
+            "input_name": self.input_name,
+            "output_name": self.output_name,
+            "result": summary,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> IdentifiedModel:
+        """Rebuild from :meth:`to_dict` output (``result`` is not restored)."""
+        try:
+            arx = ARX(d["na"], d["nb"], d["nk"])
+            return cls(
+                theta=np.asarray(d["theta"], dtype=float),
+                arx=arx,
+                ts=float(d["ts"]),
+                method=d["method"],
+                predictor=d.get("predictor", "simulation"),
+                parametrization=d.get("parametrization", "coefficients"),
+                gain=float(d.get("gain", float("nan"))),
+                penalty=float(d.get("penalty", 1e6)),
+                cost=float(d.get("cost", float("nan"))),
+                history=None if d.get("history") is None else np.asarray(d["history"]),
+                timings=dict(d.get("timings", {})),
+                bounds=None if d.get("bounds") is None else np.asarray(d["bounds"]),
+                input_name=d.get("input_name", "u"),
+                output_name=d.get("output_name", "y"),
+            )
+        except KeyError as exc:
+            raise ValueError(f"`d` must contain the key {exc.args[0]!r}") from None
+
+    def __repr__(self) -> str:
+        return (
+            f"IdentifiedModel({self.arx}, method={self.method!r}, "
+            f"predictor={self.predictor!r}, cost={self.cost:.6g}, "
+            f"stable={self.is_stable})"
+        )
+
+
+def _jsonable(v):
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+# -- bounds and parametrisation ----------------------------------------------------
+
+
+def default_bounds(
+    data: IOData, arx: ARX, parametrization: str = "coefficients"
+) -> np.ndarray:
+    """The default search box, shape (p, 2) (see the module docstring).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.signal import lfilter
+    >>> u = np.random.default_rng(0).standard_normal(200)
+    >>> y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    >>> default_bounds(IOData(u, y, ts=1.0), ARX(2, 2, 1))[:2]
+    array([[-2.,  2.],
+           [-1.,  1.]])
+    """
+    if parametrization not in _PARAMETRIZATIONS:
+        raise ValueError(
+            f"`parametrization` must be one of {_PARAMETRIZATIONS}; "
+            f"got {parametrization!r}"
+        )
+    theta_ls = arx_least_squares(data, arx)
+    rms_u = float(np.sqrt(np.mean(data.u**2)))
+    rms_y = float(np.sqrt(np.mean(data.y**2)))
+    s = 2.0 * max(float(np.max(np.abs(theta_ls[arx.na :]))), rms_y / rms_u)
+    box = np.empty((arx.n_params, 2))
+    for i in range(arx.na):
+        half = 1.0 if parametrization == "reflection" else float(comb(arx.na, i + 1))
+        box[i] = (-half, half)
+    box[arx.na :] = (-s, s)
+    return box
+
+
+def _check_bounds(bounds, p: int) -> np.ndarray:
+    try:
+        box = np.asarray(bounds, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`bounds` must be an array of shape ({p}, 2); got {bounds!r}"
+        ) from None
+    if box.shape != (p, 2):
+        raise ValueError(f"`bounds` must have shape ({p}, 2); got shape {box.shape}")
+    if not np.all(np.isfinite(box)) or np.any(box[:, 0] >= box[:, 1]):
+        raise ValueError(
+            f"`bounds` must be finite with lower < upper in each row; got {box}"
+        )
+    return box
+
+
+def _reflection_to_theta(x: np.ndarray, na: int) -> np.ndarray:
+    """Searched ``[k, b]`` -> ``[a, b]``; k folded into (-1, 1) first."""
+    x = np.atleast_2d(x)
+    a = step_up(fold_reflection(x[:, :na], _KMAX))
+    return np.concatenate([a, x[:, na:]], axis=1)
+
+
+def _stabilise(theta: np.ndarray, arx: ARX) -> np.ndarray:
+    """Reflect poles with ``|z| >= 1`` into the unit circle; return ``[k, b]``."""
+    na = arx.na
+    a, b = theta[:na], theta[na:]
+    if na == 0:
+        return theta.copy()
+    if not arx.is_stable(theta):
+        roots = np.roots(np.r_[1.0, a])
+        mag = np.abs(roots)
+        out = mag >= 1.0
+        roots[out] = 1.0 / np.conj(roots[out])
+        # A root on the circle reflects onto itself: pull it just inside.
+        roots = np.where(np.abs(roots) >= _KMAX, roots * _KMAX / np.abs(roots), roots)
+        a = np.real(np.poly(roots))[1:]
+    k = step_down(a)
+    k = np.clip(np.nan_to_num(k, nan=0.0), -_KMAX, _KMAX)
+    return np.r_[k, b]
+
+
+def _local_polish(
+    theta0: np.ndarray, arx: ARX, data: IOData, predictor: str
+) -> tuple[np.ndarray, optimize.OptimizeResult]:
+    """Least-squares polish of the chosen error; denominator as reflection coefs."""
+    na = arx.na
+    y = data.y
+    if predictor == "simulation":
+        num_lags = arx.input_lags(data.u)
+
+        def residual(x):
+            k = np.clip(x[:na], -_KMAX, _KMAX)
+            xsim = x[na:] @ num_lags
+            return signal.lfilter([1.0], np.r_[1.0, step_up(k)], xsim) - y
+
+    else:
+        phi = arx.regressors(data)
+
+        def residual(x):
+            k = np.clip(x[:na], -_KMAX, _KMAX)
+            return phi @ np.r_[step_up(k), x[na:]] - y
+
+    x0 = _stabilise(np.asarray(theta0, dtype=float), arx)
+    lower = np.r_[np.full(na, -_KMAX), np.full(arx.nb, -np.inf)]
+    upper = -lower
+    res = optimize.least_squares(
+        residual,
+        x0,
+        bounds=(lower, upper),
+        method="trf",
+        x_scale="jac",
+        xtol=1e-12,
+        ftol=1e-12,
+        gtol=1e-12,
+        max_nfev=200 * (arx.n_params + 1),
+    )
+    theta = np.r_[step_up(np.clip(res.x[:na], -_KMAX, _KMAX)), res.x[na:]]
+    return theta, res
+
+
+# -- the entry point ----------------------------------------------------------
+
+
+def identify(
+    data: IOData,
+    arx: ARX,
+    method: str = "ebsda",
+    predictor: str = "simulation",
+    parametrization: str = "coefficients",
+    rng=None,
+    refine: bool = False,
+    gain: str | float = "auto",
+    penalty: float = 1e6,
+    bounds=None,
+    **optimiser_options,
+) -> IdentifiedModel:
+    """Estimate an ARX model from input-output data.
+
+    Parameters
+    ----------
+    data : IOData
+        Estimation record.
+    arx : ARX
+        Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6).
+    method : {"ebsda", "sda", "lasda", "ls", "oe"}
+        Estimator (see the module docstring). ``"ls"`` minimises the
+        one-step error and ``"oe"`` the simulation error whatever
+        `predictor` says; `predictor` then only selects the reported cost.
+    predictor : {"simulation", "one-step"}
+        The error of the paper's cost (DESIGN.md item 3).
+    parametrization : {"coefficients", "reflection"}
+        What the spiral optimiser searches (DESIGN.md items 12-13).
+    rng : int, numpy.random.Generator or None
+        Randomness of the spiral methods (initial points and the search).
+    refine : bool
+        Polish a spiral result locally with the ``"oe"`` machinery applied
+        to the `predictor`'s error (kept only if it lowers the cost).
+        Ignored by ``"ls"`` and ``"oe"``.
+    gain, penalty
+        The cost's gain ``w`` and stability penalty, see :class:`PaperCost`.
+    bounds : array_like, shape (p, 2), optional
+        Search box in the searched parameters (``[a, b]`` or ``[k, b]``);
+        default :func:`default_bounds`.
+    **optimiser_options
+        Passed to :func:`spiralid.optim.minimize` (``n_points``, ``max_iter``,
+        ``max_nfev``, ``target``, ``callback``, ``bounds_policy``, ``x0``...).
+
+    Returns
+    -------
+    IdentifiedModel
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.signal import lfilter
+    >>> u = np.random.default_rng(0).standard_normal(300)
+    >>> y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    >>> fit = identify(IOData(u, y, ts=0.01), ARX(2, 2, 1), method="ls")
+    >>> fit.theta.round(9), fit.is_stable
+    (array([-1.5,  0.7,  1. ,  0.5]), True)
+    """
+    t_start = time.perf_counter()
+    if not isinstance(data, IOData):
+        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    if not isinstance(arx, ARX):
+        raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+    if method not in _METHODS:
+        raise ValueError(f"`method` must be one of {_METHODS}; got {method!r}")
+    if parametrization not in _PARAMETRIZATIONS:
+        raise ValueError(
+            f"`parametrization` must be one of {_PARAMETRIZATIONS}; "
+            f"got {parametrization!r}"
+        )
+    if method not in _SPIRAL and optimiser_options:
+        raise ValueError(
+            f"`optimiser_options` apply to the spiral methods {_SPIRAL}; method "
+            f"{method!r} got {sorted(optimiser_options)}"
+        )
+    cost = PaperCost(arx, data, predictor=predictor, gain=gain, penalty=penalty)
+    common = dict(
+        arx=arx,
+        ts=data.ts,
+        method=method,
+        predictor=predictor,
+        parametrization=parametrization,
+        gain=cost.w,
+        penalty=cost.penalty,
+        input_name=data.input_name,
+        output_name=data.output_name,
+    )
+
+    if method == "ls":
+        theta = arx_least_squares(data, arx)
+        t = time.perf_counter() - t_start
+        return IdentifiedModel(
+            theta,
+            cost=cost(theta),
+            timings={"search": t, "refine": 0.0, "total": t},
+            **common,
+        )
+
+    if method == "oe":
+        theta_ls = arx_least_squares(data, arx)
+        theta, res = _local_polish(theta_ls, arx, data, "simulation")
+        t = time.perf_counter() - t_start
+        return IdentifiedModel(
+            theta,
+            cost=cost(theta),
+            result=res,
+            timings={"search": t, "refine": 0.0, "total": t},
+            **common,
+        )
+
+    from spiralid.optim import minimize
+
+    gen = np.random.default_rng(rng)
+    box = (
+        default_bounds(data, arx, parametrization)
+        if bounds is None
+        else _check_bounds(bounds, arx.n_params)
+    )
+    na = arx.na
+    if parametrization == "reflection":
+
+        def fun(x):
+            return cost(_reflection_to_theta(x, na))
+
+        def to_theta(x):
+            return _reflection_to_theta(x, na)[0]
+
+    else:
+        fun = cost
+
+        def to_theta(x):
+            return np.asarray(x, dtype=float)
+
+        if "x0" not in optimiser_options:
+            # "Initial points in the feasible region" (DESIGN.md item 12).
+            m = int(optimiser_options.get("n_points", 50))
+            k = gen.uniform(-1.0, 1.0, size=(m, na))
+            b = gen.uniform(box[na:, 0], box[na:, 1], size=(m, arx.nb))
+            optimiser_options["x0"] = np.clip(
+                np.concatenate([step_up(k), b], axis=1), box[:, 0], box[:, 1]
+            )
+    res = minimize(
+        fun, box, method=method, rng=gen, vectorized=True, **optimiser_options
+    )
+    t_search = time.perf_counter() - t_start
+    theta = to_theta(res.x)
+    best = cost(theta)
+    ref_res = None
+    t_refine = 0.0
+    if refine:
+        t0 = time.perf_counter()
+        polished, ref_res = _local_polish(theta, arx, data, predictor)
+        new = cost(polished)
+        if new <= best:
+            theta, best = polished, new
+        t_refine = time.perf_counter() - t0
+    history = getattr(res, "history", None)
+    return IdentifiedModel(
+        theta,
+        cost=best,
+        result=res,
+        refine_result=ref_res,
+        history=None if history is None else np.asarray(history, dtype=float),
+        timings={
+            "search": t_search,
+            "refine": t_refine,
+            "total": time.perf_counter() - t_start,
+        },
+        bounds=box,
+        **common,
+    )
