@@ -1,0 +1,657 @@
+"""Model validation the way the paper and MATLAB's toolbox judge a model.
+
+:func:`validate` applies the measured input of a validation record to an
+identified model and reports, in one :class:`Validation`:
+
+* time domain: fit % as MATLAB's ``compare`` defines it, RMSE, the paper's
+  cost (eq. (2)-(3)) and the range of the error (the paper's Table-2), for
+  the free-run simulation (the paper's validation, Figure-3) and, labelled
+  separately, the one-step prediction;
+* residual analysis: whiteness of the residual and its independence from the
+  input, with 95 % and 99 % bands (:mod:`spiralid.sysid.correlation`);
+* frequency domain: Welch spectra of measured and modelled output and their
+  resonance peaks, and the model's own modes from its poles
+  (:mod:`spiralid.sysid.spectra`; the paper's Figure-7c);
+* structure: stability from the poles, and controllability / observability of
+  the model's state-space realisation (the paper's MATLAB ``ctrb``/``obsv``
+  check after eq. (10)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from .correlation import CorrelationTest, independence_test, whiteness_test
+from .spectra import PSD, Modes, Peaks, find_resonances, modes_from_poles, psd
+
+__all__ = [
+    "Realization",
+    "Validation",
+    "fit_percent",
+    "realization_tests",
+    "rmse",
+    "validate",
+]
+
+_RESIDUALS = ("one-step", "simulation")
+
+
+def _pair(y, yhat, name_y="y", name_yhat="yhat") -> tuple[np.ndarray, np.ndarray]:
+    a, b = np.asarray(y, dtype=float), np.asarray(yhat, dtype=float)
+    # (N, 1) columns are accepted like everywhere else in sysid.
+    a = a[:, 0] if a.ndim == 2 and a.shape[1] == 1 else a
+    b = b[:, 0] if b.ndim == 2 and b.shape[1] == 1 else b
+    if a.ndim != 1 or b.ndim != 1:
+        raise ValueError(
+            f"`{name_y}` and `{name_yhat}` must be 1-D signals; "
+            f"got shapes {a.shape} and {b.shape}"
+        )
+    if a.size != b.size:
+        raise ValueError(
+            f"`{name_y}` and `{name_yhat}` must have the same length; "
+            f"got {a.size} and {b.size}"
+        )
+    if a.size == 0:
+        raise ValueError(f"`{name_y}` must not be empty; got {a.size} samples")
+    for arr, nm in ((a, name_y), (b, name_yhat)):
+        if not np.all(np.isfinite(arr)):
+            i = int(np.flatnonzero(~np.isfinite(arr))[0])
+            raise ValueError(f"`{nm}` must be finite; got {arr[i]!r} at sample {i}")
+    return a, b
+
+
+def fit_percent(y, yhat) -> float:
+    """Normalised fit in percent, as MATLAB's ``compare`` reports it.
+
+    ``fit = 100 (1 - ||y - yhat|| / ||y - mean(y)||)``: 100 for a perfect
+    model, 0 for one no better than the output's mean, negative for worse.
+
+    Parameters
+    ----------
+    y : array_like, shape (N,)
+        Measured output.
+    yhat : array_like, shape (N,)
+        Model output (simulated or predicted).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    ``||e|| = 1`` and ``||y - mean(y)|| = sqrt(2)``, so the fit is
+    ``100 (1 - 1 / sqrt(2))``:
+
+    >>> round(fit_percent([1.0, 2.0, 3.0], [1.0, 2.0, 4.0]), 6)
+    29.289322
+    """
+    a, b = _pair(y, yhat)
+    scale = np.linalg.norm(a - a.mean())
+    if scale == 0.0:
+        raise ValueError(
+            "`y` must not be constant: the fit is relative to its variation; "
+            f"got every sample equal to {a[0]!r}"
+        )
+    return float(100.0 * (1.0 - np.linalg.norm(a - b) / scale))
+
+
+def rmse(y, yhat) -> float:
+    """Root-mean-square error ``sqrt(mean((y - yhat)^2))``.
+
+    Examples
+    --------
+    >>> rmse([0.0, 0.0], [3.0, 4.0])  # sqrt((9 + 16) / 2)
+    3.5355339059327378
+    """
+    a, b = _pair(y, yhat)
+    return float(np.sqrt(np.mean((a - b) ** 2)))
+
+
+# -- state-space realisation ------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Realization:
+    """Controllability and observability of a transfer function's realisation.
+
+    The realisation is SciPy's ``tf2ss`` (controller canonical form), the same
+    kind MATLAB's ``ss(tf)`` builds. That form is controllable by
+    construction, so a pole-zero cancellation shows up as a loss of
+    observability. Rank is counted from singular values above
+    ``rtol * s_max`` (default ``rtol = n * eps``, MATLAB's and NumPy's
+    ``rank``), which only flags a cancellation exact to rounding; a near
+    cancellation is better read from ``min_pole_zero_distance`` and the
+    singular-value ratios.
+
+    Attributes
+    ----------
+    order : int
+        State dimension n.
+    ctrb_rank, obsv_rank : int
+        Numerical ranks of ``[B, AB, .., A^(n-1) B]`` and ``[C; CA; ..]``.
+    controllable, observable : bool
+        Rank equals n.
+    ctrb_sv_ratio, obsv_sv_ratio : float
+        Smallest over largest singular value of those matrices (1 is ideal,
+        0 is singular).
+    min_pole_zero_distance : float
+        Smallest ``|p - z|`` over poles and zeros in the z-plane (``inf`` if
+        there are no zeros). Zero means a cancellation: the realisation is not
+        minimal.
+    """
+
+    order: int
+    ctrb_rank: int
+    obsv_rank: int
+    controllable: bool
+    observable: bool
+    ctrb_sv_ratio: float
+    obsv_sv_ratio: float
+    min_pole_zero_distance: float
+
+    @property
+    def minimal(self) -> bool:
+        """Controllable and observable: no pole-zero cancellation."""
+        return self.controllable and self.observable
+
+    def to_dict(self) -> dict:
+        """JSON-safe dictionary (an infinite distance becomes ``None``)."""
+        d = self.min_pole_zero_distance
+        return {
+            "order": int(self.order),
+            "ctrb_rank": int(self.ctrb_rank),
+            "obsv_rank": int(self.obsv_rank),
+            "controllable": bool(self.controllable),
+            "observable": bool(self.observable),
+            "minimal": bool(self.minimal),
+            "ctrb_sv_ratio": float(self.ctrb_sv_ratio),
+            "obsv_sv_ratio": float(self.obsv_sv_ratio),
+            "min_pole_zero_distance": float(d) if np.isfinite(d) else None,
+        }
+
+
+def _rank(mat: np.ndarray, rtol: float | None) -> tuple[int, float]:
+    s = np.linalg.svd(mat, compute_uv=False)
+    if s.size == 0 or s[0] == 0.0:
+        return 0, 0.0
+    tol = (max(mat.shape) * np.finfo(float).eps if rtol is None else rtol) * s[0]
+    return int(np.sum(s > tol)), float(s[-1] / s[0])
+
+
+def realization_tests(num, den, *, rtol: float | None = None) -> Realization:
+    """Controllability and observability of ``num(z) / den(z)``.
+
+    Parameters
+    ----------
+    num, den : array_like
+        Coefficients in descending powers of ``z`` (``scipy.signal.dlti``'s
+        convention; an ARX's ``polynomials(theta)``, padded to equal length,
+        serve as they are). ``den[0]`` must be non-zero.
+    rtol : float, optional
+        Relative singular-value tolerance for the rank; default ``n * eps``.
+
+    Returns
+    -------
+    Realization
+
+    Examples
+    --------
+    The denominator is ``(z - 0.5)(z - 0.7)``; a zero at 0.2 leaves the
+    realisation minimal, a zero at 0.5 cancels a pole:
+
+    >>> r = realization_tests([1.0, -0.2], [1.0, -1.2, 0.35])
+    >>> r.controllable, r.observable
+    (True, True)
+    >>> r = realization_tests([1.0, -0.5], [1.0, -1.2, 0.35])
+    >>> r.controllable, r.observable, r.min_pole_zero_distance < 1e-12
+    (True, False, True)
+    """
+    num = np.atleast_1d(np.asarray(num, dtype=float))
+    den = np.atleast_1d(np.asarray(den, dtype=float))
+    if num.ndim != 1 or den.ndim != 1:
+        raise ValueError(
+            f"`num` and `den` must be 1-D coefficient arrays; "
+            f"got shapes {num.shape} and {den.shape}"
+        )
+    if not (np.all(np.isfinite(num)) and np.all(np.isfinite(den))):
+        raise ValueError(f"`num` and `den` must be finite; got {num!r} and {den!r}")
+    if den.size == 0 or den[0] == 0.0:
+        raise ValueError(f"`den` must have a non-zero leading coefficient; got {den!r}")
+    if num.size > den.size:
+        raise ValueError(
+            f"`num` must not be longer than `den` (an improper transfer function "
+            f"has no state-space realisation); got {num.size} and {den.size}"
+        )
+    if rtol is not None and not (np.isfinite(rtol) and 0.0 < rtol < 1.0):
+        raise ValueError(f"`rtol` must be in (0, 1); got {rtol!r}")
+    a, b, c, _ = signal.tf2ss(num, den)
+    n = a.shape[0]
+    poles = np.roots(den)
+    zeros = np.roots(num) if np.any(num != 0.0) else np.array([])
+    dist = (
+        float(np.min(np.abs(poles[:, None] - zeros[None, :])))
+        if poles.size and zeros.size
+        else float("inf")
+    )
+    if n == 0:
+        return Realization(0, 0, 0, True, True, 1.0, 1.0, dist)
+    ctrb = np.empty((n, n))
+    obsv = np.empty((n, n))
+    col, row = b[:, 0], c[0]
+    for k in range(n):
+        ctrb[:, k] = col
+        obsv[k] = row
+        col, row = a @ col, row @ a
+    rc, sc = _rank(ctrb, rtol)
+    ro, so = _rank(obsv, rtol)
+    return Realization(n, rc, ro, rc == n, ro == n, sc, so, dist)
+
+
+# -- validation -------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Validation:
+    """Everything :func:`validate` found out about a model on a record.
+
+    Time-domain figures come in pairs: the free-run simulation (the primary
+    one, the paper's validation) and the one-step prediction (``*_one_step``).
+    Errors are ``y - yhat``.
+
+    Attributes
+    ----------
+    label : str
+        Name of the model (for tables and legends).
+    n_samples : int
+        Length N of the record.
+    ts : float
+        Sample time in seconds.
+    fit_percent, fit_percent_one_step : float
+        MATLAB ``compare`` fit, ``100 (1 - ||e|| / ||y - mean(y)||)``.
+    rmse, rmse_one_step : float
+        Root-mean-square error.
+    cost : float
+        The paper's eq. (2)-(3) on this record with the model's predictor and
+        gain (with ``gain="auto"`` it is ``100 rms(e) / rms(y)``, a percentage,
+        and includes the stability penalty when the model is unstable).
+    cost_predictor : str
+        Which error ``cost`` measures (``"simulation"`` or ``"one-step"``).
+    error_range, error_range_one_step : tuple of float
+        ``(min, max)`` of the error, as in the paper's Table-2.
+    residuals : str
+        Which error the correlation tests used (``"one-step"``, the model's
+        innovations as MATLAB's ``resid`` takes them, or ``"simulation"``).
+    whiteness, independence : CorrelationTest
+        Residual autocorrelation (lags 1..L) and input-residual
+        cross-correlation (lags -L..L).
+    psd_measured, psd_model : PSD
+        Welch spectra of the measured and the simulated output.
+    peaks_measured, peaks_model : Peaks
+        Their most prominent resonance peaks.
+    modes : Modes
+        Lightly damped modes of the model, from its poles.
+    stable : bool
+        All poles strictly inside the unit circle.
+    max_pole_radius : float
+        Largest ``|p|``.
+    realization : Realization
+        Controllability / observability of the state-space realisation.
+    poles, zeros : ndarray of complex
+        Of the transfer function in ``z``.
+    t, u, y, y_sim, y_pred : ndarray
+        Time axis and signals, for plots.
+    """
+
+    label: str
+    n_samples: int
+    ts: float
+    fit_percent: float
+    fit_percent_one_step: float
+    rmse: float
+    rmse_one_step: float
+    cost: float
+    cost_predictor: str
+    error_range: tuple[float, float]
+    error_range_one_step: tuple[float, float]
+    residuals: str
+    whiteness: CorrelationTest
+    independence: CorrelationTest
+    psd_measured: PSD
+    psd_model: PSD
+    peaks_measured: Peaks
+    peaks_model: Peaks
+    modes: Modes
+    stable: bool
+    max_pole_radius: float
+    realization: Realization
+    poles: np.ndarray
+    zeros: np.ndarray
+    t: np.ndarray
+    u: np.ndarray
+    y: np.ndarray
+    y_sim: np.ndarray
+    y_pred: np.ndarray
+
+    @property
+    def error(self) -> np.ndarray:
+        """Free-run simulation error ``y - y_sim``."""
+        return self.y - self.y_sim
+
+    @property
+    def error_one_step(self) -> np.ndarray:
+        """One-step prediction error ``y - y_pred``."""
+        return self.y - self.y_pred
+
+    def summary(self) -> str:
+        """A plain-text table of the results."""
+
+        def verdict(test: CorrelationTest) -> str:
+            parts = [
+                f"{'pass' if test.passed[lv] else 'FAIL'} at {100 * lv:g} %"
+                for lv in test.levels
+            ]
+            return f"{', '.join(parts)} (p = {test.p_value:.3g})"
+
+        def hz(x) -> str:
+            return ", ".join(f"{v:.2f}" for v in x) or "none"
+
+        rz = self.realization
+        rows = [
+            ("samples (N), ts", f"{self.n_samples}, {self.ts:g} s"),
+            ("fit % (simulation)", f"{self.fit_percent:.2f}"),
+            ("fit % (one-step)", f"{self.fit_percent_one_step:.2f}"),
+            ("RMSE (simulation)", f"{self.rmse:.4g}"),
+            ("RMSE (one-step)", f"{self.rmse_one_step:.4g}"),
+            (f"paper cost, eq. (2) ({self.cost_predictor})", f"{self.cost:.4g}"),
+            (
+                "error range (simulation)",
+                f"[{self.error_range[0]:.4f}, {self.error_range[1]:.4f}]",
+            ),
+            (
+                "error range (one-step)",
+                f"[{self.error_range_one_step[0]:.4f}, "
+                f"{self.error_range_one_step[1]:.4f}]",
+            ),
+            (f"whiteness ({self.residuals} residual)", verdict(self.whiteness)),
+            ("input-residual independence", verdict(self.independence)),
+            ("PSD peaks, measured (Hz)", hz(self.peaks_measured.frequency)),
+            ("PSD peaks, model (Hz)", hz(self.peaks_model.frequency)),
+            (
+                "model modes (Hz, damping)",
+                ", ".join(
+                    f"{f:.2f} ({z:.3f})"
+                    for f, z in zip(
+                        self.modes.frequency, self.modes.damping, strict=True
+                    )
+                )
+                or "none",
+            ),
+            ("PSD resolution (Hz)", f"{self.psd_measured.resolution:.3g}"),
+            ("stable (max |pole|)", f"{self.stable} ({self.max_pole_radius:.4f})"),
+            (
+                "controllable / observable",
+                f"{rz.controllable} / {rz.observable} (order {rz.order})",
+            ),
+            ("min |pole - zero|", f"{rz.min_pole_zero_distance:.3g}"),
+        ]
+        width = max(len(k) for k, _ in rows)
+        title = f"Validation of {self.label}" if self.label else "Validation"
+        lines = [title, "-" * max(len(title), width + 30)]
+        lines += [f"{k:<{width}}  {v}" for k, v in rows]
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.summary()
+
+    def to_dict(self, *, signals: bool = False) -> dict:
+        """JSON-safe dictionary; ``signals=True`` adds the time series."""
+
+        def cplx(z):
+            return [[float(v.real), float(v.imag)] for v in np.asarray(z)]
+
+        out = {
+            "label": self.label,
+            "n_samples": int(self.n_samples),
+            "ts": float(self.ts),
+            "fit_percent": float(self.fit_percent),
+            "fit_percent_one_step": float(self.fit_percent_one_step),
+            "rmse": float(self.rmse),
+            "rmse_one_step": float(self.rmse_one_step),
+            "cost": float(self.cost),
+            "cost_predictor": self.cost_predictor,
+            "error_range": [float(v) for v in self.error_range],
+            "error_range_one_step": [float(v) for v in self.error_range_one_step],
+            "residuals": self.residuals,
+            "whiteness": self.whiteness.to_dict(),
+            "independence": self.independence.to_dict(),
+            "psd_resolution_hz": float(self.psd_measured.resolution),
+            "psd_nperseg": int(self.psd_measured.nperseg),
+            "peaks_measured_hz": [float(v) for v in self.peaks_measured.frequency],
+            "peaks_model_hz": [float(v) for v in self.peaks_model.frequency],
+            "modes": self.modes.to_dict(),
+            "stable": bool(self.stable),
+            "max_pole_radius": float(self.max_pole_radius),
+            "realization": self.realization.to_dict(),
+            "poles": cplx(self.poles),
+            "zeros": cplx(self.zeros),
+        }
+        if signals:
+            for name in ("t", "u", "y", "y_sim", "y_pred"):
+                out[name] = [float(v) for v in getattr(self, name)]
+        return out
+
+    def plot(self) -> dict:
+        """Figures of this validation.
+
+        Returns
+        -------
+        dict of matplotlib.figure.Figure
+            ``"time"`` (measured vs simulated output and error),
+            ``"residuals"`` (correlations with bands), ``"spectrum"`` (PSDs
+            with peaks and modes) and ``"pole_zero"`` (map with unit circle).
+        """
+        from . import plots
+
+        name = self.label or "model"
+        return {
+            "time": plots.plot_time_response(
+                self.t, self.y, {name: self.y_sim}, title="Validation, free run"
+            ),
+            "residuals": plots.plot_residual_tests(self.whiteness, self.independence),
+            "spectrum": plots.plot_psd(
+                self.psd_measured,
+                {name: self.psd_model},
+                peaks=self.peaks_measured,
+                modes={name: self.modes},
+            ),
+            "pole_zero": plots.plot_pole_zero({name: (self.poles, self.zeros)}),
+        }
+
+
+def _attr(obj, name):
+    val = getattr(obj, name)
+    return val() if callable(val) else val
+
+
+def _signals_of(data):
+    for attr in ("u", "y", "ts"):
+        if not hasattr(data, attr):
+            raise ValueError(
+                f"`data` must be an IOData (with .u, .y, .ts); "
+                f"got {type(data).__name__}"
+            )
+    u = np.asarray(data.u, dtype=float).ravel()
+    y = np.asarray(data.y, dtype=float).ravel()
+    if u.size != y.size:
+        raise ValueError(
+            f"`data` must have input and output of the same length; "
+            f"got {u.size} and {y.size}"
+        )
+    return u, y, float(data.ts)
+
+
+def validate(
+    model,
+    data,
+    *,
+    lags: int = 25,
+    n_peaks: int = 3,
+    levels=(0.95, 0.99),
+    residuals: str = "one-step",
+    nperseg: int | None = None,
+    max_damping: float = 0.3,
+    gain="auto",
+    warmup=None,
+    label: str | None = None,
+) -> Validation:
+    """Validate an identified model on a record (the paper's validation phase).
+
+    Parameters
+    ----------
+    model : IdentifiedModel
+        From :func:`~spiralid.sysid.identify` (anything with ``theta``,
+        ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
+        ``predict(data)``, ``poles``, ``zeros``).
+    data : IOData
+        The validation record, usually the last third (DESIGN.md item 11).
+        The model is run from zero initial conditions over it.
+    lags : int, default 25
+        Correlation lags: autocorrelation at ``1..lags``, cross-correlation at
+        ``-lags..lags``; ``1 <= lags < N``.
+    n_peaks : int, default 3
+        Resonance peaks to find in each spectrum (three modes in 0-100 Hz for
+        the paper's arm).
+    levels : sequence of float, default (0.95, 0.99)
+        Confidence levels of the correlation bands and verdicts.
+    residuals : {"one-step", "simulation"}, default "one-step"
+        Which error the correlation tests examine. The one-step prediction
+        error is the ARX model's own estimate of its innovations, which is
+        what MATLAB's ``resid`` tests; the simulation error is the
+        output-error view.
+    nperseg : int, optional
+        Welch segment length; default :func:`~spiralid.sysid.spectra.default_nperseg`.
+    max_damping : float, default 0.3
+        Model modes with a damping ratio below this are listed.
+    gain : "auto", "model" or float, default "auto"
+        Gain ``w`` of the paper's cost on this record. ``"auto"`` recomputes
+        it on ``data`` (``w = 100 sqrt(K) / rms(y)``), so the cost is
+        ``100 rms(e) / rms(y)``, a percentage comparable between records.
+        ``"model"`` reuses the model's own ``w`` (fixed on the estimation
+        record, so on another record the cost is scaled by
+        ``sqrt(K_est / K) rms(y_est) / rms(y)``); a number is used as given.
+    warmup : IOData, optional
+        The record that immediately precedes ``data`` (typically the
+        estimation part). The model is run over it first and only the
+        ``data`` part is scored, so the validation starts from the state the
+        model has reached rather than from rest. Default: zero initial
+        conditions, as the paper applies the input to the model.
+    label : str, optional
+        Name for tables and legends; default the model's ``method``.
+
+    Returns
+    -------
+    Validation
+
+    Raises
+    ------
+    ValueError
+        ``lags`` outside ``[1, N - 1]``, unknown ``residuals``, mismatched
+        signal lengths, or a sample time of the data that differs from the
+        model's.
+
+    Notes
+    -----
+    The cost is :class:`~spiralid.sysid.PaperCost` on ``data`` with the
+    model's predictor and penalty and the gain chosen by ``gain`` (eq.
+    (2)-(3)). An unstable model's cost carries the penalty, as in the search.
+    """
+    u, y, ts = _signals_of(data)
+    n = y.size
+    if isinstance(lags, bool) or not isinstance(lags, int | np.integer):
+        raise ValueError(f"`lags` must be an integer; got {lags!r}")
+    if not 1 <= lags < n:
+        raise ValueError(
+            f"`lags` must be in [1, N - 1] = [1, {n - 1}] for a record of "
+            f"N = {n} samples; got {lags!r}"
+        )
+    if residuals not in _RESIDUALS:
+        raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
+    model_ts = getattr(model, "ts", None)
+    if model_ts is not None and not np.isclose(float(model_ts), ts, rtol=1e-9):
+        raise ValueError(
+            f"`data` sample time must match the model's ts = {float(model_ts)!r}; "
+            f"got ts = {ts!r}"
+        )
+
+    if warmup is None:
+        y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
+        y_pred = np.asarray(model.predict(data), dtype=float).ravel()
+    else:
+        wu, wy, wts = _signals_of(warmup)
+        if not np.isclose(wts, ts, rtol=1e-9):
+            raise ValueError(
+                f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
+            )
+        whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
+        y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[wu.size :]
+        y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[wu.size :]
+    y, y_sim = _pair(y, y_sim, "data.y", "model.simulate(data.u)")
+    y, y_pred = _pair(y, y_pred, "data.y", "model.predict(data)")
+    e_sim, e_pred = y - y_sim, y - y_pred
+
+    from .cost import PaperCost
+
+    predictor = getattr(model, "predictor", None) or "simulation"
+    gain = getattr(model, "gain", None)
+    gain = "auto" if gain is None else gain
+    cost = float(
+        PaperCost(model.arx, data, predictor=predictor, gain=gain)(model.theta)
+    )
+
+    e_test = e_pred if residuals == "one-step" else e_sim
+    white = whiteness_test(e_test, lags, levels)
+    indep = independence_test(u, e_test, lags, levels)
+
+    fs = 1.0 / ts
+    spec_y = psd(y, fs, nperseg=nperseg)
+    spec_m = psd(y_sim, fs, nperseg=nperseg)
+
+    poles = np.asarray(_attr(model, "poles"), dtype=complex)
+    zeros = np.asarray(_attr(model, "zeros"), dtype=complex)
+    num, den = model.arx.polynomials(model.theta)
+    label = label if label is not None else str(getattr(model, "method", "") or "")
+
+    return Validation(
+        label=label,
+        n_samples=n,
+        ts=ts,
+        fit_percent=fit_percent(y, y_sim),
+        fit_percent_one_step=fit_percent(y, y_pred),
+        rmse=rmse(y, y_sim),
+        rmse_one_step=rmse(y, y_pred),
+        cost=cost,
+        cost_predictor=predictor,
+        error_range=(float(e_sim.min()), float(e_sim.max())),
+        error_range_one_step=(float(e_pred.min()), float(e_pred.max())),
+        residuals=residuals,
+        whiteness=white,
+        independence=indep,
+        psd_measured=spec_y,
+        psd_model=spec_m,
+        peaks_measured=find_resonances(spec_y, n_peaks),
+        peaks_model=find_resonances(spec_m, n_peaks),
+        modes=modes_from_poles(poles, ts, max_damping=max_damping),
+        stable=bool(poles.size == 0 or np.max(np.abs(poles)) < 1.0),
+        max_pole_radius=float(np.max(np.abs(poles))) if poles.size else 0.0,
+        realization=realization_tests(num, den),
+        poles=poles,
+        zeros=zeros,
+        t=np.arange(n) * ts,
+        u=u,
+        y=y,
+        y_sim=y_sim,
+        y_pred=y_pred,
+    )
