@@ -1,0 +1,481 @@
+"""Figures for identification and validation (the paper's Figures 6 and 7).
+
+Every function returns a new :class:`matplotlib.figure.Figure` and never
+calls ``show()``; the figures are built with the object-oriented API
+(:class:`~matplotlib.figure.Figure`, not ``pyplot``), so nothing is
+registered with a GUI backend and nothing leaks between calls.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .correlation import CorrelationTest
+from .spectra import PSD, Modes, Peaks
+
+__all__ = [
+    "plot_convergence",
+    "plot_pole_zero",
+    "plot_psd",
+    "plot_residual_tests",
+    "plot_time_response",
+]
+
+
+def _outputs(outputs, n: int, name: str = "outputs") -> dict[str, np.ndarray]:
+    if not isinstance(outputs, Mapping):
+        outputs = {"model": outputs}
+    out = {}
+    for label, yhat in outputs.items():
+        arr = np.asarray(yhat, dtype=float).ravel()
+        if arr.size != n:
+            raise ValueError(
+                f"`{name}` must hold signals as long as `y` ({n} samples); "
+                f"got {arr.size} for {label!r}"
+            )
+        out[str(label)] = arr
+    return out
+
+
+def plot_time_response(
+    t,
+    y,
+    outputs,
+    *,
+    error: bool = True,
+    title: str | None = None,
+    ylabel: str = "output",
+) -> Figure:
+    """Measured output against one or several model outputs, and their errors.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Time in seconds.
+    y : array_like, shape (N,)
+        Measured output.
+    outputs : array_like or mapping of str to array_like
+        Model output(s), each of shape (N,); a mapping gives legend labels.
+    error : bool, default True
+        Add a second axes with the errors ``y - yhat`` (the paper's
+        Figures 6c and 7b).
+    title, ylabel : str, optional
+        Labels.
+
+    Returns
+    -------
+    Figure
+        One axes (response) or two (response, error), sharing the time axis.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(100) * 0.01
+    >>> fig = plot_time_response(t, np.sin(t), {"A": np.sin(t) + 0.1})
+    >>> len(fig.axes), len(fig.axes[0].lines)
+    (2, 2)
+    """
+    t = np.asarray(t, dtype=float).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    if t.size != y.size:
+        raise ValueError(
+            f"`t` and `y` must have the same length; got {t.size} and {y.size}"
+        )
+    outs = _outputs(outputs, y.size)
+    fig = Figure(figsize=(8, 5.5 if error else 3.5), layout="constrained")
+    axes = fig.subplots(2 if error else 1, 1, sharex=True, squeeze=False)[:, 0]
+    ax = axes[0]
+    ax.plot(t, y, color="k", lw=1.2, label="measured")
+    for label, yhat in outs.items():
+        ax.plot(t, yhat, lw=1.0, label=label)
+    ax.set_ylabel(ylabel)
+    ax.legend(loc="best", fontsize="small")
+    if title:
+        ax.set_title(title)
+    if error:
+        ax = axes[1]
+        for label, yhat in outs.items():
+            ax.plot(t, y - yhat, lw=0.9, label=label)
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set_ylabel("error")
+        ax.legend(loc="best", fontsize="small")
+    axes[-1].set_xlabel("time (s)")
+    return fig
+
+
+def plot_residual_tests(*tests: CorrelationTest) -> Figure:
+    """Residual correlations with their confidence bands, one axes per test.
+
+    Each test (from :func:`~spiralid.sysid.correlation.whiteness_test` or
+    :func:`~spiralid.sysid.correlation.independence_test`) is drawn as stems
+    with dashed ``+-z/sqrt(N)`` bands for each of its levels, and its verdict
+    in the title, as MATLAB's ``resid`` lays them out.
+
+    Returns
+    -------
+    Figure
+        ``len(tests)`` axes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from spiralid.sysid.correlation import independence_test, whiteness_test
+    >>> rng = np.random.default_rng(0)
+    >>> u, e = rng.standard_normal(500), rng.standard_normal(500)
+    >>> fig = plot_residual_tests(whiteness_test(e), independence_test(u, e))
+    >>> len(fig.axes)
+    2
+    """
+    if not tests:
+        raise ValueError("`tests` must contain at least one CorrelationTest; got none")
+    for i, tst in enumerate(tests):
+        if not isinstance(tst, CorrelationTest):
+            raise ValueError(
+                f"`tests` must be CorrelationTest objects; got "
+                f"{type(tst).__name__} at position {i}"
+            )
+    fig = Figure(figsize=(8, 2.8 * len(tests)), layout="constrained")
+    axes = fig.subplots(len(tests), 1, squeeze=False)[:, 0]
+    styles = ("--", ":", "-.")
+    for ax, tst in zip(axes, tests, strict=True):
+        ax.stem(tst.lags, tst.values, basefmt=" ")
+        for j, lv in enumerate(tst.levels):
+            b = tst.bands[lv]
+            ls = styles[j % len(styles)]
+            ax.axhline(b, color="r", ls=ls, lw=0.9, label=f"{100 * lv:g} % band")
+            ax.axhline(-b, color="r", ls=ls, lw=0.9)
+        verdict = ", ".join(
+            f"{'pass' if tst.passed[lv] else 'fail'} {100 * lv:g} %"
+            for lv in tst.levels
+        )
+        what = (
+            "Residual autocorrelation"
+            if tst.kind == "autocorrelation"
+            else "Input-residual cross-correlation"
+        )
+        ax.set_title(f"{what}: {verdict} (p = {tst.p_value:.3g})", fontsize="medium")
+        ax.set_xlabel("lag (samples)")
+        ax.legend(loc="upper right", fontsize="small")
+    return fig
+
+
+def plot_psd(
+    measured: PSD,
+    models: Mapping[str, PSD] | PSD | None = None,
+    *,
+    peaks: Peaks | None = None,
+    modes: Mapping[str, Modes] | None = None,
+    fmax: float | None = None,
+) -> Figure:
+    """Power spectral densities of measured and model outputs (dB), with modes.
+
+    The paper's Figure 7c. Measured peaks are marked with dots on the measured
+    curve and labelled in Hz; each model's modes from its poles are marked as
+    vertical dotted lines in that model's colour.
+
+    Parameters
+    ----------
+    measured : PSD
+        Spectrum of the measured output.
+    models : PSD or mapping of str to PSD, optional
+        Spectra of model outputs.
+    peaks : Peaks, optional
+        Peaks of the measured spectrum to mark.
+    modes : mapping of str to Modes, optional
+        Model resonances to mark, keyed like ``models``.
+    fmax : float, optional
+        Upper frequency limit of the plot (default ``fs/2``).
+
+    Returns
+    -------
+    Figure
+        One axes.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from spiralid.sysid.spectra import psd
+    >>> x = np.random.default_rng(0).standard_normal(1024)
+    >>> fig = plot_psd(psd(x, 100.0), {"model": psd(0.5 * x, 100.0)})
+    >>> len(fig.axes), len(fig.axes[0].lines)
+    (1, 2)
+    """
+    if not isinstance(measured, PSD):
+        raise ValueError(f"`measured` must be a PSD; got {type(measured).__name__}")
+    if models is None:
+        models = {}
+    elif isinstance(models, PSD):
+        models = {"model": models}
+    tiny = np.finfo(float).tiny
+    fig = Figure(figsize=(8, 4), layout="constrained")
+    ax = fig.subplots()
+    ax.plot(
+        measured.f,
+        10 * np.log10(np.maximum(measured.p, tiny)),
+        color="k",
+        lw=1.2,
+        label="measured",
+    )
+    colours = {}
+    for label, spec in models.items():
+        (line,) = ax.plot(
+            spec.f, 10 * np.log10(np.maximum(spec.p, tiny)), lw=1.0, label=label
+        )
+        colours[label] = line.get_color()
+    if peaks is not None and peaks.frequency.size:
+        ax.plot(peaks.frequency, peaks.level_db, "o", color="k", ms=5, label="_peaks")
+        for f, lv in zip(peaks.frequency, peaks.level_db, strict=True):
+            ax.annotate(
+                f"{f:.2f} Hz",
+                (f, lv),
+                textcoords="offset points",
+                xytext=(4, 6),
+                fontsize="small",
+            )
+    for label, md in (modes or {}).items():
+        colour = colours.get(label, "tab:gray")
+        for f in md.frequency:
+            ax.axvline(f, color=colour, ls=":", lw=0.9)
+    ax.set_xlim(0.0, measured.fs / 2.0 if fmax is None else float(fmax))
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("PSD (dB/Hz)")
+    ax.set_title(f"Welch PSD (resolution {measured.resolution:.3g} Hz)")
+    ax.legend(loc="best", fontsize="small")
+    return fig
+
+
+def plot_pole_zero(models) -> Figure:
+    """Pole-zero map in the z-plane with the unit circle, for several models.
+
+    Parameters
+    ----------
+    models : mapping of str to (poles, zeros)
+        Poles are drawn as crosses and zeros as circles, one colour per model.
+        Objects with ``poles`` and ``zeros`` attributes (an
+        ``IdentifiedModel``) are accepted in place of the pair.
+
+    Returns
+    -------
+    Figure
+        One axes with equal aspect.
+
+    Examples
+    --------
+    >>> fig = plot_pole_zero({"A": ([0.5 + 0.5j, 0.5 - 0.5j], [0.0])})
+    >>> len(fig.axes)
+    1
+    """
+    if not isinstance(models, Mapping):
+        raise ValueError(
+            f"`models` must be a mapping of label to (poles, zeros); "
+            f"got {type(models).__name__}"
+        )
+    fig = Figure(figsize=(5.5, 5.5), layout="constrained")
+    ax = fig.subplots()
+    w = np.linspace(0.0, 2 * np.pi, 361)
+    ax.plot(np.cos(w), np.sin(w), color="k", lw=0.8, label="_unit circle")
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    ax.axvline(0.0, color="0.7", lw=0.5)
+    for label, pz in models.items():
+        if hasattr(pz, "poles") and hasattr(pz, "zeros"):
+            p, z = pz.poles, pz.zeros
+        else:
+            try:
+                p, z = pz
+            except (TypeError, ValueError):
+                raise ValueError(
+                    f"`models` values must be (poles, zeros) pairs; got {pz!r} "
+                    f"for {label!r}"
+                ) from None
+        p = np.atleast_1d(np.asarray(p, dtype=complex))
+        z = np.atleast_1d(np.asarray(z, dtype=complex))
+        (line,) = ax.plot(p.real, p.imag, "x", ms=8, mew=1.5, label=f"{label} poles")
+        ax.plot(
+            z.real,
+            z.imag,
+            "o",
+            ms=7,
+            mfc="none",
+            color=line.get_color(),
+            label=f"{label} zeros",
+        )
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("Re z")
+    ax.set_ylabel("Im z")
+    ax.set_title("Pole-zero map")
+    ax.legend(loc="best", fontsize="small")
+    return fig
+
+
+def _step_on_grid(times: np.ndarray, values: np.ndarray, grid: np.ndarray):
+    # Best-so-far is a step function: at time g it is the last value logged
+    # at or before g (NaN before the first log).
+    idx = np.searchsorted(times, grid, side="right") - 1
+    out = np.full(grid.shape, np.nan)
+    ok = idx >= 0
+    out[ok] = values[idx[ok]]
+    return out
+
+
+def _runs(value, name: str) -> list[np.ndarray]:
+    if hasattr(value, "history"):
+        value = value.history
+    if isinstance(value, np.ndarray) and value.ndim == 1:
+        runs = [value]
+    elif isinstance(value, np.ndarray) and value.ndim == 2:
+        runs = list(value)
+    elif isinstance(value, Sequence) and value and np.ndim(value[0]) == 0:
+        runs = [np.asarray(value)]
+    else:
+        runs = [np.asarray(getattr(v, "history", v)) for v in value]
+    out = []
+    for r in runs:
+        r = np.asarray(r, dtype=float).ravel()
+        if r.size == 0:
+            raise ValueError(
+                f"`{name}` must hold non-empty histories; got an empty one"
+            )
+        out.append(r)
+    return out
+
+
+def plot_convergence(
+    histories,
+    *,
+    times=None,
+    log: bool = True,
+    band: tuple[float, float] = (25.0, 75.0),
+) -> Figure:
+    """Best cost against iteration (and wall time), one curve per method.
+
+    The paper's Figure 6a. With several histories for a method (one per seed)
+    the median is drawn with a shaded band between the ``band`` percentiles
+    (the interquartile range by default); with one, the history itself.
+
+    Parameters
+    ----------
+    histories : mapping of str to history or list of histories
+        A history is the best cost after each iteration, index 0 the initial
+        population (``SpiralResult.history``); a result object with a
+        ``history`` attribute is accepted in its place. Histories of one method
+        may differ in length; the statistics at an iteration use the runs that
+        reached it.
+    times : mapping of str to (float or array or list of those), optional
+        Wall time per method, keyed like ``histories``: for each run either
+        the total search time in seconds (iterations then taken as evenly
+        spaced in time) or the time of every history entry. Adds a second axes
+        of best cost against time, where runs are compared on a common time
+        grid as step functions.
+    log : bool, default True
+        Logarithmic cost axis.
+    band : (float, float), default (25, 75)
+        Percentiles of the shaded band.
+
+    Returns
+    -------
+    Figure
+        One axes (vs iteration) or two (vs iteration, vs time).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = [np.geomspace(10, 1, 51), np.geomspace(20, 2, 51)]
+    >>> fig = plot_convergence({"Eb-SDA": h}, times={"Eb-SDA": [1.0, 1.2]})
+    >>> len(fig.axes)
+    2
+    """
+    if not isinstance(histories, Mapping) or not histories:
+        raise ValueError(
+            "`histories` must be a non-empty mapping of label to history "
+            f"(or list of histories); got {histories!r:.60}"
+        )
+    lo_q, hi_q = band
+    if not 0.0 <= lo_q < hi_q <= 100.0:
+        raise ValueError(
+            f"`band` must be percentiles 0 <= lo < hi <= 100; got {band!r}"
+        )
+    runs = {str(k): _runs(v, "histories") for k, v in histories.items()}
+    time_runs = {}
+    if times is not None:
+        if not isinstance(times, Mapping) or set(map(str, times)) != set(runs):
+            raise ValueError(
+                "`times` must be a mapping with the same labels as `histories` "
+                f"({sorted(runs)}); got {times!r:.80}"
+            )
+        for k, v in times.items():
+            k = str(k)
+            if len(runs[k]) == 1:
+                # One run: its total, its per-entry times, or a one-item list.
+                per = [v[0]] if np.ndim(v) == 1 and np.size(v) == 1 else [v]
+            elif np.ndim(v) == 0:
+                per = [v]  # rejected below: one entry for several runs
+            else:
+                per = list(v)
+            if len(per) != len(runs[k]):
+                raise ValueError(
+                    f"`times` for {k!r} must give one entry per history "
+                    f"({len(runs[k])}); got {len(per)}"
+                )
+            tr = []
+            for tv, h in zip(per, runs[k], strict=True):
+                if np.ndim(tv) == 0:
+                    total = float(tv)
+                    if not (np.isfinite(total) and total > 0):
+                        raise ValueError(
+                            f"`times` totals must be positive; got {tv!r} for {k!r}"
+                        )
+                    tr.append(np.linspace(0.0, total, h.size))
+                else:
+                    tv = np.asarray(tv, dtype=float).ravel()
+                    if tv.size != h.size or np.any(np.diff(tv) < 0):
+                        raise ValueError(
+                            f"`times` for {k!r} must be non-decreasing and as long "
+                            f"as its history ({h.size}); got {tv.size} entries"
+                        )
+                    tr.append(tv)
+            time_runs[k] = tr
+
+    fig = Figure(figsize=(8, 6.5 if time_runs else 3.8), layout="constrained")
+    axes = fig.subplots(2 if time_runs else 1, 1, squeeze=False)[:, 0]
+
+    def draw(ax, x, stack, label):
+        if stack.shape[0] == 1:
+            ax.plot(x, stack[0], lw=1.2, label=label)
+            return
+        count = np.sum(np.isfinite(stack), axis=0)
+        ok = count > 0
+        x, stack = x[ok], stack[:, ok]
+        med = np.nanmedian(stack, axis=0)
+        lo = np.nanpercentile(stack, lo_q, axis=0)
+        hi = np.nanpercentile(stack, hi_q, axis=0)
+        (line,) = ax.plot(x, med, lw=1.2, label=f"{label} (median of {len(stack)})")
+        ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.25, lw=0)
+
+    for label, hs in runs.items():
+        n = max(h.size for h in hs)
+        stack = np.full((len(hs), n), np.nan)
+        for i, h in enumerate(hs):
+            stack[i, : h.size] = h
+        draw(axes[0], np.arange(n), stack, label)
+    axes[0].set_xlabel("iteration")
+    if time_runs:
+        ax = axes[1]
+        for label, hs in runs.items():
+            tr = time_runs[label]
+            end = max(t[-1] for t in tr)
+            grid = np.linspace(0.0, end, 400) if len(hs) > 1 else tr[0]
+            stack = np.vstack(
+                [_step_on_grid(t, h, grid) for t, h in zip(tr, hs, strict=True)]
+            )
+            draw(ax, grid, stack, label)
+        ax.set_xlabel("wall time (s)")
+    for ax in axes:
+        ax.set_ylabel("best cost")
+        if log:
+            ax.set_yscale("log")
+        ax.legend(loc="best", fontsize="small")
+    axes[0].set_title("Convergence")
+    return fig
