@@ -1,0 +1,469 @@
+"""The single-link flexible manipulator rig: modes and sampled simulation.
+
+Default constants are those of the University of Sheffield rig used in the
+paper (its reference [13]), as reported by Azad (1994, PhD thesis, Sheffield)
+and Tokhi & Azad (e.g. "Control of flexible manipulator systems", Proc. IMechE
+Part I 210, 1996; "Flexible Robot Manipulators", IET 2008): an aluminium beam
+of 900 x 19.008 x 3.2004 mm, E = 71 GPa, rho = 2710 kg/m^3, hub inertia
+5.86e-4 kg m^2.  The damping ratio is ours (the sources give none we could
+use; "a few percent" is typical of a bolted aluminium link).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property, lru_cache
+
+import numpy as np
+from scipy.linalg import eigh
+
+from spiralid.fms._zoh import discretise_zoh, simulate_discrete
+from spiralid.fms.beam import assemble
+from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
+
+__all__ = ["FlexibleManipulator", "Recording"]
+
+_OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
+
+
+def _positive(name: str, value: float) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v > 0.0):
+        raise ValueError(f"`{name}` must be a finite number > 0; got {value!r}")
+    return v
+
+
+def _nonneg(name: str, value: float) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v >= 0.0):
+        raise ValueError(f"`{name}` must be a finite number >= 0; got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class Recording:
+    """Sampled signals of one experiment on the rig.
+
+    Sample ``k`` is taken at ``t[k] = k ts``, the instant the torque ``u[k]``
+    starts to be applied (it is held until ``t[k+1]``): states are those
+    reached under ``u[0..k-1]``, and an output with direct feedthrough (the
+    end-point acceleration without anti-aliasing filter) includes ``D u[k]``,
+    the right-hand side of the step, as in ``y = C x + D u``.
+
+    Attributes
+    ----------
+    t : ndarray
+        Sample instants (s).
+    u : ndarray
+        Hub torque (N m).
+    hub_angle : ndarray
+        Hub angle as the encoder reports it (rad).
+    hub_velocity : ndarray
+        Hub angular velocity as the tachometer reports it (rad/s).
+    end_acceleration : ndarray
+        End-point acceleration as the accelerometer reports it (m/s^2):
+        ``L theta'' + w''(L)``.
+    tip_deflection : ndarray
+        Exact tip deflection ``w(L)`` relative to the hub frame (m); not a
+        measured channel.
+    ts : float
+        Sample time (s).
+    state : ndarray or None
+        With ``return_state=True``: the exact ``(q, q')`` in the rig's
+        generalised coordinates at each sample, shape ``(N, 2 ndof)``.
+    """
+
+    t: np.ndarray
+    u: np.ndarray
+    hub_angle: np.ndarray
+    hub_velocity: np.ndarray
+    end_acceleration: np.ndarray
+    tip_deflection: np.ndarray
+    ts: float
+    state: np.ndarray | None = None
+
+    def iodata(self, name: str = "end_acceleration"):
+        """The torque and one output channel as a :class:`spiralid.IOData`.
+
+        ``spiralid.sysid.data`` is imported here, inside the method: it is the
+        one sanctioned dependency of ``fms`` on the rest of the package, kept
+        local so that ``fms`` itself imports nothing of ours.
+
+        Examples
+        --------
+        >>> from spiralid.fms import FlexibleManipulator, bang_bang
+        >>> u = bang_bang(0.3, 0.05, 0.1, 1.0, 500.0)
+        >>> d = FlexibleManipulator().simulate(u).iodata("end_acceleration")
+        >>> d.n, d.ts, d.output_name
+        (500, 0.002, 'end_acceleration')
+        """
+        from spiralid.sysid.data import IOData
+
+        if name not in _OUTPUTS:
+            raise ValueError(f"`name` must be one of {_OUTPUTS}; got {name!r}")
+        return IOData(
+            self.u,
+            getattr(self, name),
+            ts=self.ts,
+            input_name="torque",
+            output_name=name,
+        )
+
+
+@dataclass(frozen=True, kw_only=True)
+class FlexibleManipulator:
+    """Hub-beam-payload finite-element model of the Sheffield rig.
+
+    A rigid hub turning in the horizontal plane drives an aluminium
+    Euler-Bernoulli beam clamped to it, with an optional tip payload.  The
+    beam is split into ``n_elements`` Hermite cubic elements with consistent
+    mass; the hub angle is the first generalised coordinate (see
+    :mod:`spiralid.fms.beam`).
+
+    Parameters
+    ----------
+    length : float
+        Beam length L (m).  Default 0.9 (Azad 1994).
+    width, thickness : float
+        Beam cross-section (m).  Defaults 19.008e-3 and 3.2004e-3 (Azad 1994).
+    youngs_modulus : float
+        E (Pa).  Default 71e9 (aluminium; Azad 1994).
+    density : float
+        rho (kg/m^3).  Default 2710 (aluminium; Azad 1994).
+    hub_inertia : float
+        I_h (kg m^2), > 0.  Default 5.86e-4 (Azad 1994).
+    payload_mass : float
+        Tip point mass m_p (kg).  Default 0 (the paper's experiments).
+    payload_inertia : float
+        Tip payload's own moment of inertia (kg m^2).  Default 0.
+    damping_ratio : float
+        Modal damping ratio of every flexible mode, in [0, 1).  Default 0.02
+        (our choice: "a few percent").  The rigid mode is never damped by it.
+    hub_friction : float
+        Viscous friction at the hub (N m s/rad).  Default 0.
+    n_elements : int
+        Number of beam elements, >= 1.  Default 10.
+
+    Examples
+    --------
+    >>> rig = FlexibleManipulator()
+    >>> np.round(rig.modes(3), 1)
+    array([13.3, 35.1, 64.8])
+    """
+
+    length: float = 0.9
+    width: float = 19.008e-3
+    thickness: float = 3.2004e-3
+    youngs_modulus: float = 71e9
+    density: float = 2710.0
+    hub_inertia: float = 5.86e-4
+    payload_mass: float = 0.0
+    payload_inertia: float = 0.0
+    damping_ratio: float = 0.02
+    hub_friction: float = 0.0
+    n_elements: int = 10
+
+    def __post_init__(self) -> None:
+        for name in (
+            "length",
+            "width",
+            "thickness",
+            "youngs_modulus",
+            "density",
+            "hub_inertia",
+        ):
+            object.__setattr__(self, name, _positive(name, getattr(self, name)))
+        for name in ("payload_mass", "payload_inertia", "hub_friction"):
+            object.__setattr__(self, name, _nonneg(name, getattr(self, name)))
+        z = float(self.damping_ratio)
+        if not (math.isfinite(z) and 0.0 <= z < 1.0):
+            raise ValueError(
+                f"`damping_ratio` must be in [0, 1); got {self.damping_ratio!r}"
+            )
+        object.__setattr__(self, "damping_ratio", z)
+        ne = self.n_elements
+        if isinstance(ne, bool) or not isinstance(ne, int | np.integer) or ne < 1:
+            raise ValueError(f"`n_elements` must be an integer >= 1; got {ne!r}")
+        object.__setattr__(self, "n_elements", int(ne))
+
+    # ------------------------------------------------------------ properties
+    @property
+    def ndof(self) -> int:
+        """Number of generalised coordinates, ``2 n_elements + 1``."""
+        return 2 * self.n_elements + 1
+
+    @property
+    def area(self) -> float:
+        """Cross-section area A (m^2)."""
+        return self.width * self.thickness
+
+    @property
+    def flexural_rigidity(self) -> float:
+        """E I (N m^2), I = width thickness^3 / 12."""
+        return self.youngs_modulus * self.width * self.thickness**3 / 12.0
+
+    @property
+    def total_inertia(self) -> float:
+        """Rigid-body inertia about the hub: I_h + rho A L^3 / 3 + m_p L^2 + J_p."""
+        return float(self.mass_matrix[0, 0])
+
+    @cached_property
+    def _mk(self) -> tuple[np.ndarray, np.ndarray]:
+        M, K = assemble(
+            self.n_elements,
+            self.length,
+            self.flexural_rigidity,
+            self.density * self.area,
+            self.hub_inertia,
+            self.payload_mass,
+            self.payload_inertia,
+        )
+        M.flags.writeable = False
+        K.flags.writeable = False
+        return M, K
+
+    @property
+    def mass_matrix(self) -> np.ndarray:
+        """Consistent mass matrix (read-only), coordinates as in ``beam``."""
+        return self._mk[0]
+
+    @property
+    def stiffness_matrix(self) -> np.ndarray:
+        """Stiffness matrix (read-only); zero row/column for the hub angle."""
+        return self._mk[1]
+
+    @cached_property
+    def _modal(self) -> tuple[np.ndarray, np.ndarray]:
+        """Natural frequencies (rad/s, rigid first) and mass-normalised modes.
+
+        The rigid mode is exactly ``e_theta / sqrt(J)``; the flexible modes
+        are found on the complement that is mass-orthogonal to it (eliminate
+        ``theta'' = -m_tw w'' / J`` from the hub row, leaving the Schur
+        complement mass ``M_ww - m_tw m_tw^T / J``), so no eigenvalue has to
+        be recognised as a numerical zero.
+        """
+        M, K = self._mk
+        J = M[0, 0]
+        mtw = M[0, 1:]
+        meff = M[1:, 1:] - np.outer(mtw, mtw) / J
+        lam, v = eigh(K[1:, 1:], meff)
+        n = self.ndof
+        phi = np.zeros((n, n))
+        phi[0, 0] = 1.0 / math.sqrt(J)
+        phi[1:, 1:] = v
+        phi[0, 1:] = -(mtw @ v) / J
+        omega = np.concatenate([[0.0], np.sqrt(lam)])
+        return omega, phi
+
+    @property
+    def damping_matrix(self) -> np.ndarray:
+        """Damping matrix: modal damping of the flexible modes plus hub friction.
+
+        ``C = M Phi diag(2 zeta w_i) Phi^T M + c_h e_theta e_theta^T`` with
+        the rigid mode's entry zero, so only friction damps the rigid motion.
+        """
+        omega, phi = self._modal
+        mp = self.mass_matrix @ phi
+        C = (mp * (2.0 * self.damping_ratio * omega)) @ mp.T
+        C[0, 0] += self.hub_friction
+        return C
+
+    # --------------------------------------------------------------- methods
+    def modes(self, n: int | None = None) -> np.ndarray:
+        """Undamped natural frequencies of the flexible modes (Hz), ascending.
+
+        Parameters
+        ----------
+        n : int, optional
+            Return only the first ``n``; default all ``2 n_elements``.
+
+        Examples
+        --------
+        >>> FlexibleManipulator(n_elements=20).modes(2).round(2)
+        array([13.31, 35.11])
+        """
+        f = self._modal[0][1:] / (2.0 * math.pi)
+        if n is None:
+            return f
+        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+            raise ValueError(f"`n` must be a positive integer or None; got {n!r}")
+        return f[:n]
+
+    def _plant(self) -> tuple[np.ndarray, ...]:
+        """Continuous model in modal coordinates, scaled for the exponential.
+
+        State ``s = [eta, nu]`` with ``q = Phi eta`` and velocities
+        ``nu_0 = eta_0'`` (rigid), ``nu_i = eta_i' / w_i`` (flexible), so
+        every entry of ``A`` is of order ``w_i`` rather than ``w_i^2``.
+        Returns ``A, B`` and output rows ``(C, D)`` for hub angle, hub
+        velocity, end-point acceleration and tip deflection, plus the
+        velocity scaling.
+        """
+        omega, phi = self._modal
+        n = self.ndof
+        scale = omega.copy()
+        scale[0] = 1.0
+        g = phi[0]  # hub torque's modal participation
+        cm = np.diag(2.0 * self.damping_ratio * omega) + self.hub_friction * np.outer(
+            g, g
+        )
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.diag(scale)
+        A[n:, :n] = -np.diag(omega**2 / scale)
+        A[n:, n:] = -(cm * scale[None, :]) / scale[:, None]
+        B = np.concatenate([np.zeros(n), g / scale])
+        tip = phi[n - 2]
+        h = self.length * phi[0] + tip  # end point's share of each mode
+        C = np.zeros((4, 2 * n))
+        D = np.zeros(4)
+        C[0, :n] = g
+        C[1, n:] = g * scale
+        C[2, :n] = -h * omega**2
+        C[2, n:] = -(h @ cm) * scale
+        D[2] = h @ g
+        C[3, :n] = tip
+        return A, B, C, D, scale
+
+    def simulate(
+        self,
+        torque,
+        fs: float = 500.0,
+        rng=None,
+        *,
+        sensors: Sensors | None = None,
+        x0=None,
+        return_state: bool = False,
+    ) -> Recording:
+        """Drive the hub with a sampled torque held constant between samples.
+
+        The continuous model (plus the anti-aliasing filters) is discretised
+        exactly for a zero-order hold, ``Ad = e^{A ts}``, ``Bd = int e^{As} ds
+        B`` (one matrix exponential), and run in closed form: no numerical
+        ODE integration.
+
+        Parameters
+        ----------
+        torque : array_like, shape (N,) or (N, 1)
+            Hub torque in N m at ``t = k / fs``, held for one sample.
+        fs : float
+            Sample rate in Hz, > 0.
+        rng : None, int or numpy.random.Generator
+            Seed of the sensor noise (only drawn when a noise std is > 0:
+            tachometer first, then accelerometer).
+        sensors : Sensors, optional
+            Instrumentation; default ``Sensors()`` (2048-line x4 encoder, no
+            noise, 4th-order Butterworth anti-aliasing at half Nyquist on the
+            tachometer and accelerometer).  ``Sensors.ideal()`` samples the
+            exact signals.
+        x0 : array_like, shape (2 ndof,), optional
+            Initial ``(q, q')`` in generalised coordinates; default rest.
+            Anti-aliasing filters start at rest.
+        return_state : bool
+            Also return the exact ``(q, q')`` at every sample.
+
+        Returns
+        -------
+        Recording
+
+        Examples
+        --------
+        >>> from spiralid.fms import bang_bang
+        >>> rig = FlexibleManipulator()
+        >>> u = bang_bang(0.3, 0.1, 0.0, 4.0, 500.0)
+        >>> rec = rig.simulate(u, sensors=Sensors.ideal())
+        >>> round(float(rec.hub_angle[-1]) / (0.3 * 0.1**2 / rig.total_inertia), 2)
+        1.0
+        """
+        fs_v = float(fs) if np.isscalar(fs) else math.nan
+        if not (math.isfinite(fs_v) and fs_v > 0.0):
+            raise ValueError(f"`fs` must be a finite number > 0; got {fs!r}")
+        u = np.asarray(torque, dtype=float)
+        if u.ndim == 2 and u.shape[1] == 1:
+            u = u[:, 0]
+        if u.ndim != 1 or u.size == 0:
+            raise ValueError(
+                "`torque` must be a non-empty 1-D array or (N, 1); "
+                f"got shape {np.shape(torque)}"
+            )
+        if not np.all(np.isfinite(u)):
+            bad = int(np.flatnonzero(~np.isfinite(u))[0])
+            raise ValueError(f"`torque` must be finite; got {u[bad]!r} at index {bad}")
+        if sensors is None:
+            sensors = Sensors()
+        elif not isinstance(sensors, Sensors):
+            raise ValueError(f"`sensors` must be a Sensors or None; got {sensors!r}")
+        n = self.ndof
+        if x0 is None:
+            x0v = np.zeros(2 * n)
+        else:
+            x0v = np.asarray(x0, dtype=float).ravel()
+            if x0v.size != 2 * n or not np.all(np.isfinite(x0v)):
+                raise ValueError(
+                    f"`x0` must hold {2 * n} finite numbers (q, q'); "
+                    f"got shape {np.shape(x0)}"
+                )
+        gen = np.random.default_rng(rng)
+
+        ts = 1.0 / fs_v
+        Ad, Bd, C, D, scale = _discrete(
+            self, ts, sensors.antialias_order, sensors.antialias_cutoff
+        )
+        _, phi = self._modal
+        M = self.mass_matrix
+        nx = Ad.shape[0]
+        s0 = np.zeros(nx)
+        s0[:n] = phi.T @ (M @ x0v[:n])
+        s0[n : 2 * n] = (phi.T @ (M @ x0v[n:])) / scale
+        y, s = simulate_discrete(Ad, Bd, C, D, u, s0, return_state)
+
+        hub_velocity = y[:, 1]
+        acc = y[:, 2]
+        if sensors.tach_noise > 0.0:
+            hub_velocity = hub_velocity + gen.normal(0.0, sensors.tach_noise, u.size)
+        if sensors.accel_noise > 0.0:
+            acc = acc + gen.normal(0.0, sensors.accel_noise, u.size)
+        state = None
+        if s is not None:
+            state = np.hstack([s[:, :n] @ phi.T, (s[:, n : 2 * n] * scale) @ phi.T])
+        return Recording(
+            t=np.arange(u.size) * ts,
+            u=u.copy(),
+            hub_angle=quantise(y[:, 0], sensors.encoder_resolution),
+            hub_velocity=hub_velocity,
+            end_acceleration=acc,
+            tip_deflection=y[:, 3].copy(),
+            ts=ts,
+            state=state,
+        )
+
+
+@lru_cache(maxsize=16)
+def _discrete(
+    rig: FlexibleManipulator, ts: float, order: int, cutoff: float
+) -> tuple[np.ndarray, ...]:
+    """Exact ZOH model of the rig plus anti-aliasing filters (cached)."""
+    A, B, C, D, scale = rig._plant()
+    if order > 0:
+        af, bf, cf = butterworth_ss(order, cutoff * 0.5 / ts)
+        npl = A.shape[0]
+        nf = order
+        big = np.zeros((npl + 2 * nf, npl + 2 * nf))
+        bb = np.zeros(npl + 2 * nf)
+        big[:npl, :npl] = A
+        bb[:npl] = B
+        cc = np.zeros((4, npl + 2 * nf))
+        dd = D.copy()
+        cc[[0, 3], :npl] = C[[0, 3]]
+        for k, row in enumerate((1, 2)):
+            sl = slice(npl + k * nf, npl + (k + 1) * nf)
+            big[sl, sl] = af
+            big[sl, :npl] = np.outer(bf, C[row])
+            bb[sl] = bf * D[row]
+            cc[row, sl] = cf
+            dd[row] = 0.0
+        A, B, C, D = big, bb, cc, dd
+    Ad, Bd = discretise_zoh(A, B, ts)
+    for arr in (Ad, Bd, C, D, scale):
+        arr.flags.writeable = False
+    return Ad, Bd, C, D, scale

@@ -1,0 +1,159 @@
+"""Torque inputs for the rig: bang-bang, PRBS and chirp, sampled at ``fs``.
+
+Sample ``k`` is the torque held on ``[k / fs, (k + 1) / fs)``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import signal as _signal
+
+__all__ = ["bang_bang", "chirp", "prbs"]
+
+
+def _finite(name: str, value: float) -> float:
+    v = float(value) if np.isscalar(value) else math.nan
+    if not math.isfinite(v):
+        raise ValueError(f"`{name}` must be a finite number; got {value!r}")
+    return v
+
+
+def _positive(name: str, value: float) -> float:
+    v = float(value) if np.isscalar(value) else math.nan
+    if not (math.isfinite(v) and v > 0.0):
+        raise ValueError(f"`{name}` must be a finite number > 0; got {value!r}")
+    return v
+
+
+def _nsamples(duration: float, fs: float) -> int:
+    duration = _positive("duration", duration)
+    fs = _positive("fs", fs)
+    n = round(duration * fs)
+    if n < 1:
+        raise ValueError(
+            f"`duration` must span at least one sample at fs={fs}; got {duration!r}"
+        )
+    return n
+
+
+def bang_bang(
+    amplitude: float, width: float, start: float, duration: float, fs: float
+) -> np.ndarray:
+    """Bang-bang torque: ``+amplitude`` for ``width`` s, then ``-amplitude``.
+
+    The paper's rig is usually excited this way: the first pulse accelerates
+    the hub, the second brakes it, so a rigid hub would come to rest at
+    ``amplitude width^2 / J``.  Edges fall on the nearest samples.
+
+    Parameters
+    ----------
+    amplitude : float
+        Torque of the first pulse (N m); negative turns the other way.
+    width : float
+        Width of each pulse (s); at least one sample.
+    start : float
+        Time of the first edge (s), >= 0.
+    duration : float
+        Length of the record (s); must contain both pulses.
+    fs : float
+        Sample rate (Hz).
+
+    Examples
+    --------
+    >>> bang_bang(1.0, 0.2, 0.1, 0.6, 10.0)
+    array([ 0.,  1.,  1., -1., -1.,  0.])
+    """
+    amplitude = _finite("amplitude", amplitude)
+    width = _positive("width", width)
+    start = _finite("start", start)
+    if start < 0.0:
+        raise ValueError(f"`start` must be >= 0; got {start!r}")
+    n = _nsamples(duration, fs)
+    w = round(width * fs)
+    if w < 1:
+        raise ValueError(
+            f"`width` must be at least one sample (1/fs = {1 / fs:g} s); got {width!r}"
+        )
+    i0 = round(start * fs)
+    if i0 + 2 * w > n:
+        raise ValueError(
+            f"`duration` must hold both pulses ({(i0 + 2 * w) / fs:g} s); "
+            f"got {duration!r}"
+        )
+    u = np.zeros(n)
+    u[i0 : i0 + w] = amplitude
+    u[i0 + w : i0 + 2 * w] = -amplitude
+    return u
+
+
+def prbs(
+    amplitude: float,
+    duration: float,
+    fs: float,
+    n_bits: int = 10,
+    hold: int = 1,
+) -> np.ndarray:
+    """Pseudo-random binary torque from a maximum-length shift register.
+
+    Each bit of ``scipy.signal.max_len_seq(n_bits)`` (period ``2^n_bits -
+    1`` bits) becomes ``+-amplitude`` held for ``hold`` samples; the sequence
+    repeats to fill ``duration``.  Deterministic: the register starts from
+    all ones.  Note the free hub integrates a PRBS's mean and drift.
+
+    Examples
+    --------
+    >>> prbs(2.0, 0.7, 10.0, n_bits=3)
+    array([ 2.,  2.,  2., -2.,  2., -2., -2.])
+    """
+    amplitude = _finite("amplitude", amplitude)
+    n = _nsamples(duration, fs)
+    if isinstance(n_bits, bool) or not isinstance(n_bits, int | np.integer):
+        raise ValueError(f"`n_bits` must be an integer in [2, 32]; got {n_bits!r}")
+    if not 2 <= n_bits <= 32:
+        raise ValueError(f"`n_bits` must be an integer in [2, 32]; got {n_bits!r}")
+    if isinstance(hold, bool) or not isinstance(hold, int | np.integer) or hold < 1:
+        raise ValueError(f"`hold` must be a positive integer; got {hold!r}")
+    nbits_needed = -(-n // hold)
+    period = 2**n_bits - 1
+    seq, _ = _signal.max_len_seq(int(n_bits), length=min(period, nbits_needed))
+    bits = np.resize(seq, nbits_needed)
+    return amplitude * (2.0 * np.repeat(bits, hold)[:n] - 1.0)
+
+
+def chirp(
+    amplitude: float,
+    f0: float,
+    f1: float,
+    duration: float,
+    fs: float,
+    method: str = "linear",
+) -> np.ndarray:
+    """Swept-sine torque from ``f0`` to ``f1`` Hz over ``duration``.
+
+    ``amplitude * scipy.signal.chirp(t, f0, duration, f1, method)``, with
+    both frequencies at most the Nyquist frequency ``fs / 2``.
+
+    Examples
+    --------
+    >>> chirp(1.0, 0.0, 1.0, 1.0, 4.0).round(3)
+    array([ 1.   ,  0.981,  0.707, -0.195])
+    """
+    amplitude = _finite("amplitude", amplitude)
+    n = _nsamples(duration, fs)
+    fs = float(fs)
+    nyq = 0.5 * fs
+    for name, f in (("f0", f0), ("f1", f1)):
+        v = _finite(name, f)
+        if not 0.0 <= v <= nyq:
+            raise ValueError(f"`{name}` must be in [0, fs/2 = {nyq:g}] Hz; got {f!r}")
+    methods = ("linear", "quadratic", "logarithmic", "hyperbolic")
+    if method not in methods:
+        raise ValueError(f"`method` must be one of {methods}; got {method!r}")
+    if method in ("logarithmic", "hyperbolic") and (float(f0) <= 0 or float(f1) <= 0):
+        raise ValueError(
+            f"`f0` and `f1` must be > 0 for method={method!r}; got {f0!r}, {f1!r}"
+        )
+    t = np.arange(n) / fs
+    return amplitude * _signal.chirp(t, float(f0), float(duration), float(f1), method)
