@@ -21,7 +21,9 @@ from .sysid import ARX as ARX
 from .sysid import IdentifiedModel as IdentifiedModel
 from .sysid import IOData as IOData
 from .sysid import PaperCost as PaperCost
+from .sysid import Validation as Validation
 from .sysid import arx_least_squares as arx_least_squares
 from .sysid import identify as identify
+from .sysid import validate as validate
 
 # --- report ---

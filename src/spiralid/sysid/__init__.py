@@ -16,3 +16,16 @@ from .polynomials import step_down as step_down
 from .polynomials import step_up as step_up
 
 # --- validation (validate, plots) ---
+# isort: split
+from . import plots as plots
+from .correlation import CorrelationTest as CorrelationTest
+from .correlation import independence_test as independence_test
+from .correlation import whiteness_test as whiteness_test
+from .spectra import find_resonances as find_resonances
+from .spectra import modes_from_poles as modes_from_poles
+from .spectra import psd as psd
+from .validate import Realization as Realization
+from .validate import Validation as Validation
+from .validate import fit_percent as fit_percent
+from .validate import realization_tests as realization_tests
+from .validate import validate as validate
