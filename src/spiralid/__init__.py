@@ -16,6 +16,9 @@ except PackageNotFoundError:  # running from a source tree without install
 
 # --- optim ---
 # --- fms ---
+from . import fms as fms
+from .fms import FlexibleManipulator as FlexibleManipulator
+from .fms import Recording as Recording
 # --- sysid ---
 from .sysid import ARX as ARX
 from .sysid import IdentifiedModel as IdentifiedModel
