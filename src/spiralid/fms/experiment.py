@@ -75,7 +75,7 @@ class Experiment:
         --------
         >>> u = paper_experiment().torque()
         >>> u.size, float(u.max()), int(np.count_nonzero(u))
-        (3000, 0.3, 120)
+        (3000, 0.3, 240)
         """
         u = np.zeros(round(self.duration * self.fs))
         for j in range(self.n_pulses):
