@@ -110,7 +110,7 @@ def _as_signal(x, name: str) -> np.ndarray:
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
         raise ValueError(
-            f"`{name}` must be finite; got {arr[bad[0]]!r} at sample {bad[0]}"
+            f"`{name}` must be finite; got {float(arr[bad[0]])!r} at sample {bad[0]}"
         )
     return arr
 

@@ -171,7 +171,7 @@ def psd(x, fs: float, *, nperseg: int | None = None) -> PSD:
         raise ValueError(f"`x` must have at least 2 samples; got {x.size}")
     if not np.all(np.isfinite(x)):
         bad = int(np.flatnonzero(~np.isfinite(x))[0])
-        raise ValueError(f"`x` must be finite; got {x[bad]!r} at sample {bad}")
+        raise ValueError(f"`x` must be finite; got {float(x[bad])!r} at sample {bad}")
     fs = _check_fs(fs)
     if nperseg is None:
         nperseg = default_nperseg(x.size)

@@ -59,7 +59,9 @@ def _pair(y, yhat, name_y="y", name_yhat="yhat") -> tuple[np.ndarray, np.ndarray
     for arr, nm in ((a, name_y), (b, name_yhat)):
         if not np.all(np.isfinite(arr)):
             i = int(np.flatnonzero(~np.isfinite(arr))[0])
-            raise ValueError(f"`{nm}` must be finite; got {arr[i]!r} at sample {i}")
+            raise ValueError(
+                f"`{nm}` must be finite; got {float(arr[i])!r} at sample {i}"
+            )
     return a, b
 
 
