@@ -388,7 +388,9 @@ class FlexibleManipulator:
             )
         if not np.all(np.isfinite(u)):
             bad = int(np.flatnonzero(~np.isfinite(u))[0])
-            raise ValueError(f"`torque` must be finite; got {u[bad]!r} at index {bad}")
+            raise ValueError(
+                f"`torque` must be finite; got {float(u[bad])!r} at index {bad}"
+            )
         if sensors is None:
             sensors = Sensors()
         elif not isinstance(sensors, Sensors):
