@@ -229,7 +229,10 @@ def realization_tests(num, den, *, rtol: float | None = None) -> Realization:
         )
     if rtol is not None and not (np.isfinite(rtol) and 0.0 < rtol < 1.0):
         raise ValueError(f"`rtol` must be in (0, 1); got {rtol!r}")
-    a, b, c, _ = signal.tf2ss(num, den)
+    # Leading zeros of the numerator (input delay nk > 0) are exact; strip them
+    # so that tf2ss does not warn about badly conditioned coefficients.
+    num_trim = np.trim_zeros(num, "f")
+    a, b, c, _ = signal.tf2ss(num_trim if num_trim.size else [0.0], den)
     n = a.shape[0]
     poles = np.roots(den)
     zeros = np.roots(num) if np.any(num != 0.0) else np.array([])
@@ -607,11 +610,19 @@ def validate(
     from .cost import PaperCost
 
     predictor = getattr(model, "predictor", None) or "simulation"
-    gain = getattr(model, "gain", None)
-    gain = "auto" if gain is None else gain
-    cost = float(
-        PaperCost(model.arx, data, predictor=predictor, gain=gain)(model.theta)
-    )
+    if isinstance(gain, str) and gain == "model":
+        gain = getattr(model, "gain", None)
+        if gain is None or not np.isfinite(gain):
+            raise ValueError(
+                f"`gain` 'model' needs a model with a finite gain; got {gain!r}"
+            )
+    elif isinstance(gain, str) and gain != "auto":
+        raise ValueError(
+            f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
+        )
+    penalty = float(getattr(model, "penalty", 1e6))
+    cost = PaperCost(model.arx, data, predictor=predictor, gain=gain, penalty=penalty)
+    cost = float(cost(model.theta))
 
     e_test = e_pred if residuals == "one-step" else e_sim
     white = whiteness_test(e_test, lags, levels)
