@@ -1,0 +1,285 @@
+"""Radius and angle rules of the spiral model.
+
+A rule maps each moving point's fitness deviation ``d_i = |f(x_i(k)) - min J|``
+(``min J`` being the centre's cost at iteration k) to the spiral radius
+``r_i`` and rotation angle ``theta_i`` of its next step (paper, Figure-4,
+step 2). A non-finite cost gives ``d_i = inf``.
+
+- :class:`ConstantSpiral`: the original SDA, one radius and angle for all.
+- :class:`ExponentialSpiral`: Eb-SDA, eq. (4) with the constants of eq. (7)
+  and (8).
+- :class:`LinearSpiral`: a linear adaptive rule, the alternative the paper
+  contrasts Eb-SDA with (our reading; see the class).
+"""
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import expit
+
+__all__ = [
+    "ConstantSpiral",
+    "ExponentialSpiral",
+    "LinearSpiral",
+    "SpiralRule",
+    "exponential_rule",
+]
+
+# Beyond z = 60 the value moves by under expit(-60) (upper - lower), about
+# 1e-26 (upper - lower): below half an ulp of `lower` for any sensible
+# limits. Capping z there keeps c2 * d finite for any d, inf included.
+_Z_CAP = 60.0
+
+
+class SpiralRule(ABC):
+    """Maps fitness deviations to spiral radii and angles.
+
+    Subclass it and implement ``__call__`` to pass a custom rule as the
+    ``method`` of :func:`spiralid.optim.minimize`.
+    """
+
+    @abstractmethod
+    def __call__(self, d: np.ndarray, rng: np.random.Generator):
+        """Radius and angle for each moving point.
+
+        Parameters
+        ----------
+        d : ndarray, shape (k,)
+            Fitness deviations ``|f(x_i(k)) - min J| >= 0``; ``inf`` for a
+            non-finite cost.
+        rng : numpy.random.Generator
+            The search's generator, for rules that draw.
+
+        Returns
+        -------
+        r, theta : float or ndarray of shape (k,)
+            Scalars mean one radius (angle) for all points.
+        """
+
+
+def _real(value, name: str) -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`{name}` must be a finite real number; got {value!r}"
+        ) from None
+    if not math.isfinite(out):
+        raise ValueError(f"`{name}` must be a finite real number; got {value!r}")
+    return out
+
+
+def _check_interval(lo, hi, lo_name, hi_name, radius: bool):
+    lo = _real(lo, lo_name)
+    hi = _real(hi, hi_name)
+    if radius and not 0.0 < lo < hi <= 1.0:
+        raise ValueError(
+            f"`{lo_name}` and `{hi_name}` must satisfy 0 < {lo_name} < {hi_name} <= 1; "
+            f"got {lo_name}={lo!r}, {hi_name}={hi!r}"
+        )
+    if not radius and not lo < hi:
+        raise ValueError(
+            f"`{lo_name}` and `{hi_name}` must satisfy {lo_name} < {hi_name}; "
+            f"got {lo_name}={lo!r}, {hi_name}={hi!r}"
+        )
+    return lo, hi
+
+
+def _positive(value, name: str) -> float:
+    out = _real(value, name)
+    if out <= 0.0:
+        raise ValueError(f"`{name}` must be a finite number > 0; got {value!r}")
+    return out
+
+
+@dataclass(frozen=True)
+class ConstantSpiral(SpiralRule):
+    """Original SDA: constant radius and angle (Tamura & Yasuda 2011).
+
+    Parameters
+    ----------
+    radius : float
+        Spiral radius in (0, 1]; default 0.95.
+    angle : float
+        Rotation angle in radians; default pi / 4.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ConstantSpiral()(np.zeros(3), np.random.default_rng(0))
+    (0.95, 0.7853981633974483)
+    """
+
+    radius: float = 0.95
+    angle: float = math.pi / 4
+
+    def __post_init__(self):
+        r = _real(self.radius, "radius")
+        if not 0.0 < r <= 1.0:
+            raise ValueError(f"`radius` must be in (0, 1]; got {self.radius!r}")
+        object.__setattr__(self, "radius", r)
+        object.__setattr__(self, "angle", _real(self.angle, "angle"))
+
+    def __call__(self, d, rng):
+        return self.radius, self.angle
+
+
+def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.ndarray:
+    """Eq. (4): ``(lower - upper) / (1 + c1 / exp(c2 d)) + upper``.
+
+    Evaluated as ``lower + (upper - lower) * expit(ln c1 - c2 d)``, which is
+    the same function but finite and warning-free for any ``d >= 0``,
+    ``inf`` included (penalised costs make ``d`` huge). It falls
+    monotonically from ``upper + (lower - upper) / (1 + c1)`` at ``d = 0``
+    to ``lower`` as ``d -> inf``.
+
+    Parameters
+    ----------
+    d : array_like
+        Fitness deviations, ``>= 0`` (``inf`` allowed).
+    lower, upper : float
+        ``r_l, r_u`` (or ``theta_l, theta_u``).
+    c1, c2 : float
+        Positive constants of eq. (4).
+
+    Returns
+    -------
+    ndarray
+        Values of eq. (4), same shape as ``d``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> exponential_rule(np.array([0.0, np.inf]), 0.1, 1.0, 100.0, 1.5).round(6)
+    array([0.991089, 0.1     ])
+    """
+    d = np.asarray(d, dtype=np.float64)
+    cap = max((_Z_CAP + math.log(c1)) / c2, 0.0)
+    z = c2 * np.minimum(d, cap) - math.log(c1)
+    # Written from the lower end so that the d -> inf limit is exactly `lower`.
+    return lower + (upper - lower) * expit(-z)
+
+
+@dataclass(frozen=True)
+class ExponentialSpiral(SpiralRule):
+    """Eb-SDA: exponential-based radius and angle, eq. (4), (7) and (8).
+
+    ``r_i = (r_l - r_u) / (1 + r_c1 / exp(r_c2 d_i)) + r_u`` and likewise
+    ``theta_i`` with ``th_l, th_u, th_c1, th_c2``. Points close in cost to
+    the centre keep a radius near ``r_u``; points far from it jump towards
+    it with radius near ``r_l``. Where ``d_i == 0`` exactly, the radius and
+    the angle are drawn uniformly from ``[r_l, r_u]`` and ``[th_l, th_u]``,
+    as the paper prescribes (radii first, then angles, from ``rng``). A
+    non-finite cost gives ``d_i = inf``, hence ``r_l`` and ``th_l``.
+
+    Defaults are the paper's: eq. (7) ``r_l=0.1, r_u=1, c1=100, c2=1.5``;
+    eq. (8), garbled in print, read in the same form with ``th_l=0.1,
+    th_u=2`` (radians), ``c1=10, c2=1``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> r, th = ExponentialSpiral()(np.array([1e300, np.inf]), np.random.default_rng(0))
+    >>> r.tolist(), th.tolist()
+    ([0.1, 0.1], [0.1, 0.1])
+    """
+
+    r_l: float = 0.1
+    r_u: float = 1.0
+    r_c1: float = 100.0
+    r_c2: float = 1.5
+    th_l: float = 0.1
+    th_u: float = 2.0
+    th_c1: float = 10.0
+    th_c2: float = 1.0
+
+    def __post_init__(self):
+        r_l, r_u = _check_interval(self.r_l, self.r_u, "r_l", "r_u", radius=True)
+        th_l, th_u = _check_interval(self.th_l, self.th_u, "th_l", "th_u", radius=False)
+        values = {"r_l": r_l, "r_u": r_u, "th_l": th_l, "th_u": th_u}
+        for name in ("r_c1", "r_c2", "th_c1", "th_c2"):
+            values[name] = _positive(getattr(self, name), name)
+        for name, value in values.items():
+            object.__setattr__(self, name, value)
+
+    def radius(self, d) -> np.ndarray:
+        """Eq. (4)/(7) without the random draw at ``d == 0``."""
+        return exponential_rule(d, self.r_l, self.r_u, self.r_c1, self.r_c2)
+
+    def angle(self, d) -> np.ndarray:
+        """Eq. (8) without the random draw at ``d == 0``."""
+        return exponential_rule(d, self.th_l, self.th_u, self.th_c1, self.th_c2)
+
+    def __call__(self, d, rng):
+        d = np.asarray(d, dtype=np.float64)
+        r = self.radius(d)
+        theta = self.angle(d)
+        zero = d == 0.0
+        k = int(np.count_nonzero(zero))
+        if k:
+            r[zero] = rng.uniform(self.r_l, self.r_u, k)
+            theta[zero] = rng.uniform(self.th_l, self.th_u, k)
+        return r, theta
+
+
+@dataclass(frozen=True)
+class LinearSpiral(SpiralRule):
+    """Linear adaptive radius and angle (LASDA; our reading).
+
+    The paper contrasts Eb-SDA with a linear adaptive rule without stating
+    it. We read it as ``r_u`` at ``d = 0`` falling linearly to ``r_l`` at
+    ``d >= d_max``, and the angle likewise from ``th_u`` to ``th_l``::
+
+        r_i = r_u + (r_l - r_u) * min(d_i / d_max, 1)
+
+    Parameters
+    ----------
+    r_l, r_u, th_l, th_u : float
+        Limits, defaulting to Eb-SDA's (eq. (7)-(8)).
+    d_max : float or None
+        Deviation at which the lower limits are reached. ``None`` (default)
+        uses each iteration's largest finite deviation, which makes the rule
+        independent of the cost's scale: the worst finite point gets ``r_l``
+        and the centre's ties get ``r_u``. ``inf`` deviations (non-finite
+        costs) get the lower limits.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> r, th = LinearSpiral()(np.array([0.0, 1.0, 2.0]), np.random.default_rng(0))
+    >>> r.tolist()
+    [1.0, 0.55, 0.1]
+    """
+
+    r_l: float = 0.1
+    r_u: float = 1.0
+    th_l: float = 0.1
+    th_u: float = 2.0
+    d_max: float | None = None
+
+    def __post_init__(self):
+        r_l, r_u = _check_interval(self.r_l, self.r_u, "r_l", "r_u", radius=True)
+        th_l, th_u = _check_interval(self.th_l, self.th_u, "th_l", "th_u", radius=False)
+        for name, value in {"r_l": r_l, "r_u": r_u, "th_l": th_l, "th_u": th_u}.items():
+            object.__setattr__(self, name, value)
+        if self.d_max is not None:
+            object.__setattr__(self, "d_max", _positive(self.d_max, "d_max"))
+
+    def _fraction(self, d: np.ndarray) -> np.ndarray:
+        d_max = self.d_max
+        if d_max is None:
+            finite = d[np.isfinite(d)]
+            d_max = float(finite.max()) if finite.size else 0.0
+        if d_max <= 0.0:
+            return (d > 0.0).astype(np.float64)
+        # Capping d first keeps d / d_max from overflowing for a tiny d_max.
+        return np.minimum(d, d_max) / d_max
+
+    def __call__(self, d, rng):
+        d = np.asarray(d, dtype=np.float64)
+        g = 1.0 - self._fraction(d)
+        r = self.r_l + (self.r_u - self.r_l) * g
+        theta = self.th_l + (self.th_u - self.th_l) * g
+        return r, theta
