@@ -15,6 +15,11 @@ except PackageNotFoundError:  # running from a source tree without install
     __version__ = "0.0.0+unknown"
 
 # --- optim ---
+from . import optim as optim
+from .optim import SpiralResult as SpiralResult
+from .optim import minimize as minimize
+
+# isort: split
 # --- fms ---
 from . import fms as fms
 from .fms import FlexibleManipulator as FlexibleManipulator
