@@ -327,7 +327,12 @@ def _runs(value, name: str) -> list[np.ndarray]:
         runs = [value]
     elif isinstance(value, np.ndarray) and value.ndim == 2:
         runs = list(value)
-    elif isinstance(value, Sequence) and value and np.ndim(value[0]) == 0:
+    elif (
+        isinstance(value, Sequence)
+        and value
+        and np.ndim(value[0]) == 0
+        and not hasattr(value[0], "history")
+    ):
         runs = [np.asarray(value)]
     else:
         runs = [np.asarray(getattr(v, "history", v)) for v in value]
