@@ -9,12 +9,17 @@ with parameter vector ``theta = [a_1..a_na, b_0..b_(nb-1)]``. The paper's
 eq. (6) is ``ARX(8, 8, 0)`` (b_0 multiplies z^8; DESIGN.md item 1); its
 printed eq. (9)-(10) have ``nk = 1``.
 
-Initial samples: every signal before ``t = 0`` is taken as zero, in the
-regressors (one-step prediction) exactly as in :meth:`ARX.simulate` and
-``scipy.signal.lfilter``. So the one-step error and the simulation error are
-sums over the same ``K = N`` samples, and :func:`arx_least_squares` is the
-exact minimiser of the one-step error that :class:`~spiralid.sysid.PaperCost`
-evaluates.
+Initial samples: the first ``t0 = max_lag = max(na, nk + nb - 1)`` samples
+of a record serve as initial conditions. The regression matrix of
+:meth:`ARX.regressors` has all ``N`` rows (zero for samples before
+``t = 0``, so :meth:`ARX.predict` returns ``N`` values), but estimation and
+the paper's cost use only rows ``t >= t0``, where every regressor is a
+measured sample: :func:`arx_least_squares` is the exact minimiser of that
+one-step error, which is the one
+:class:`~spiralid.sysid.PaperCost` evaluates. (Zero-filling the first rows
+instead makes the least-squares ARX(8, 8, 0) of the real flexible arm
+unstable: its record starts in motion.) :meth:`ARX.simulate` is the free
+run from zero initial conditions, exactly ``scipy.signal.lfilter``.
 """
 
 from __future__ import annotations
@@ -144,6 +149,7 @@ class ARX:
 
         Row ``t`` is ``[-y(t-1)..-y(t-na), u(t-nk)..u(t-nk-nb+1)]`` with zero
         for every sample before ``t = 0``, so ``y = Phi @ theta + e``.
+        Estimation uses rows ``max_lag:`` only (see the module docstring).
 
         Returns
         -------
@@ -163,6 +169,8 @@ class ARX:
 
     def predict(self, theta, data: IOData) -> np.ndarray:
         """One-step-ahead prediction ``Phi @ theta`` (uses measured past outputs).
+
+        The first ``max_lag`` values use zero for samples before ``t = 0``.
 
         Returns
         -------
@@ -314,9 +322,9 @@ def _ar_filter_batch(x, a, out):  # pragma: no cover - compiled
 def arx_least_squares(data: IOData, arx: ARX) -> np.ndarray:
     """Least-squares ARX estimate: the exact minimiser of the one-step error.
 
-    Minimises ``||y - Phi theta||^2`` over all ``N`` samples with the
-    zero-initial-condition regressors of :meth:`ARX.regressors`, which is
-    the one-step error of :class:`~spiralid.sysid.PaperCost` (eq. (2)).
+    Minimises ``sum_{t >= max_lag} (y(t) - phi(t)' theta)^2``, the one-step
+    error of :class:`~spiralid.sysid.PaperCost` (eq. (2)); the first
+    ``max_lag`` samples are initial conditions.
 
     Parameters
     ----------
@@ -352,8 +360,9 @@ def arx_least_squares(data: IOData, arx: ARX) -> np.ndarray:
             f"`data` input is constant ({data.u[0]!r}): the input does not excite "
             "the system, so least squares is singular"
         )
-    phi = arx.regressors(data)
-    theta, _, rank, _ = np.linalg.lstsq(phi, data.y, rcond=None)
+    t0 = arx.max_lag
+    phi = arx.regressors(data)[t0:]
+    theta, _, rank, _ = np.linalg.lstsq(phi, data.y[t0:], rcond=None)
     if rank < arx.n_params:
         raise ValueError(
             f"`data` does not excite the system enough for {arx}: the regression "

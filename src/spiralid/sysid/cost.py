@@ -8,10 +8,21 @@ How we read it (DESIGN.md items 2-3):
 - ``gain="auto"`` sets ``w = 100 sqrt(K) / rms(y)``, so ``f`` is the RMS
   error as a percentage of the RMS of the output *as given* (not detrended:
   detrend the data first if an offset should not count).
-- ``predictor="simulation"``: ``e`` is the free-run simulation error from
-  the input alone; ``"one-step"``: ``e`` is the equation (one-step
-  prediction) error ``y - Phi theta``. Both sum over all ``K = N`` samples
-  with zero initial conditions (see :mod:`spiralid.sysid.arx`).
+- Both predictors sum over the same ``K = N - t0`` samples ``t >= t0``,
+  where ``t0 = max_lag = max(na, nk + nb - 1)``: the first ``t0`` samples
+  are the initial conditions (see :mod:`spiralid.sysid.arx`).
+  ``predictor="one-step"``: ``e`` is the equation (one-step prediction)
+  error ``y - Phi theta``. ``predictor="simulation"``: ``e`` is the free-run
+  simulation error from the input alone, the model's own past outputs
+  fed back, started at ``t0`` from the measured past (so the first
+  simulated sample equals the first one-step prediction). Starting from
+  the measured state rather than from rest matters for a lightly damped
+  plant whose record starts in motion: a zero initial state leaves a
+  transient no parameter can remove.
+- ``gain="auto"`` sets ``w = 100 sqrt(K) / rms(y)`` (rms over the same
+  ``K`` samples), so ``f`` is the RMS error as a percentage of the RMS of
+  the output *as given* (not detrended: detrend the data first if an
+  offset should not count). The zero model costs exactly 100.
 - Stability is decided from the denominator (Schur-Cohn test, exact for
   ``|z| >= 1``) *before* any simulation. An unstable candidate is never
   simulated: its error term in eq. (3) is the one-step error term, which
@@ -23,6 +34,7 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+from scipy.signal import lfilter, lfiltic
 
 from .arx import ARX
 from .data import IOData
@@ -41,7 +53,7 @@ class PaperCost:
     arx : ARX
         Model structure.
     data : IOData
-        Estimation record (``K = data.n`` samples).
+        Estimation record (``K = data.n - arx.max_lag`` samples count).
     predictor : {"simulation", "one-step"}
         Which output error ``e`` the cost measures.
     gain : "auto" or float
@@ -54,7 +66,9 @@ class PaperCost:
     w : float
         The gain actually used.
     K : int
-        Number of samples.
+        Number of samples in the sums, ``data.n - t0``.
+    t0 : int
+        First sample of the sums, ``arx.max_lag``.
     gram, phity, yty
         ``Phi' Phi``, ``Phi' y`` and ``y' y``: the one-step error is
         ``y'y - 2 theta' Phi'y + theta' Phi'Phi theta``, O(p^2) per candidate.
@@ -104,8 +118,9 @@ class PaperCost:
         self.data = data
         self.predictor = predictor
         self.penalty = pen
-        self.K = data.n
-        y = data.y
+        self.t0 = arx.max_lag
+        self.K = data.n - self.t0
+        y = data.y[self.t0 :]
         if isinstance(gain, str):
             if gain != "auto":
                 raise ValueError(
@@ -129,12 +144,12 @@ class PaperCost:
                     f"`gain` must be 'auto' or a positive number; got {gain!r}"
                 )
             self.w = w
-        phi = arx.regressors(data)
+        phi = arx.regressors(data)[self.t0 :]
         self.gram = phi.T @ phi
         self.phity = phi.T @ y
         self.yty = float(y @ y)
-        self._y = np.ascontiguousarray(y)
-        self._ulags = arx.input_lags(data.u)
+        self._y = np.ascontiguousarray(data.y)
+        self._ulags = np.ascontiguousarray(arx.input_lags(data.u)[:, self.t0 :])
 
     @property
     def n_params(self) -> int:
@@ -170,18 +185,43 @@ class PaperCost:
         sse = np.maximum(sse, 0.0)
         return float(sse[0]) if single else sse
 
-    def sse_simulation(self, thetas) -> np.ndarray | float:
-        """``sum e^2`` of the simulation error; ``inf`` for unstable candidates
-        (they are not simulated)."""
-        th, single = self._thetas(thetas)
-        stable = is_stable_polynomial(th[:, : self.arx.na])
+    def _simulate_sse(self, th: np.ndarray, stable: np.ndarray) -> np.ndarray:
         sse = np.full(th.shape[0], np.inf)
         if stable.any():
             x = th[:, self.arx.na :] @ self._ulags
             _ar_filter_sse(
-                x, np.ascontiguousarray(th[:, : self.arx.na]), self._y, stable, sse
+                x,
+                np.ascontiguousarray(th[:, : self.arx.na]),
+                self._y,
+                self.t0,
+                stable,
+                sse,
             )
+        return sse
+
+    def sse_simulation(self, thetas) -> np.ndarray | float:
+        """``sum e^2`` of the simulation error; ``inf`` for unstable candidates
+        (they are not simulated)."""
+        th, single = self._thetas(thetas)
+        sse = self._simulate_sse(th, is_stable_polynomial(th[:, : self.arx.na]))
         return float(sse[0]) if single else sse
+
+    def simulate(self, theta) -> np.ndarray:
+        """The simulated output the simulation error compares with ``y[t0:]``.
+
+        Free run for ``t >= t0`` started from the measured past (not from rest).
+        """
+        th, single = self._thetas(theta)
+        if not single:
+            raise ValueError(f"`theta` must be a single vector; got shape {th.shape}")
+        na = self.arx.na
+        den = np.r_[1.0, th[0, :na]]
+        x = th[0, na:] @ self._ulags
+        past = self._y[self.t0 - na : self.t0][::-1]
+        zi = lfiltic([1.0], den, past) if na else None
+        if zi is None:
+            return x
+        return lfilter([1.0], den, x, zi=zi)[0]
 
     def __call__(self, thetas) -> np.ndarray | float:
         """Evaluate eq. (2)-(3).
@@ -199,12 +239,7 @@ class PaperCost:
         if self.predictor == "one-step":
             sse = self.sse_one_step(th)
         else:
-            sse = np.empty(th.shape[0])
-            if stable.any():
-                x = th[:, self.arx.na :] @ self._ulags
-                _ar_filter_sse(
-                    x, np.ascontiguousarray(th[:, : self.arx.na]), self._y, stable, sse
-                )
+            sse = self._simulate_sse(th, stable)
             if not stable.all():
                 # Unstable: not simulated; the error term of eq. (3) is the
                 # (finite) one-step error term.
@@ -214,22 +249,26 @@ class PaperCost:
 
 
 @numba.njit(cache=True)
-def _ar_filter_sse(x, a, y, mask, sse):  # pragma: no cover - compiled
-    """sse[r] = ||y - x[r] / A_r||^2 for rows with mask[r]; others untouched."""
-    m, n = x.shape
+def _ar_filter_sse(x, a, y, t0, mask, sse):  # pragma: no cover - compiled
+    """sse[r] = sum_{t >= t0} (y(t) - yhat_r(t))^2 for rows with mask[r].
+
+    ``A_r(q) yhat = x[r]`` for ``t >= t0`` (``x[r, t - t0]`` is the numerator
+    part), with ``yhat(t) = y(t)`` for ``t < t0``; other rows are untouched.
+    """
+    m, k = x.shape
     na = a.shape[1]
-    buf = np.zeros(n + na)
+    buf = np.empty(k + na)
     for r in range(m):
         if not mask[r]:
             continue
         for i in range(na):
-            buf[i] = 0.0
+            buf[i] = y[t0 - na + i]
         acc_sse = 0.0
-        for t in range(n):
+        for t in range(k):
             acc = x[r, t]
             for i in range(na):
                 acc -= a[r, i] * buf[na + t - 1 - i]
             buf[na + t] = acc
-            d = y[t] - acc
+            d = y[t0 + t] - acc
             acc_sse += d * d
         sse[r] = acc_sse

@@ -8,11 +8,12 @@ Methods
 ``"ls"``
     Least squares, the exact minimiser of the one-step error.
 ``"oe"``
-    Output error: ``scipy.optimize.least_squares`` (trust-region
-    reflective) on the free-run simulation error, started from least
-    squares, kept stable by searching the denominator as reflection
-    coefficients in ``[-kmax, kmax]`` (unstable poles of the start are first
-    reflected into the unit circle, ``z -> 1 / conj(z)``).
+    Output error: ``scipy.optimize.least_squares`` (Levenberg-Marquardt,
+    analytic Jacobian) on the simulation error of :class:`PaperCost`,
+    started from least squares, kept stable by searching the denominator
+    as reflection coefficients ``k = kmax tanh(z)``, ``kmax = 1 - 1e-6``
+    (unstable poles of the start are first reflected into the unit circle,
+    ``z -> 1 / conj(z)``).
 
 Search space of the spiral methods (DESIGN.md items 12-13)
 ------------------------------------------------------------
@@ -300,43 +301,91 @@ def _stabilise(theta: np.ndarray, arx: ARX) -> np.ndarray:
     return np.r_[k, b]
 
 
+def _step_up_jacobian(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Step-up with its Jacobian ``D[i, j] = d a_i / d k_j`` (forward mode)."""
+    n = k.size
+    a = np.zeros(n)
+    jac = np.zeros((n, n))
+    for j in range(n):
+        prev, dprev = a[:j].copy(), jac[:j].copy()
+        a[:j] = prev + k[j] * prev[::-1]
+        jac[:j] = dprev + k[j] * dprev[::-1]
+        jac[:j, j] += prev[::-1]
+        a[j] = k[j]
+        jac[j, j] = 1.0
+    return a, jac
+
+
 def _local_polish(
     theta0: np.ndarray, arx: ARX, data: IOData, predictor: str
 ) -> tuple[np.ndarray, optimize.OptimizeResult]:
-    """Least-squares polish of the chosen error; denominator as reflection coefs."""
-    na = arx.na
+    """Levenberg-Marquardt polish of the `predictor`'s error as
+    :class:`PaperCost` defines it, kept stable: the denominator is searched
+    as ``k = kmax tanh(z)`` (reflection coefficients, so every step is
+    stable) with ``z`` unconstrained. Analytic Jacobian:
+    ``d yhat / d b_j = u(t-nk-j) / A`` and ``d yhat / d a_i = -yhat(t-i) / A``
+    (simulation, measured initial state fixed), ``Phi`` (one-step)."""
+    na, t0 = arx.na, arx.max_lag
     y = data.y
+    yv = y[t0:]
+    n_k = yv.size
+    phi = arx.regressors(data)[t0:]
+    ulags = arx.input_lags(data.u)[:, t0:]
+    past = y[t0 - na : t0][::-1]
+
+    def parts(x):
+        th = np.tanh(x[:na])
+        a, dadk = _step_up_jacobian(_KMAX * th)
+        return a, dadk * (_KMAX * (1.0 - th * th)), x[na:]
+
     if predictor == "simulation":
-        num_lags = arx.input_lags(data.u)
+
+        def simulate(a, b):
+            xs = b @ ulags
+            if na == 0:
+                return xs
+            den = np.r_[1.0, a]
+            zi = signal.lfiltic([1.0], den, past)
+            return signal.lfilter([1.0], den, xs, zi=zi)[0]
 
         def residual(x):
-            k = np.clip(x[:na], -_KMAX, _KMAX)
-            xsim = x[na:] @ num_lags
-            return signal.lfilter([1.0], np.r_[1.0, step_up(k)], xsim) - y
+            a, _, b = parts(x)
+            return simulate(a, b) - yv
+
+        def jacobian(x):
+            a, dadz, b = parts(x)
+            yext = np.r_[y[:t0], simulate(a, b)]
+            lagged = [-yext[t0 - i : t0 - i + n_k] for i in range(1, na + 1)]
+            rows = np.vstack([*lagged, ulags]) if na else ulags
+            sens = signal.lfilter([1.0], np.r_[1.0, a], rows, axis=1).T
+            return np.hstack([sens[:, :na] @ dadz, sens[:, na:]])
 
     else:
-        phi = arx.regressors(data)
 
         def residual(x):
-            k = np.clip(x[:na], -_KMAX, _KMAX)
-            return phi @ np.r_[step_up(k), x[na:]] - y
+            a, _, b = parts(x)
+            return phi @ np.r_[a, b] - yv
 
-    x0 = _stabilise(np.asarray(theta0, dtype=float), arx)
-    lower = np.r_[np.full(na, -_KMAX), np.full(arx.nb, -np.inf)]
-    upper = -lower
+        def jacobian(x):
+            _, dadz, _ = parts(x)
+            return np.hstack([phi[:, :na] @ dadz, phi[:, na:]])
+
+    start = _stabilise(np.asarray(theta0, dtype=float), arx)
+    ratio = np.clip(start[:na] / _KMAX, -1.0 + 1e-12, 1.0 - 1e-12)
+    x0 = np.r_[np.arctanh(ratio), start[na:]]
     res = optimize.least_squares(
         residual,
         x0,
-        bounds=(lower, upper),
-        method="trf",
+        jac=jacobian,
+        method="lm",
         x_scale="jac",
         xtol=1e-12,
         ftol=1e-12,
         gtol=1e-12,
-        max_nfev=200 * (arx.n_params + 1),
+        max_nfev=100 * (arx.n_params + 1),
     )
-    theta = np.r_[step_up(np.clip(res.x[:na], -_KMAX, _KMAX)), res.x[na:]]
-    return theta, res
+    a, _, b = parts(res.x)
+    return np.r_[a, b], res
 
 
 # -- the entry point ----------------------------------------------------------
