@@ -3,6 +3,7 @@
 Knows nothing of system identification. See :func:`minimize`.
 """
 
+from spiralid.optim import testfunctions
 from spiralid.optim.rotation import planes, rotate, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,
@@ -25,4 +26,5 @@ __all__ = [
     "planes",
     "rotate",
     "rotation_matrix",
+    "testfunctions",
 ]
