@@ -79,17 +79,18 @@ def simulate_discrete(
         xs[b] = x
         x = am @ x + drive[b]
     obs = np.swapaxes(powers[:m], 1, 2) @ C.T  # (m, n, p): (C Ad^j)^T
-    y = np.einsum("bn,jnp->bjp", xs, obs)
+    # Matrix products (BLAS) rather than einsum for the two big contractions.
+    y = (xs @ obs.transpose(1, 0, 2).reshape(n, m * p)).reshape(nb, m, p)
     # Toeplitz part: y[b, j] += sum_{i <= j} markov[j - i] u[b, i].
     idx = np.arange(m)
     lag = idx[:, None] - idx[None, :]
     toep = np.where((lag >= 0)[..., None], markov[np.clip(lag, 0, None)], 0.0)
-    y += np.einsum("bi,jip->bjp", U, toep)
+    y += (U @ toep.transpose(1, 0, 2).reshape(m, m * p)).reshape(nb, m, p)
     y = y.reshape(nb * m, p)[:N]
     if not return_state:
         return y, None
-    xt = np.einsum("bn,jkn->bjk", xs, powers[:m])
+    xt = (xs @ powers[:m].transpose(2, 0, 1).reshape(n, m * n)).reshape(nb, m, n)
     # x[b, j] += sum_{i < j} Ad^(j-1-i) Bd u[b, i].
     sb = np.where((lag >= 1)[..., None], pb[np.clip(lag - 1, 0, None)], 0.0)
-    xt += np.einsum("bi,jin->bjn", U, sb)
+    xt += (U @ sb.transpose(1, 0, 2).reshape(m, m * n)).reshape(nb, m, n)
     return y, xt.reshape(nb * m, n)[:N]

@@ -51,10 +51,12 @@ class Sensors:
         Cut-off as a fraction of the Nyquist frequency, in (0, 1].  The
         default (order 4 at 0.5 x Nyquist, i.e. 125 Hz at 500 Hz) passes the
         three modes the paper identifies (default rig: 13.3, 35.1, 64.8 Hz;
-        gain loss under 0.03 dB, though with phase lag), attenuates the fifth
-        mode (188 Hz) by about 28 dB and anything at or above Nyquist by at
-        least 48 dB, so aliasing is negligible; the fourth mode (116 Hz) is
-        passed at -1.9 dB.
+        gain loss under 0.03 dB, though with phase lag), passes the fourth
+        (116 Hz) at -1.9 dB, and attenuates the fifth (188 Hz) by 14 dB and
+        anything at or above Nyquist by at least 24 dB (24 dB per octave
+        beyond), e.g. the sixth mode (280 Hz, which would alias to 220 Hz)
+        by 28 dB.  A higher order or lower cut-off trades more phase lag in
+        the band of interest for less aliasing.
 
     Examples
     --------
