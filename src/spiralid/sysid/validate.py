@@ -279,9 +279,10 @@ class Validation:
     rmse, rmse_one_step : float
         Root-mean-square error.
     cost : float
-        The paper's eq. (2)-(3) on this record with the model's predictor and
-        gain (with ``gain="auto"`` it is ``100 rms(e) / rms(y)``, a percentage,
-        and includes the stability penalty when the model is unstable).
+        The paper's eq. (2)-(3) on this record for the error of the model's
+        predictor, with the gain :func:`validate` was given (with
+        ``gain="auto"`` it is ``100 rms(e) / rms(y)``, a percentage), plus the
+        stability penalty when the model is unstable.
     cost_predictor : str
         Which error ``cost`` measures (``"simulation"`` or ``"one-step"``).
     error_range, error_range_one_step : tuple of float
@@ -569,9 +570,15 @@ def validate(
 
     Notes
     -----
-    The cost is :class:`~spiralid.sysid.PaperCost` on ``data`` with the
-    model's predictor and penalty and the gain chosen by ``gain`` (eq.
-    (2)-(3)). An unstable model's cost carries the penalty, as in the search.
+    The cost is eq. (2)-(3), ``w sqrt(sum e^2) / K`` plus the model's penalty
+    when a pole has ``|z| >= 1``, with ``e`` the error of the model's own
+    predictor (``model.predictor``) computed exactly as for the fit and error
+    range (zero initial conditions, or after ``warmup``). It therefore equals
+    ``100 rms(e) / rms(y)`` with ``gain="auto"``. It can differ slightly from
+    :class:`~spiralid.sysid.PaperCost` on the same record, which starts its
+    free run from the measured first samples (see :mod:`spiralid.sysid.cost`);
+    for poles very close to the unit circle the difference can be large,
+    because the start-up transient then hardly decays.
     """
     u, y, ts = _signals_of(data)
     n = y.size
@@ -591,6 +598,43 @@ def validate(
             f"got ts = {ts!r}"
         )
 
+    predictor = getattr(model, "predictor", None) or "simulation"
+    if predictor not in _RESIDUALS:
+        raise ValueError(
+            f"`model.predictor` must be one of {_RESIDUALS}; got {predictor!r}"
+        )
+    if isinstance(gain, str) and gain == "auto":
+        rms_y = float(np.sqrt(np.mean(y**2)))
+        if rms_y == 0.0:
+            raise ValueError(
+                "`gain` 'auto' needs a non-zero output; `data.y` is all zero"
+            )
+        w = 100.0 * np.sqrt(n) / rms_y
+    elif isinstance(gain, str) and gain == "model":
+        w = float(getattr(model, "gain", np.nan))
+        if not (np.isfinite(w) and w > 0):
+            raise ValueError(
+                f"`gain` 'model' needs a model with a finite positive gain; got {w!r}"
+            )
+    elif isinstance(gain, str):
+        raise ValueError(
+            f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
+        )
+    else:
+        try:
+            w = float(gain)
+        except (TypeError, ValueError):
+            w = float("nan")
+        if not (np.isfinite(w) and w > 0):
+            raise ValueError(
+                f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
+            )
+    penalty = float(getattr(model, "penalty", 1e6))
+    poles = np.asarray(_attr(model, "poles"), dtype=complex)
+    zeros = np.asarray(_attr(model, "zeros"), dtype=complex)
+    max_radius = float(np.max(np.abs(poles))) if poles.size else 0.0
+    stable = max_radius < 1.0
+
     if warmup is None:
         y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
         y_pred = np.asarray(model.predict(data), dtype=float).ravel()
@@ -603,26 +647,20 @@ def validate(
         whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
         y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[wu.size :]
         y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[wu.size :]
+    if y_sim.size == n and not np.all(np.isfinite(y_sim)):
+        raise ValueError(
+            f"`model` is unstable (max |pole| = {max_radius:.6g}) and its free-run "
+            f"output overflows on this record of N = {n} samples; a free-run "
+            "validation of it is meaningless"
+        )
     y, y_sim = _pair(y, y_sim, "data.y", "model.simulate(data.u)")
     y, y_pred = _pair(y, y_pred, "data.y", "model.predict(data)")
     e_sim, e_pred = y - y_sim, y - y_pred
 
-    from .cost import PaperCost
-
-    predictor = getattr(model, "predictor", None) or "simulation"
-    if isinstance(gain, str) and gain == "model":
-        gain = getattr(model, "gain", None)
-        if gain is None or not np.isfinite(gain):
-            raise ValueError(
-                f"`gain` 'model' needs a model with a finite gain; got {gain!r}"
-            )
-    elif isinstance(gain, str) and gain != "auto":
-        raise ValueError(
-            f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
-        )
-    penalty = float(getattr(model, "penalty", 1e6))
-    cost = PaperCost(model.arx, data, predictor=predictor, gain=gain, penalty=penalty)
-    cost = float(cost(model.theta))
+    # Eq. (2)-(3) on the very errors the fit and error range are computed
+    # from, so the columns of a Table-2 row agree with one another.
+    e_cost = e_sim if predictor == "simulation" else e_pred
+    cost = w * np.sqrt(np.sum(e_cost**2)) / n + (0.0 if stable else penalty)
 
     e_test = e_pred if residuals == "one-step" else e_sim
     white = whiteness_test(e_test, lags, levels)
@@ -632,8 +670,6 @@ def validate(
     spec_y = psd(y, fs, nperseg=nperseg)
     spec_m = psd(y_sim, fs, nperseg=nperseg)
 
-    poles = np.asarray(_attr(model, "poles"), dtype=complex)
-    zeros = np.asarray(_attr(model, "zeros"), dtype=complex)
     num, den = model.arx.polynomials(model.theta)
     label = label if label is not None else str(getattr(model, "method", "") or "")
 
@@ -645,7 +681,7 @@ def validate(
         fit_percent_one_step=fit_percent(y, y_pred),
         rmse=rmse(y, y_sim),
         rmse_one_step=rmse(y, y_pred),
-        cost=cost,
+        cost=float(cost),
         cost_predictor=predictor,
         error_range=(float(e_sim.min()), float(e_sim.max())),
         error_range_one_step=(float(e_pred.min()), float(e_pred.max())),
@@ -657,8 +693,8 @@ def validate(
         peaks_measured=find_resonances(spec_y, n_peaks),
         peaks_model=find_resonances(spec_m, n_peaks),
         modes=modes_from_poles(poles, ts, max_damping=max_damping),
-        stable=bool(poles.size == 0 or np.max(np.abs(poles)) < 1.0),
-        max_pole_radius=float(np.max(np.abs(poles))) if poles.size else 0.0,
+        stable=bool(stable),
+        max_pole_radius=max_radius,
         realization=realization_tests(num, den),
         poles=poles,
         zeros=zeros,
