@@ -143,3 +143,14 @@ def test_bad_inputs():
         whiteness_test(np.zeros(10), lags=2, levels=(95,))
     with pytest.raises(ValueError, match="`rtol` must be in"):
         independence_test(np.zeros(10), np.zeros(10), 2, rtol=0.0)
+
+
+def test_cross_band_scale_matches_bartlett_for_two_ar1_signals():
+    # sum_m rho_e(m) rho_u(m) = sum_m (0.9 * 0.7)^|m| = (1 + 0.63) / (1 - 0.63)
+    rng = np.random.default_rng(5)
+    u, e = ar1(rng, 20000, 0.9), ar1(rng, 20000, 0.7)
+    t = independence_test(u, e)
+    assert t.band_scale == pytest.approx(np.sqrt(1.63 / 0.37), rel=0.1)
+    assert whiteness_test(e).band_scale == 1.0
+    white = independence_test(rng.standard_normal(5000), rng.standard_normal(5000))
+    assert white.band_scale == pytest.approx(1.0, abs=0.1)

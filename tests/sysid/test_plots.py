@@ -148,3 +148,14 @@ def test_validation_plot_gives_four_figures():
     assert set(figs) == {"time", "residuals", "spectrum", "pole_zero"}
     assert all(isinstance(f, Figure) for f in figs.values())
     assert [len(f.axes) for f in figs.values()] == [2, 2, 1, 1]
+
+
+def test_residual_plot_adds_colour_adjusted_bands_for_coloured_signals():
+    rng = np.random.default_rng(0)
+    u = signal.lfilter([1.0], [1.0, -0.9], rng.standard_normal(2000))
+    e = signal.lfilter([1.0], [1.0, -0.7], rng.standard_normal(2000))
+    c = independence_test(u, e, 10)
+    assert c.band_scale > 1.5
+    (ax,) = plots.plot_residual_tests(c).axes
+    labels = [ln.get_label() for ln in ax.lines]
+    assert "95 % band, colour-adjusted" in labels

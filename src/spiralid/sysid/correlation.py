@@ -67,6 +67,13 @@ class CorrelationTest:
         ``P(chi2(dof) >= statistic)``.
     passed : dict
         ``{level: statistic <= chi2.ppf(level, dof)}``.
+    band_scale : float
+        Standard deviation of a single correlation under the null hypothesis,
+        in units of ``1/sqrt(N)``: 1 for the whiteness test; for the
+        cross-correlation test ``sqrt(P_00)`` from Bartlett's formula, larger
+        than 1 when both the input and the residual are coloured.
+        ``band_scale * bands[level]`` is the per-lag band that accounts for
+        that colour (what the verdict effectively uses).
     """
 
     kind: str
@@ -80,6 +87,7 @@ class CorrelationTest:
     dof: int
     p_value: float
     passed: dict[float, bool] = field(default_factory=dict)
+    band_scale: float = 1.0
 
     def to_dict(self) -> dict:
         """JSON-safe dictionary (level keys become strings such as ``"0.95"``)."""
@@ -95,6 +103,7 @@ class CorrelationTest:
             "dof": int(self.dof),
             "p_value": float(self.p_value),
             "passed": {str(k): bool(v) for k, v in self.passed.items()},
+            "band_scale": float(self.band_scale),
         }
 
 
@@ -193,7 +202,9 @@ def _bands(levels, n):
     return {lv: float(stats.norm.ppf(0.5 + lv / 2.0) / np.sqrt(n)) for lv in levels}
 
 
-def _finish(kind, lags, values, n, levels, statistic, dof) -> CorrelationTest:
+def _finish(
+    kind, lags, values, n, levels, statistic, dof, band_scale=1.0
+) -> CorrelationTest:
     bands = _bands(levels, n)
     p_value = float(stats.chi2.sf(statistic, dof)) if dof > 0 else 1.0
     return CorrelationTest(
@@ -210,6 +221,7 @@ def _finish(kind, lags, values, n, levels, statistic, dof) -> CorrelationTest:
         passed={
             lv: bool(dof == 0 or statistic <= stats.chi2.ppf(lv, dof)) for lv in levels
         },
+        band_scale=float(band_scale),
     )
 
 
@@ -323,8 +335,9 @@ def independence_test(
     cov = 0.5 * (cov + cov.T)
     w, v = linalg.eigh(cov)
     keep = w > rtol * max(w.max(), 0.0)
+    scale = float(np.sqrt(max(cov[lags, lags], 0.0)))
     if not keep.any():
-        return _finish("cross-correlation", k, r, n, levels, 0.0, 0)
+        return _finish("cross-correlation", k, r, n, levels, 0.0, 0, scale)
     proj = v[:, keep].T @ r
     zeta = n * float(np.sum(proj**2 / w[keep]))
-    return _finish("cross-correlation", k, r, n, levels, zeta, int(keep.sum()))
+    return _finish("cross-correlation", k, r, n, levels, zeta, int(keep.sum()), scale)

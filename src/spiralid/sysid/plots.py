@@ -112,7 +112,9 @@ def plot_residual_tests(*tests: CorrelationTest) -> Figure:
     Each test (from :func:`~spiralid.sysid.correlation.whiteness_test` or
     :func:`~spiralid.sysid.correlation.independence_test`) is drawn as stems
     with dashed ``+-z/sqrt(N)`` bands for each of its levels, and its verdict
-    in the title, as MATLAB's ``resid`` lays them out.
+    in the title, as MATLAB's ``resid`` lays them out. When the test's
+    ``band_scale`` differs from 1 (coloured input and residual), the
+    colour-adjusted bands ``band_scale * z / sqrt(N)`` are drawn as well.
 
     Returns
     -------
@@ -147,6 +149,15 @@ def plot_residual_tests(*tests: CorrelationTest) -> Figure:
             ls = styles[j % len(styles)]
             ax.axhline(b, color="r", ls=ls, lw=0.9, label=f"{100 * lv:g} % band")
             ax.axhline(-b, color="r", ls=ls, lw=0.9)
+        if abs(tst.band_scale - 1.0) > 0.05:
+            # Coloured input and residual widen the null spread of each lag;
+            # show that band too, or a sine-sweep input looks like a failure.
+            for j, lv in enumerate(tst.levels):
+                b = tst.bands[lv] * tst.band_scale
+                ls = styles[j % len(styles)]
+                lab = f"{100 * lv:g} % band, colour-adjusted"
+                ax.axhline(b, color="tab:green", ls=ls, lw=0.9, label=lab)
+                ax.axhline(-b, color="tab:green", ls=ls, lw=0.9)
         verdict = ", ".join(
             f"{'pass' if tst.passed[lv] else 'fail'} {100 * lv:g} %"
             for lv in tst.levels
