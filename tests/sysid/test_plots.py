@@ -159,3 +159,34 @@ def test_residual_plot_adds_colour_adjusted_bands_for_coloured_signals():
     (ax,) = plots.plot_residual_tests(c).axes
     labels = [ln.get_label() for ln in ax.lines]
     assert "95 % band, colour-adjusted" in labels
+
+
+def test_plot_validations_overlays_models_on_one_record():
+    wn, zeta, ts = 2 * np.pi * 11.72, 0.05, 0.002
+    num, den, _ = signal.cont2discrete(([wn**2], [1, 2 * zeta * wn, wn**2]), ts)
+    u = np.random.default_rng(0).standard_normal(1000)
+    data = IOData(u, signal.lfilter(num.ravel(), den, u), ts=ts)
+    theta = np.r_[den[1:], num.ravel()[1:]]
+    vals = {
+        name: validate(
+            IdentifiedModel(theta=theta * k, arx=ARX(2, 2, 1), ts=ts, method=name),
+            data,
+        )
+        for name, k in (("SDA", [1, 1, 1.2, 1]), ("Eb-SDA", [1, 1, 1.05, 1]))
+    }
+    figs = plots.plot_validations(vals)
+    assert set(figs) == {"time", "spectrum", "pole_zero"}
+    top = figs["time"].axes[0]
+    assert [ln.get_label() for ln in top.lines] == ["measured", "SDA", "Eb-SDA"]
+    figs = plots.plot_validations(list(vals.values()), fmax=100.0)
+    assert figs["spectrum"].axes[0].get_xlim()[1] == 100.0
+    other = validate(
+        IdentifiedModel(theta=theta, arx=ARX(2, 2, 1), ts=ts, method="x"),
+        IOData(u[:500], data.y[:500], ts=ts),
+    )
+    with pytest.raises(
+        ValueError, match="`validations` must all be on the same record"
+    ):
+        plots.plot_validations([vals["SDA"], other])
+    with pytest.raises(ValueError, match="`validations` must hold at least one"):
+        plots.plot_validations([])

@@ -22,6 +22,7 @@ __all__ = [
     "plot_psd",
     "plot_residual_tests",
     "plot_time_response",
+    "plot_validations",
 ]
 
 
@@ -495,3 +496,50 @@ def plot_convergence(
         ax.legend(loc="best", fontsize="small")
     axes[0].set_title("Convergence")
     return fig
+
+
+def plot_validations(validations, *, fmax: float | None = None) -> dict[str, Figure]:
+    """Several models validated on the same record, overlaid (paper Figure 7).
+
+    Parameters
+    ----------
+    validations : sequence of Validation or mapping of str to Validation
+        Results of :func:`~spiralid.sysid.validate` on one record; a mapping
+        gives the legend labels, otherwise each validation's ``label`` is used.
+    fmax : float, optional
+        Upper frequency limit of the spectrum plot.
+
+    Returns
+    -------
+    dict of Figure
+        ``"time"`` (measured and simulated outputs, errors), ``"spectrum"``
+        (Welch PSDs with measured peaks and each model's modes) and
+        ``"pole_zero"``.
+    """
+    if isinstance(validations, Mapping):
+        items = [(str(k), v) for k, v in validations.items()]
+    else:
+        items = [(v.label or f"model {i + 1}", v) for i, v in enumerate(validations)]
+    if not items:
+        raise ValueError("`validations` must hold at least one Validation; got none")
+    ref = items[0][1]
+    for label, v in items[1:]:
+        if v.y.shape != ref.y.shape or v.ts != ref.ts or not np.array_equal(v.y, ref.y):
+            raise ValueError(
+                f"`validations` must all be on the same record; {label!r} differs "
+                f"from {items[0][0]!r} (N = {v.y.size} vs {ref.y.size}, "
+                f"ts = {v.ts} vs {ref.ts})"
+            )
+    return {
+        "time": plot_time_response(
+            ref.t, ref.y, {k: v.y_sim for k, v in items}, title="Free-run output"
+        ),
+        "spectrum": plot_psd(
+            ref.psd_measured,
+            {k: v.psd_model for k, v in items},
+            peaks=ref.peaks_measured,
+            modes={k: v.modes for k, v in items},
+            fmax=fmax,
+        ),
+        "pole_zero": plot_pole_zero({k: (v.poles, v.zeros) for k, v in items}),
+    }
