@@ -1,0 +1,536 @@
+"""The ``spiralid`` command: simulate the rig, identify, validate, reproduce.
+
+Every subcommand has ``--help``. Bad arguments and bad input end with exit
+status 2 and a one-line ``spiralid <command>: error: ...`` message on
+standard error, never a traceback. Output directories must be new or empty
+unless ``--force``; files are never overwritten without ``--force``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["main"]
+
+
+class UsageError(Exception):
+    """A problem with what the user asked for: exit 2 with one line."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports a bad argument in one line, not usage + error."""
+
+    def error(self, message: str):  # type: ignore[override]
+        raise UsageError(message)
+
+
+# -- helpers ------------------------------------------------------------------
+
+
+def _column(value: str) -> str | int:
+    """A column given by name, or by 0-based index when it is all digits."""
+    return int(value) if value.isdigit() else value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number; got {text!r}") from None
+    if not np.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number; got {text!r}")
+    return value
+
+
+def _nonneg_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer; got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0; got {text!r}")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    value = _nonneg_int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1; got {text!r}")
+    return value
+
+
+def _fraction(text: str) -> float:
+    value = _positive_float(text)
+    if not value < 1:
+        raise argparse.ArgumentTypeError(f"must be in (0, 1); got {text!r}")
+    return value
+
+
+def _add_data_options(p: argparse.ArgumentParser, required_ts: bool = False) -> None:
+    p.add_argument(
+        "--input",
+        type=_column,
+        default=None,
+        help="input column (CSV name or 0-based index) or variable (NPZ/MAT); "
+        "default 'u', or 'torque_Nm' in files written by `spiralid simulate`",
+    )
+    p.add_argument(
+        "--output",
+        type=_column,
+        default=None,
+        help="output column or variable; default 'y', or "
+        "'end_acceleration_m_s2' in files written by `spiralid simulate`",
+    )
+    p.add_argument(
+        "--ts",
+        type=_positive_float,
+        default=None,
+        help="sample time in seconds (CSV: required unless a time_s column is "
+        "present; NPZ/MAT: default the file's 'ts')",
+    )
+
+
+def _load(path: str, input, output, ts):
+    """Read CSV, NPZ or MAT into IOData, with the defaults of `simulate` files."""
+    from spiralid.sysid import IOData
+
+    file = Path(path)
+    if not file.is_file():
+        raise UsageError(f"data file {path!r} does not exist")
+    suffix = file.suffix.lower()
+    if suffix == ".csv":
+        header = file.open().readline().strip().split(",")
+        written_by_us = "torque_Nm" in header
+        if input is None:
+            input = "torque_Nm" if written_by_us else "u"
+        if output is None:
+            output = "end_acceleration_m_s2" if written_by_us else "y"
+        if ts is None:
+            if "time_s" not in header:
+                raise UsageError(
+                    f"--ts is required for {path!r}: a CSV file carries no sample "
+                    "time (or give a 'time_s' column)"
+                )
+            t = np.loadtxt(
+                file, delimiter=",", skiprows=1, usecols=[header.index("time_s")]
+            )
+            steps = np.diff(t)
+            if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
+                raise UsageError(f"the time_s column of {path!r} is not evenly spaced")
+            ts = float(steps.mean())
+        return IOData.from_csv(file, input=input, output=output, ts=ts)
+    if suffix in (".npz", ".mat"):
+        if input is None:
+            input = "u"
+        if output is None:
+            output = "y"
+        if isinstance(input, int) or isinstance(output, int):
+            raise UsageError(
+                f"--input/--output must be variable names for {suffix} files"
+            )
+        loader = IOData.from_npz if suffix == ".npz" else IOData.from_mat
+        return loader(file, input=input, output=output, ts=ts)
+    raise UsageError(f"data file {path!r} must end in .csv, .npz or .mat")
+
+
+def _new_file(path: Path, force: bool) -> Path:
+    if path.exists() and not force:
+        raise UsageError(f"{str(path)!r} exists; pass --force to overwrite it")
+    if path.exists() and path.is_dir():
+        raise UsageError(f"{str(path)!r} is a directory")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def _out_dir(path: str, force: bool) -> Path:
+    from spiralid.report.output import check_output_dir
+
+    try:
+        out = check_output_dir(path, force)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def _save_figures(figures: dict, out: Path, prefix: str = "") -> list[Path]:
+    paths = []
+    for name, fig in figures.items():
+        path = out / f"{prefix}{name}.png"
+        fig.savefig(path, dpi=110)
+        paths.append(path)
+    return paths
+
+
+def _progress(args, total: int, label: str):
+    from spiralid.report.progress import ProgressBar
+
+    return ProgressBar(total, label, enabled=not args.quiet)
+
+
+# -- subcommands ----------------------------------------------------------------
+
+
+def _cmd_simulate(args) -> int:
+    from spiralid.fms import (
+        Experiment,
+        FlexibleManipulator,
+        Sensors,
+        bang_bang,
+        chirp,
+        prbs,
+    )
+
+    rig = FlexibleManipulator(payload_mass=args.payload)
+    fs = args.fs
+    if args.signal == "paper":
+        exp = Experiment(
+            amplitude=args.amplitude if args.amplitude is not None else 0.3,
+            duration=args.duration,
+            fs=fs,
+            n_pulses=max(int(args.duration // 1.0), 1),
+        )
+        torque = exp.torque()
+    elif args.signal == "bang-bang":
+        amp = 0.3 if args.amplitude is None else args.amplitude
+        torque = bang_bang(amp, args.width, 0.1, args.duration, fs)
+    elif args.signal == "prbs":
+        amp = 0.1 if args.amplitude is None else args.amplitude
+        torque = prbs(amp, args.duration, fs)
+    else:
+        amp = 0.1 if args.amplitude is None else args.amplitude
+        torque = chirp(amp, 1.0, min(100.0, fs / 2), args.duration, fs)
+    sensors = Sensors(accel_noise=args.accel_noise, tach_noise=args.tach_noise)
+    rec = rig.simulate(torque, fs=fs, rng=args.seed, sensors=sensors)
+    path = _new_file(Path(args.out), args.force)
+    columns = {
+        "time_s": rec.t,
+        "torque_Nm": rec.u,
+        "hub_angle_rad": rec.hub_angle,
+        "hub_velocity_rad_s": rec.hub_velocity,
+        "end_acceleration_m_s2": rec.end_acceleration,
+    }
+    if path.suffix.lower() == ".npz":
+        np.savez(
+            path,
+            ts=np.float64(rec.ts),
+            u=rec.u,
+            y=rec.end_acceleration,
+            **columns,
+        )
+    elif path.suffix.lower() == ".csv":
+        np.savetxt(
+            path,
+            np.column_stack(list(columns.values())),
+            delimiter=",",
+            header=",".join(columns),
+            comments="",
+            fmt="%.10g",
+        )
+    else:
+        raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
+    if not args.quiet:
+        print(
+            f"wrote {path} ({rec.u.size} samples at {fs:g} Hz; rig modes "
+            + ", ".join(f"{f:.2f}" for f in rig.modes(3))
+            + " Hz)"
+        )
+    return 0
+
+
+def _structure(args):
+    from spiralid.sysid import ARX
+
+    return ARX(args.na, args.nb, args.nk)
+
+
+def _cmd_identify(args) -> int:
+    from spiralid.sysid import identify, validate
+    from spiralid.sysid.plots import plot_convergence
+
+    data = _load(args.data, args.input, args.output, args.ts)
+    arx = _structure(args)
+    est, val = data.split(args.fraction)
+    arx.check_length(est, "estimation part of DATA")
+    out = _out_dir(args.out, args.force)
+    options = {}
+    if args.method in ("sda", "ebsda", "lasda"):
+        options = {"n_points": args.points, "max_iter": args.iterations}
+        if args.budget is not None:
+            options["max_nfev"] = args.budget
+    elif args.refine:
+        raise UsageError("--refine applies to the spiral methods sda, ebsda, lasda")
+    model = identify(
+        est,
+        arx,
+        method=args.method,
+        predictor=args.predictor,
+        parametrization=args.parametrization,
+        refine=args.refine,
+        rng=args.seed,
+        **options,
+    )
+    v_est = validate(model, est, label=f"{args.method} (estimation)")
+    v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
+    model_path = out / "model.json"
+    model_path.write_text(json.dumps(model.to_dict(), indent=2))
+    (out / "validation.json").write_text(
+        json.dumps(
+            {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
+        )
+    )
+    summary = "\n\n".join(
+        [
+            f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}",
+            f"estimation cost (eq. 2): {model.cost:.6g}",
+            v_est.summary(),
+            v_val.summary(),
+        ]
+    )
+    (out / "summary.txt").write_text(summary + "\n")
+    _save_figures(v_val.plot(), out, "validation_")
+    _save_figures(v_est.plot(), out, "estimation_")
+    if model.history is not None:
+        plot_convergence({args.method: model.history}).savefig(
+            out / "convergence.png", dpi=110
+        )
+    if not args.quiet:
+        print(summary)
+        print(f"\nwrote {model_path} and figures in {out}")
+    return 0
+
+
+def _cmd_validate(args) -> int:
+    from spiralid.sysid import IdentifiedModel, validate
+
+    path = Path(args.model)
+    if not path.is_file():
+        raise UsageError(f"model file {args.model!r} does not exist")
+    try:
+        model = IdentifiedModel.from_dict(json.loads(path.read_text()))
+    except (json.JSONDecodeError, KeyError, TypeError) as exc:
+        raise UsageError(
+            f"{args.model!r} is not a spiralid model file ({exc})"
+        ) from None
+    ts = args.ts if args.ts is not None else model.ts
+    data = _load(args.data, args.input, args.output, ts)
+    if args.fraction is not None:
+        warm, data = data.split(args.fraction)
+    else:
+        warm = None
+    v = validate(model, data, warmup=warm, label=model.method)
+    text = v.summary()
+    if args.out is not None:
+        out = _out_dir(args.out, args.force)
+        (out / "validation.json").write_text(json.dumps(v.to_dict(), indent=2))
+        (out / "summary.txt").write_text(text + "\n")
+        _save_figures(v.plot(), out)
+    if not args.quiet:
+        print(text)
+    return 0
+
+
+def _cmd_reproduce(args, argv: list[str]) -> int:
+    from spiralid.report import reproduce, summary_text, write_reproduction
+    from spiralid.report.output import check_output_dir
+
+    try:
+        check_output_dir(args.out, args.force)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    data = None
+    if args.data is not None:
+        data = _load(args.data, args.input, args.output, args.ts)
+    n_configs = 7
+    bar = _progress(args, args.seeds * n_configs + 2, "reproduce")
+    try:
+        rep = reproduce(
+            data,
+            seeds=range(args.first_seed, args.first_seed + args.seeds),
+            max_nfev=args.budget,
+            n_points=args.points,
+            workers=args.workers,
+            progress=lambda done, total: bar(done),
+        )
+    finally:
+        bar.close()
+    command = "spiralid " + shlex.join(argv)
+    write_reproduction(rep, args.out, force=args.force, command=command)
+    if not args.quiet:
+        print(summary_text(rep))
+        print(f"\nwrote figures, results.json and report.html in {args.out}")
+    return 0
+
+
+# -- the parser -------------------------------------------------------------------
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``spiralid`` command."""
+    parser = _Parser(
+        prog="spiralid",
+        description="System identification with spiral dynamic optimisation "
+        "(SDA and exponential-based SDA) for flexible structures.",
+    )
+    from spiralid import __version__
+
+    parser.add_argument(
+        "--version", action="version", version=f"spiralid {__version__}"
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser(
+        "simulate",
+        help="simulate the flexible manipulator rig and write a CSV or NPZ",
+        description="Drive the finite-element flexible manipulator rig with a "
+        "torque signal and write time, torque, hub angle, hub velocity and "
+        "end-point acceleration (CSV header carries the units).",
+    )
+    p.add_argument(
+        "--signal",
+        choices=["paper", "bang-bang", "prbs", "chirp"],
+        default="paper",
+        help="torque input: 'paper' is the reproduction's train of bang-bang "
+        "pulses (one per second), 'bang-bang' a single pulse pair (default paper)",
+    )
+    p.add_argument("--amplitude", type=float, default=None, help="torque (N m)")
+    p.add_argument(
+        "--width", type=_positive_float, default=0.04, help="bang-bang pulse width (s)"
+    )
+    p.add_argument(
+        "--duration", type=_positive_float, default=6.0, help="record length (s)"
+    )
+    p.add_argument("--fs", type=_positive_float, default=500.0, help="sample rate (Hz)")
+    p.add_argument("--payload", type=float, default=0.0, help="tip payload (kg)")
+    p.add_argument(
+        "--accel-noise", type=float, default=1.0, help="accelerometer noise std (m/s^2)"
+    )
+    p.add_argument(
+        "--tach-noise", type=float, default=0.01, help="tachometer noise std (rad/s)"
+    )
+    p.add_argument("--seed", type=_nonneg_int, default=0, help="noise seed")
+    p.add_argument("--out", default="rig.csv", help="output file, .csv or .npz")
+    p.add_argument("--force", action="store_true", help="overwrite --out")
+    p.add_argument("--quiet", action="store_true", help="print nothing")
+
+    p = sub.add_parser(
+        "identify",
+        help="identify an ARX model from a data file",
+        description="Estimate an ARX model on the first --fraction of DATA and "
+        "validate it on the rest; write model.json, validation.json, "
+        "summary.txt and figures into --out.",
+    )
+    p.add_argument("data", help="CSV, NPZ or MAT file")
+    _add_data_options(p)
+    p.add_argument("--na", type=_nonneg_int, default=8, help="poles (default 8)")
+    p.add_argument(
+        "--nb", type=_positive_int, default=8, help="numerator terms (default 8)"
+    )
+    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (default 0)")
+    p.add_argument(
+        "--method", choices=["ebsda", "sda", "lasda", "ls", "oe"], default="ebsda"
+    )
+    p.add_argument(
+        "--predictor", choices=["simulation", "one-step"], default="simulation"
+    )
+    p.add_argument(
+        "--parametrization",
+        choices=["coefficients", "reflection"],
+        default="coefficients",
+    )
+    p.add_argument(
+        "--refine", action="store_true", help="polish a spiral result locally"
+    )
+    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+    p.add_argument(
+        "--iterations", type=_positive_int, default=500, help="max iterations"
+    )
+    p.add_argument(
+        "--budget", type=_positive_int, default=None, help="max cost evaluations"
+    )
+    p.add_argument("--seed", type=_nonneg_int, default=0)
+    p.add_argument("--fraction", type=_fraction, default=2 / 3, help="estimation share")
+    p.add_argument("--out", default="spiralid-identify", help="output directory")
+    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
+    p.add_argument("--quiet", action="store_true", help="print nothing")
+
+    p = sub.add_parser(
+        "validate",
+        help="validate a saved model on a data file",
+        description="Fit %%, error range, residual tests, spectra, modes, "
+        "stability and realisation tests of MODEL on DATA.",
+    )
+    p.add_argument("model", help="model.json written by `spiralid identify`")
+    p.add_argument("data", help="CSV, NPZ or MAT file")
+    _add_data_options(p)
+    p.add_argument(
+        "--fraction",
+        type=_fraction,
+        default=None,
+        help="run the model over the whole record but score only the part after "
+        "this share (e.g. 0.6667 for the validation third); default: score all",
+    )
+    p.add_argument(
+        "--out", default=None, help="directory for validation.json and figures"
+    )
+    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
+    p.add_argument("--quiet", action="store_true", help="print nothing")
+
+    p = sub.add_parser(
+        "reproduce",
+        help="the paper's SDA vs Eb-SDA experiment with baselines and statistics",
+        description="Identify ARX(8, 8, 0) by SDA and Eb-SDA (paper-faithful and "
+        "reflection parametrisations, refine, gain sensitivity) over several "
+        "seeds at an equal budget, beside least squares and output error; write "
+        "Table-2, Figures 6-7, results.json and report.html into --out.",
+    )
+    p.add_argument("--seeds", type=_positive_int, default=6, help="number of seeds")
+    p.add_argument("--first-seed", type=_nonneg_int, default=0)
+    p.add_argument(
+        "--budget", type=_positive_int, default=20_000, help="cost evaluations per run"
+    )
+    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+    p.add_argument("--workers", type=_positive_int, default=None, help="processes")
+    p.add_argument("--data", default=None, help="your own CSV/NPZ/MAT record")
+    _add_data_options(p)
+    p.add_argument("--out", default="spiralid-reproduce", help="output directory")
+    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the ``spiralid`` command; return its exit status."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    command = argv[0] if argv and not argv[0].startswith("-") else None
+    prefix = f"spiralid {command}" if command else "spiralid"
+    try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return 2
+        if args.command == "simulate":
+            return _cmd_simulate(args)
+        if args.command == "identify":
+            return _cmd_identify(args)
+        if args.command == "validate":
+            return _cmd_validate(args)
+        return _cmd_reproduce(args, argv)
+    except (UsageError, ValueError, OSError) as exc:
+        message = " ".join(str(exc).split())
+        print(f"{prefix}: error: {message}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{prefix}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
