@@ -259,7 +259,7 @@ def plot_psd(
     return fig
 
 
-def plot_pole_zero(models) -> Figure:
+def plot_pole_zero(models, *, radius: float | None = None) -> Figure:
     """Pole-zero map in the z-plane with the unit circle, for several models.
 
     Parameters
@@ -268,6 +268,10 @@ def plot_pole_zero(models) -> Figure:
         Poles are drawn as crosses and zeros as circles, one colour per model.
         Objects with ``poles`` and ``zeros`` attributes (an
         ``IdentifiedModel``) are accepted in place of the pair.
+    radius : float, optional
+        Half-width of the square view around the origin. Default: enough to
+        show every pole and zero, but at most 2; points beyond the view (an
+        ARX numerator often has a far zero) are counted in the title.
 
     Returns
     -------
@@ -291,6 +295,9 @@ def plot_pole_zero(models) -> Figure:
     ax.plot(np.cos(w), np.sin(w), color="k", lw=0.8, label="_unit circle")
     ax.axhline(0.0, color="0.7", lw=0.5)
     ax.axvline(0.0, color="0.7", lw=0.5)
+    if radius is not None and not (np.isfinite(radius) and radius > 0):
+        raise ValueError(f"`radius` must be a positive number; got {radius!r}")
+    everything = []
     for label, pz in models.items():
         if hasattr(pz, "poles") and hasattr(pz, "zeros"):
             p, z = pz.poles, pz.zeros
@@ -304,6 +311,7 @@ def plot_pole_zero(models) -> Figure:
                 ) from None
         p = np.atleast_1d(np.asarray(p, dtype=complex))
         z = np.atleast_1d(np.asarray(z, dtype=complex))
+        everything.append(np.abs(np.r_[p, z]))
         (line,) = ax.plot(p.real, p.imag, "x", ms=8, mew=1.5, label=f"{label} poles")
         ax.plot(
             z.real,
@@ -314,10 +322,19 @@ def plot_pole_zero(models) -> Figure:
             color=line.get_color(),
             label=f"{label} zeros",
         )
-    ax.set_aspect("equal", adjustable="datalim")
+    mags = np.concatenate(everything) if everything else np.zeros(0)
+    if radius is None:
+        radius = float(np.clip(1.1 * mags.max(), 1.15, 2.0)) if mags.size else 1.15
+    outside = int(np.sum(mags > radius))
+    ax.set_xlim(-radius, radius)
+    ax.set_ylim(-radius, radius)
+    ax.set_aspect("equal")
     ax.set_xlabel("Re z")
     ax.set_ylabel("Im z")
-    ax.set_title("Pole-zero map")
+    title = "Pole-zero map"
+    if outside:
+        title += f" ({outside} outside the view, largest |z| = {mags.max():.3g})"
+    ax.set_title(title, fontsize="medium")
     ax.legend(loc="best", fontsize="small")
     return fig
 
