@@ -42,7 +42,7 @@ class Experiment:
     - ``accel_noise = 1.0`` m/s^2 (about 2 % of the acceleration's RMS,
       34 dB SNR), ``tach_noise = 0.01`` rad/s; the default
       :class:`~spiralid.fms.sensors.Sensors` otherwise (encoder x4,
-      4th-order Butterworth anti-aliasing at half Nyquist).
+      4th-order Butterworth anti-aliasing at 0.35 x Nyquist, 87.5 Hz).
     """
 
     amplitude: float = 0.3

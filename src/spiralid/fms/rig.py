@@ -358,7 +358,7 @@ class FlexibleManipulator:
             tachometer first, then accelerometer).
         sensors : Sensors, optional
             Instrumentation; default ``Sensors()`` (2048-line x4 encoder, no
-            noise, 4th-order Butterworth anti-aliasing at half Nyquist on the
+            noise, 4th-order Butterworth anti-aliasing at 0.35 x Nyquist on the
             tachometer and accelerometer).  ``Sensors.ideal()`` samples the
             exact signals.
         x0 : array_like, shape (2 ndof,), optional
