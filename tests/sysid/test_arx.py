@@ -143,13 +143,13 @@ def test_bad_theta_short_record_constant_input():
         arx.simulate(np.zeros(5), np.ones(10))
     short = IOData(np.arange(20.0), np.arange(20.0), ts=1.0)
     with pytest.raises(
-        ValueError, match="`data` is too short for ARX.8, 8, 0.: needs at least 25"
+        ValueError, match=r"`data` is too short for ARX\(8, 8, 0\): needs at least 25"
     ):
         arx_least_squares(short, arx)
     const = IOData(
         np.full(100, 2.0), np.random.default_rng(0).standard_normal(100), ts=1.0
     )
     with pytest.raises(
-        ValueError, match="`data` input is constant .*does not excite the system"
+        ValueError, match=r"`data` input is constant .*does not excite the system"
     ):
         arx_least_squares(const, ARX(2, 2, 1))
