@@ -568,6 +568,28 @@ def validate(
         signal lengths, or a sample time of the data that differs from the
         model's.
 
+    Examples
+    --------
+    A noise-free ARX(2, 2, 1) record: least squares recovers the system, and
+    the validation part is reproduced exactly.
+
+    >>> import numpy as np
+    >>> from scipy import signal
+    >>> from spiralid.sysid import ARX, IOData, identify
+    >>> u = np.random.default_rng(0).standard_normal(600)
+    >>> y = signal.lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    >>> est, val = IOData(u, y, ts=0.01).split(2 / 3)
+    >>> fit = identify(est, ARX(2, 2, 1), method="ls")
+    >>> rep = validate(fit, val, warmup=est, max_damping=1.0)
+    >>> round(rep.fit_percent, 6), rep.stable, rep.realization.minimal
+    (100.0, True, True)
+
+    The pole pair of ``1 - 1.5 z^-1 + 0.7 z^-2`` is a mode at 7.84 Hz with
+    damping 0.36 (listed because ``max_damping`` was raised from 0.3):
+
+    >>> np.round(rep.modes.frequency, 2), np.round(rep.modes.damping, 2)
+    (array([7.84]), array([0.36]))
+
     Notes
     -----
     The cost is eq. (2)-(3), ``w sqrt(sum e^2) / K`` plus the model's penalty
