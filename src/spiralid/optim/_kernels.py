@@ -4,6 +4,12 @@ Per-point angles (Eb-SDA) rule out one shared rotation matrix, and a NumPy
 loop over the n(n-1)/2 planes costs several microseconds per point at n = 16,
 so the plane sweep is compiled with Numba. ``cache=True`` keeps the compile
 cost to the first call on a machine.
+
+Both kernels hold the vectors transposed, one row per coordinate, and sweep
+each plane across all points at once: consecutive planes share a coordinate,
+so sweeping one point at a time would be a serial chain of dependent
+multiply-adds, while across points the work is independent and contiguous.
+Each point still sees exactly the same operations in the same order.
 """
 
 import numba
@@ -11,47 +17,107 @@ import numpy as np
 
 
 @numba.njit(cache=True, nogil=True)
-def sweep(v, c, s, planes):  # pragma: no cover - compiled
-    """Rotate each row of ``v`` in place by its own angle.
+def _sweep_columns(w, c, s, planes):  # pragma: no cover - compiled
+    k = w.shape[1]
+    for t in range(planes.shape[0]):
+        wp = w[planes[t, 0]]
+        wq = w[planes[t, 1]]
+        for i in range(k):
+            a = wp[i]
+            b = wq[i]
+            wp[i] = c[i] * a - s[i] * b
+            wq[i] = s[i] * a + c[i] * b
+
+
+@numba.njit(cache=True, nogil=True)
+def sweep(v, theta, planes):  # pragma: no cover - compiled
+    """Return the rows of ``v`` (m, n) each rotated by its own ``theta[i]``.
 
     ``planes`` lists the (p, q) planes (0-based) in the order they are
     applied to a vector, i.e. the reverse of the matrix-product order.
     """
-    m, _ = v.shape
-    k = planes.shape[0]
-    for i in range(m):
-        ci = c[i]
-        si = s[i]
-        for t in range(k):
-            p = planes[t, 0]
-            q = planes[t, 1]
-            a = v[i, p]
-            b = v[i, q]
-            v[i, p] = ci * a - si * b
-            v[i, q] = si * a + ci * b
+    w = np.ascontiguousarray(v.T)
+    _sweep_columns(w, np.cos(theta), np.sin(theta), planes)
+    return np.ascontiguousarray(w.T)
 
 
 @numba.njit(cache=True, nogil=True)
-def spiral_step(x, r, c, s, planes):  # pragma: no cover - compiled
+def spiral_step(x, r, theta, planes):  # pragma: no cover - compiled
     """Move rows 1.. of ``x`` in place: x_i <- x_0 + r_i R(theta_i) (x_i - x_0).
 
-    Row 0 is the centre and is left untouched.
+    ``r`` and ``theta`` hold one value per moving row. Row 0 is the centre
+    and is left untouched.
     """
     m, n = x.shape
-    k = planes.shape[0]
-    w = np.empty(n)
-    for i in range(1, m):
+    k = m - 1
+    w = np.empty((n, k))
+    for i in range(k):
         for j in range(n):
-            w[j] = x[i, j] - x[0, j]
-        ci = c[i - 1]
-        si = s[i - 1]
-        for t in range(k):
-            p = planes[t, 0]
-            q = planes[t, 1]
-            a = w[p]
-            b = w[q]
-            w[p] = ci * a - si * b
-            w[q] = si * a + ci * b
-        ri = r[i - 1]
+            w[j, i] = x[i + 1, j] - x[0, j]
+    _sweep_columns(w, np.cos(theta), np.sin(theta), planes)
+    for i in range(k):
+        ri = r[i]
         for j in range(n):
-            x[i, j] = x[0, j] + ri * w[j]
+            x[i + 1, j] = x[0, j] + ri * w[j, i]
+
+
+@numba.njit(cache=True, nogil=True)
+def promote(x, f):  # pragma: no cover - compiled
+    """Swap the best finite point into row 0; ties keep the lowest index.
+
+    Non-finite costs never win; if no cost is finite nothing moves.
+    """
+    best = -1
+    for i in range(f.size):
+        fi = f[i]
+        if np.isfinite(fi) and (best < 0 or fi < f[best]):
+            best = i
+    if best > 0:
+        for j in range(x.shape[1]):
+            t = x[0, j]
+            x[0, j] = x[best, j]
+            x[best, j] = t
+        t = f[0]
+        f[0] = f[best]
+        f[best] = t
+
+
+@numba.njit(cache=True, nogil=True)
+def deviations(f):  # pragma: no cover - compiled
+    """``|f[i] - f[0]|`` for i >= 1; ``inf`` where either cost is non-finite."""
+    k = f.size - 1
+    d = np.empty(k)
+    fc = f[0]
+    ok = np.isfinite(fc)
+    for i in range(k):
+        fi = f[i + 1]
+        # Costs of opposite sign may differ by more than the largest float:
+        # the difference then rounds to inf, which is what it should rank as.
+        d[i] = abs(fi - fc) if ok and np.isfinite(fi) else np.inf
+    return d
+
+
+@numba.njit(cache=True, nogil=True)
+def exponential(d, lower, span, c2, log_c1, cap):  # pragma: no cover - compiled
+    """Eq. (4) for each row's constants: ``lower + span * expit(ln c1 - c2 d)``.
+
+    Returns the (rows, k) values and how many ``d`` are exactly 0.
+    """
+    rows = lower.size
+    k = d.size
+    out = np.empty((rows, k))
+    zeros = 0
+    for i in range(k):
+        if d[i] == 0.0:
+            zeros += 1
+    for j in range(rows):
+        for i in range(k):
+            u = log_c1[j] - min(d[i], cap[j]) * c2[j]
+            # expit(u) without overflow for either sign of u.
+            if u >= 0.0:
+                e = 1.0 / (1.0 + np.exp(-u))
+            else:
+                t = np.exp(u)
+                e = t / (1.0 + t)
+            out[j, i] = lower[j] + span[j] * e
+    return out, zeros

@@ -145,7 +145,7 @@ def rotate(v, theta) -> np.ndarray:
         raise ValueError(
             f"`v` must have shape (m, n) or (n,) with n >= 1; got shape {arr.shape}"
         )
-    batch = np.array(arr.reshape(-1, arr.shape[-1]), dtype=np.float64, order="C")
+    batch = np.ascontiguousarray(arr.reshape(-1, arr.shape[-1]))
     m, n = batch.shape
     t = np.asarray(theta, dtype=np.float64)
     if t.ndim == 0:
@@ -157,5 +157,4 @@ def rotate(v, theta) -> np.ndarray:
         )
     if not np.all(np.isfinite(t)):
         raise ValueError(f"`theta` must be finite; got {theta!r}")
-    _kernels.sweep(batch, np.cos(t), np.sin(t), _sweep_order(n))
-    return batch.reshape(arr.shape)
+    return _kernels.sweep(batch, t, _sweep_order(n)).reshape(arr.shape)

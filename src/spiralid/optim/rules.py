@@ -17,7 +17,8 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import expit
+
+from spiralid.optim import _kernels
 
 __all__ = [
     "ConstantSpiral",
@@ -129,7 +130,8 @@ class ConstantSpiral(SpiralRule):
 def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.ndarray:
     """Eq. (4): ``(lower - upper) / (1 + c1 / exp(c2 d)) + upper``.
 
-    Evaluated as ``lower + (upper - lower) * expit(ln c1 - c2 d)``, which is
+    Evaluated as ``lower + (upper - lower) * expit(ln c1 - c2 d)`` (compiled,
+    with a sign-split logistic), which is
     the same function but finite and warning-free for any ``d >= 0``,
     ``inf`` included (penalised costs make ``d`` huge). It falls
     monotonically from ``upper + (lower - upper) / (1 + c1)`` at ``d = 0``
@@ -156,10 +158,19 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
     array([0.991089, 0.1     ])
     """
     d = np.asarray(d, dtype=np.float64)
+    if np.isnan(d).any() or (d < 0).any():
+        raise ValueError(f"`d` must be >= 0 (inf allowed); got {d!r}")
+    lower, upper, c1, c2 = (float(v) for v in (lower, upper, c1, c2))
     cap = max((_Z_CAP + math.log(c1)) / c2, 0.0)
-    z = c2 * np.minimum(d, cap) - math.log(c1)
-    # Written from the lower end so that the d -> inf limit is exactly `lower`.
-    return lower + (upper - lower) * expit(-z)
+    out, _ = _kernels.exponential(
+        d.ravel(),
+        np.array([lower]),
+        np.array([upper - lower]),
+        np.array([c2]),
+        np.array([math.log(c1)]),
+        np.array([cap]),
+    )
+    return out[0].reshape(d.shape)
 
 
 @dataclass(frozen=True)
@@ -203,6 +214,21 @@ class ExponentialSpiral(SpiralRule):
             values[name] = _positive(getattr(self, name), name)
         for name, value in values.items():
             object.__setattr__(self, name, value)
+        # Radius and angle evaluated together, as `exponential_rule` does.
+        c1 = (values["r_c1"], values["th_c1"])
+        c2 = (values["r_c2"], values["th_c2"])
+        # Python floats: the cap may overflow to inf without a warning.
+        cap = [
+            max((_Z_CAP + math.log(a)) / b, 0.0) for a, b in zip(c1, c2, strict=True)
+        ]
+        consts = (
+            np.array([r_l, th_l]),
+            np.array([r_u - r_l, th_u - th_l]),
+            np.array(c2),
+            np.array([math.log(a) for a in c1]),
+            np.array(cap),
+        )
+        object.__setattr__(self, "_consts", consts)
 
     def radius(self, d) -> np.ndarray:
         """Eq. (4)/(7) without the random draw at ``d == 0``."""
@@ -214,13 +240,11 @@ class ExponentialSpiral(SpiralRule):
 
     def __call__(self, d, rng):
         d = np.asarray(d, dtype=np.float64)
-        r = self.radius(d)
-        theta = self.angle(d)
-        zero = d == 0.0
-        k = int(np.count_nonzero(zero))
-        if k:
-            r[zero] = rng.uniform(self.r_l, self.r_u, k)
-            theta[zero] = rng.uniform(self.th_l, self.th_u, k)
+        (r, theta), zeros = _kernels.exponential(d, *self._consts)
+        if zeros:
+            zero = d == 0.0
+            r[zero] = rng.uniform(self.r_l, self.r_u, zeros)
+            theta[zero] = rng.uniform(self.th_l, self.th_u, zeros)
         return r, theta
 
 

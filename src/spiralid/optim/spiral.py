@@ -170,6 +170,18 @@ def _parse_method(method) -> SpiralRule:
     )
 
 
+def _per_point(value, k: int, what: str) -> np.ndarray:
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.shape == (k,):
+        return arr
+    if arr.ndim == 0:
+        return np.full(k, float(arr))
+    raise ValueError(
+        f"`method` rule must return a scalar {what} or one per moving point, "
+        f"shape ({k},); got shape {arr.shape}"
+    )
+
+
 class SpiralSearch:
     """A spiral search you can step yourself; :func:`minimize` drives one.
 
@@ -300,37 +312,15 @@ class SpiralSearch:
 
     def _promote(self) -> None:
         """Move the best finite point to row 0 (ties keep the incumbent)."""
-        f = self._f
-        finite = np.isfinite(f)
-        if finite.all():
-            i = int(np.argmin(f))
-        elif finite.any():
-            i = int(np.argmin(np.where(finite, f, np.inf)))
-        else:
-            return
-        if i != 0:
-            self._x[[0, i]] = self._x[[i, 0]]
-            f[0], f[i] = f[i], f[0]
+        _kernels.promote(self._x, self._f)
 
     def _best_cost(self) -> float:
         f0 = float(self._f[0])
         return f0 if math.isfinite(f0) else math.inf
 
     def _deviations(self) -> np.ndarray:
-        fc = self._f[0]
-        fm = self._f[1:]
-        if math.isfinite(fc):
-            finite = np.isfinite(fm)
-            if finite.all():
-                if fc >= 0.0:
-                    return fm - fc
-                with np.errstate(over="ignore"):
-                    return fm - fc
-            d = np.full(fm.shape, np.inf)
-            with np.errstate(over="ignore"):
-                d[finite] = fm[finite] - fc
-            return d
-        return np.full(fm.shape, np.inf)
+        """``|f(x_i) - min J|`` of the moving points; ``inf`` if non-finite."""
+        return _kernels.deviations(self._f)
 
     def _rotation(self, theta: float) -> np.ndarray:
         cached_theta, matrix = self._matrix
@@ -356,31 +346,31 @@ class SpiralSearch:
     def step(self) -> tuple[np.ndarray, float]:
         """Perform one iteration; return the best point and cost."""
         x = self._x
-        m = x.shape[0]
+        k = x.shape[0] - 1
         r, theta = self.rule(self._deviations(), self._rng)
         if np.ndim(theta) == 0 and np.ndim(r) == 0:
             # One angle for all points: one dense product beats the sweep.
-            w = (x[1:] - x[0]) @ self._rotation(float(theta)).T
-            x[1:] = x[0] + float(r) * w
+            r = float(r)
+            theta = float(theta)
+            w = x[1:] - x[0]
+            x[1:] = w @ self._rotation(theta).T
+            x[1:] *= r
+            x[1:] += x[0]
+            self.mean_radius.append(r)
+            self.mean_angle.append(theta)
         else:
-            r_arr = np.broadcast_to(np.asarray(r, dtype=np.float64), (m - 1,))
-            t_arr = np.broadcast_to(np.asarray(theta, dtype=np.float64), (m - 1,))
-            _kernels.spiral_step(
-                x,
-                np.ascontiguousarray(r_arr),
-                np.cos(t_arr),
-                np.sin(t_arr),
-                self._planes,
-            )
+            r = _per_point(r, k, "radius")
+            theta = _per_point(theta, k, "angle")
+            _kernels.spiral_step(x, r, theta, self._planes)
+            self.mean_radius.append(float(r.sum()) / k)
+            self.mean_angle.append(float(theta.sum()) / k)
         if self.bounds_policy != "none":
             self._apply_bounds(x[1:])
         self._f[1:] = self._evaluate(x[1:])
-        self.nfev += m - 1
+        self.nfev += k
         self.nit += 1
         self._promote()
         self.history.append(self._best_cost())
-        self.mean_radius.append(float(np.mean(r)))
-        self.mean_angle.append(float(np.mean(theta)))
         return self.x, float(self._f[0])
 
     def __iter__(self):
