@@ -47,7 +47,7 @@ from .cost import PaperCost
 from .data import IOData
 from .polynomials import fold_reflection, step_down, step_up
 
-__all__ = ["IdentifiedModel", "default_bounds", "identify"]
+__all__ = ["IdentifiedModel", "default_bounds", "feasible_initial_points", "identify"]
 
 _SPIRAL = ("sda", "ebsda", "lasda")
 _METHODS = ("ls", "oe", *_SPIRAL)
@@ -148,6 +148,10 @@ class IdentifiedModel:
     def to_dlti(self) -> signal.dlti:
         """The model as a ``scipy.signal.dlti`` transfer function with ``dt = ts``."""
         num, den = self.polynomials
+        # Leading zeros (nk > 0) are exact in positive powers of z; dropping
+        # them avoids SciPy's "badly conditioned" warning.
+        nz = np.flatnonzero(num)
+        num = num[nz[0] :] if nz.size else num[-1:]
         return signal.dlti(num, den, dt=self.ts)
 
     # -- serialisation -----------------------------------------------------------
@@ -257,6 +261,24 @@ def default_bounds(
         box[i] = (-half, half)
     box[arx.na :] = (-s, s)
     return box
+
+
+def feasible_initial_points(box: np.ndarray, arx: ARX, m: int, rng=None) -> np.ndarray:
+    """``m`` initial points "in the feasible region" (DESIGN.md item 12).
+
+    Denominators: reflection coefficients uniform in (-1, 1) mapped by
+    step-up, so every point is stable (a uniform draw in the coefficient box
+    almost never is for na = 8); numerators uniform in their box.
+
+    Returns
+    -------
+    ndarray, shape (m, p)
+    """
+    gen = np.random.default_rng(rng)
+    na = arx.na
+    k = gen.uniform(-1.0, 1.0, size=(m, na))
+    b = gen.uniform(box[na:, 0], box[na:, 1], size=(m, arx.nb))
+    return np.clip(np.concatenate([step_up(k), b], axis=1), box[:, 0], box[:, 1])
 
 
 def _check_bounds(bounds, p: int) -> np.ndarray:
@@ -525,13 +547,8 @@ def identify(
             return np.asarray(x, dtype=float)
 
         if "x0" not in optimiser_options:
-            # "Initial points in the feasible region" (DESIGN.md item 12).
             m = int(optimiser_options.get("n_points", 50))
-            k = gen.uniform(-1.0, 1.0, size=(m, na))
-            b = gen.uniform(box[na:, 0], box[na:, 1], size=(m, arx.nb))
-            optimiser_options["x0"] = np.clip(
-                np.concatenate([step_up(k), b], axis=1), box[:, 0], box[:, 1]
-            )
+            optimiser_options["x0"] = feasible_initial_points(box, arx, m, gen)
     res = minimize(
         fun, box, method=method, rng=gen, vectorized=True, **optimiser_options
     )
