@@ -1,0 +1,102 @@
+"""The reproduction experiment: numbers, statistics and determinism."""
+
+import json
+
+import numpy as np
+import pytest
+from scipy import stats
+from scipy.signal import lfilter
+
+from spiralid import ARX, IOData
+from spiralid.report import Configuration, reproduce
+from spiralid.report.output import results_dict, summary_text, verdict
+
+CONFIGS = (Configuration("SDA", "sda"), Configuration("Eb-SDA", "ebsda"))
+
+
+@pytest.fixture(scope="module")
+def data():
+    rng = np.random.default_rng(7)
+    u = rng.standard_normal(600)
+    y = lfilter([0.0, 0.5, 0.25], [1.0, -1.2, 0.5], u) + 0.01 * rng.standard_normal(600)
+    return IOData(u, y, ts=0.01)
+
+
+@pytest.fixture(scope="module")
+def rep(data):
+    return reproduce(
+        data, seeds=3, max_nfev=600, arx=ARX(2, 2, 1), configurations=CONFIGS, workers=1
+    )
+
+
+def _numbers(rep):
+    d = results_dict(rep)
+    for key in ("elapsed_seconds", "versions", "command"):
+        d.pop(key)
+    for runs in d["runs"].values():
+        for r in runs:
+            r.pop("seconds")
+    for r in d["baselines"].values():
+        r.pop("seconds")
+    return json.dumps(d, sort_keys=True)
+
+
+def test_same_seeds_same_numbers_in_one_or_two_processes(data, rep):
+    again = reproduce(
+        data, seeds=3, max_nfev=600, arx=ARX(2, 2, 1), configurations=CONFIGS, workers=2
+    )
+    assert _numbers(again) == _numbers(rep)
+
+
+def test_statistics_and_rank_sum_match_numpy_and_scipy(rep):
+    costs = np.array([r.cost for r in rep.runs["SDA"]])
+    s = rep.statistics("SDA")
+    assert s["cost_mean"] == pytest.approx(costs.mean())
+    assert s["cost_std"] == pytest.approx(costs.std(ddof=1))
+    assert s["cost_median"] == pytest.approx(np.median(costs))
+    assert (s["cost_best"], s["cost_worst"]) == (costs.min(), costs.max())
+    other = [r.cost for r in rep.runs["Eb-SDA"]]
+    expected = stats.ranksums(other, costs)
+    assert rep.ranksum("Eb-SDA", "SDA")["p_two_sided"] == pytest.approx(expected.pvalue)
+    assert rep.best("SDA").cost == costs.min()
+
+
+def test_runs_respect_the_budget_and_seeds(rep):
+    for runs in rep.runs.values():
+        assert [r.seed for r in runs] == [0, 1, 2]
+        assert all(r.model.result.nfev <= 600 for r in runs)
+        # Times are stamped once per history entry, from zero, increasing.
+        for r in runs:
+            assert r.times.size == r.history.size
+            assert r.times[0] == 0 and np.all(np.diff(r.times) >= 0)
+
+
+def test_baselines_and_table2(rep, data):
+    # On noise-light data from an ARX(2, 2, 1) model, least squares is
+    # near-perfect: validation fit well above 95 %.
+    assert rep.baselines["LS"].fit_val > 95
+    rows = {row["label"]: row for row in rep.table2()}
+    assert set(rows) == {"SDA", "Eb-SDA", "LS", "OE"}
+    lo, hi = rows["LS"]["error_range_validation"]
+    model = rep.baselines["LS"].model
+    err = data.y[rep.estimation.n :] - model.simulate(data.u)[rep.estimation.n :]
+    assert (lo, hi) == pytest.approx((err.min(), err.max()))
+
+
+def test_summary_and_verdict_are_honest(rep):
+    text = summary_text(rep)
+    assert "Table-2" in text and verdict(rep) in text
+    a = rep.statistics("Eb-SDA")["cost_median"]
+    b = rep.statistics("SDA")["cost_median"]
+    assert verdict(rep).startswith("Eb-SDA beat") == (
+        a < b and rep.ranksum("Eb-SDA", "SDA")["p_less"] < 0.05
+    )
+
+
+def test_bad_input(data):
+    with pytest.raises(ValueError, match="`seeds`"):
+        reproduce(data, seeds=[], arx=ARX(2, 2, 1))
+    with pytest.raises(ValueError, match="`max_nfev`"):
+        reproduce(data, max_nfev=1, arx=ARX(2, 2, 1))
+    with pytest.raises(ValueError, match="`data`"):
+        reproduce(np.zeros(10))

@@ -1,0 +1,209 @@
+"""The `spiralid` console script, run as a user would (subprocess)."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spiralid import IdentifiedModel, IOData
+from spiralid.fms import FlexibleManipulator, paper_experiment
+
+SCRIPT = Path(sys.executable).parent / "spiralid"
+ARM = (
+    Path(__file__).resolve().parents[1]
+    / ".."
+    / "shared"
+    / "data"
+    / "daisy_robot_arm.csv"
+)
+
+
+def run(*args, cwd):
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    return subprocess.run(
+        [str(SCRIPT), *map(str, args)], cwd=cwd, env=env, capture_output=True, text=True
+    )
+
+
+@pytest.fixture(scope="module")
+def rig_csv(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("rig")
+    proc = run("simulate", "--out", "rig.csv", "--seed", "3", cwd=tmp)
+    assert proc.returncode == 0, proc.stderr
+    return tmp / "rig.csv"
+
+
+def test_help_of_every_subcommand(tmp_path):
+    for sub in ("simulate", "identify", "validate", "reproduce"):
+        proc = run(sub, "--help", cwd=tmp_path)
+        assert proc.returncode == 0
+        assert f"usage: spiralid {sub}" in proc.stdout
+
+
+def test_simulate_csv_matches_the_library(rig_csv):
+    header = rig_csv.read_text().splitlines()[0].split(",")
+    assert header == [
+        "time_s",
+        "torque_Nm",
+        "hub_angle_rad",
+        "hub_velocity_rad_s",
+        "end_acceleration_m_s2",
+    ]
+    table = np.loadtxt(rig_csv, delimiter=",", skiprows=1)
+    exp = paper_experiment()
+    rec = FlexibleManipulator().simulate(
+        exp.torque(), fs=exp.fs, rng=3, sensors=exp.sensors()
+    )
+    assert table.shape == (rec.u.size, 5)
+    np.testing.assert_allclose(table[:, 1], rec.u, rtol=1e-9)
+    np.testing.assert_allclose(table[:, 4], rec.end_acceleration, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(np.diff(table[:, 0]), 1 / 500, rtol=1e-6)
+
+
+def test_simulate_npz_loads_as_iodata(tmp_path):
+    proc = run(
+        "simulate",
+        "--signal",
+        "prbs",
+        "--duration",
+        "1",
+        "--out",
+        "r.npz",
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    data = IOData.from_npz(tmp_path / "r.npz")
+    assert data.n == 500 and data.ts == pytest.approx(0.002)
+    assert set(np.unique(data.u)) == {-0.1, 0.1}
+
+
+def test_simulate_refuses_to_overwrite(rig_csv):
+    before = rig_csv.read_bytes()
+    proc = run("simulate", "--out", rig_csv.name, cwd=rig_csv.parent)
+    assert proc.returncode == 2
+    assert "--force" in proc.stderr
+    assert rig_csv.read_bytes() == before
+
+
+def test_identify_then_validate(rig_csv, tmp_path):
+    proc = run(
+        "identify", rig_csv, "--budget", "400", "--out", tmp_path / "m", cwd=tmp_path
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "fit % (simulation)" in proc.stdout
+    model = IdentifiedModel.from_dict(
+        json.loads((tmp_path / "m" / "model.json").read_text())
+    )
+    assert model.method == "ebsda" and model.theta.shape == (16,)
+    assert model.result is None or model.result.nfev <= 400
+    assert (tmp_path / "m" / "validation_time.png").stat().st_size > 1000
+    assert (tmp_path / "m" / "convergence.png").exists()
+    # The saved model reproduces the same validation on the same data.
+    saved = json.loads((tmp_path / "m" / "validation.json").read_text())
+    proc = run(
+        "validate",
+        tmp_path / "m" / "model.json",
+        rig_csv,
+        "--fraction",
+        "0.6666666666666666",
+        "--out",
+        tmp_path / "v",
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    again = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert again["fit_percent"] == pytest.approx(
+        saved["validation"]["fit_percent"], rel=1e-9
+    )
+
+
+@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
+def test_identify_least_squares_on_the_real_arm(tmp_path):
+    proc = run(
+        "identify", ARM, "--ts", "0.01", "--method", "ls", "--out", "arm", cwd=tmp_path
+    )
+    assert proc.returncode == 0, proc.stderr
+    val = json.loads((tmp_path / "arm" / "validation.json").read_text())["validation"]
+    # The data's README: least-squares ARX(8, 8, 0) validates at about 95 %.
+    assert abs(val["fit_percent"] - 95.0) <= 1.0
+
+
+def _reproduce_ok(tmp_path, *extra):
+    out = tmp_path / "rep"
+    proc = run(
+        "reproduce",
+        "--seeds",
+        "2",
+        "--budget",
+        "300",
+        "--workers",
+        "1",
+        "--quiet",
+        "--out",
+        out,
+        *extra,
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    results = json.loads((out / "results.json").read_text())
+    html = (out / "report.html").read_text()
+    assert html.count("data:image/png;base64,") == 6
+    for stem in ("fig6a_convergence", "fig7c_spectrum", "pole_zero"):
+        assert (out / f"{stem}.png").stat().st_size > 1000
+    return results
+
+
+def test_reproduce_on_the_simulated_rig(tmp_path):
+    results = _reproduce_ok(tmp_path)
+    assert results["seeds"] == [0, 1]
+    assert results["structure"] == {"na": 8, "nb": 8, "nk": 0}
+    labels = [row["label"] for row in results["table2"]]
+    assert labels[:2] == ["SDA", "Eb-SDA"] and {"LS", "OE"} <= set(labels)
+    for runs in results["runs"].values():
+        assert [r["seed"] for r in runs] == [0, 1]
+        assert all(r["nfev"] <= 300 for r in runs)
+    stats = results["statistics"]["SDA"]
+    costs = [r["cost_estimation"] for r in results["runs"]["SDA"]]
+    assert stats["cost_median"] == pytest.approx(np.median(costs))
+    assert 0 <= results["ranksum"][0]["p_two_sided"] <= 1
+    assert results["versions"]["spiralid"]
+
+
+@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
+def test_reproduce_on_the_real_arm(tmp_path):
+    results = _reproduce_ok(
+        tmp_path, "--data", ARM, "--input", "u", "--output", "y", "--ts", "0.01"
+    )
+    assert results["data"]["n_samples"] == 1024
+    assert results["data"]["n_estimation"] == round(1024 * 2 / 3)
+    ls = next(r for r in results["table2"] if r["label"] == "LS")
+    assert abs(ls["fit_validation_percent"] - 95.0) <= 1.0
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["identify", "missing.csv", "--ts", "1"], "does not exist"),
+        (["identify", "ARM", "--ts", "0.01", "--input", "torque"], "columns"),
+        (["identify", "ARM", "--ts", "0.01", "--na", "600"], "too short"),
+        (["identify", "ARM", "--na", "-2"], "--na"),
+        (["reproduce", "--data", "ARM", "--ts", "0.01", "--out", "."], "not empty"),
+        (["validate", "nothing.json", "ARM"], "does not exist"),
+        (["simulate", "--fs", "0"], "--fs"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_bad_arguments_exit_2_with_one_line(tmp_path, args, message):
+    (tmp_path / "keep.txt").write_text("user data")
+    args = [str(ARM) if a == "ARM" else a for a in args]
+    proc = run(*args, cwd=tmp_path)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert message in lines[0]
+    assert "Traceback" not in proc.stderr
+    assert (tmp_path / "keep.txt").read_text() == "user data"
