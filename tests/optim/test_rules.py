@@ -173,3 +173,20 @@ def test_linear_bad_constants():
         LinearSpiral(d_max=0.0)
     with pytest.raises(ValueError, match=r"^`r_l` and `r_u` must satisfy"):
         LinearSpiral(r_l=1.0, r_u=0.2)
+
+
+def test_exponential_rule_rejects_nan_or_negative_d():
+    with pytest.raises(ValueError, match=r"^`d` must be >= 0 \(inf allowed\)"):
+        exponential_rule(np.array([1.0, np.nan]), 0.1, 1.0, 100.0, 1.5)
+    with pytest.raises(ValueError, match=r"^`d` must be >= 0"):
+        exponential_rule(-1.0, 0.1, 1.0, 100.0, 1.5)
+
+
+def test_exponential_rule_keeps_shape():
+    d = np.array([[0.0, 1.0], [2.0, np.inf]])
+    out = exponential_rule(d, 0.1, 1.0, 100.0, 1.5)
+    assert out.shape == (2, 2)
+    np.testing.assert_allclose(
+        out[:, :1].ravel(), literal_eq4(d[:, 0], 0.1, 1, 100, 1.5)
+    )
+    assert np.ndim(exponential_rule(0.5, 0.1, 1.0, 100.0, 1.5)) == 0

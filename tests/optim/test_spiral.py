@@ -1,5 +1,7 @@
 """The search loop, checked against hand-built steps and independent bookkeeping."""
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -465,3 +467,21 @@ def test_objective_wrong_shape():
 
     with pytest.raises(ValueError, match=r"^`fun` must return shape \(3,\)"):
         minimize(late, B2, n_points=4, vectorized=True)
+
+
+def test_costs_of_opposite_sign_beyond_float_range():
+    # |1e308 - (-1e308)| overflows: the deviation must be inf, silently.
+    rule = RecordingRule(ExponentialSpiral())
+    x0 = np.array([[0.0, 0.0], [0.5, 0.5], [-0.5, 0.5]])
+
+    def fun(X):
+        return np.where(X[:, 0] == 0.0, -1e308, 1e308)
+
+    with warnings.catch_warnings(), np.errstate(all="raise"):
+        warnings.simplefilter("error")
+        search = SpiralSearch(fun, B2, rule, n_points=3, rng=0, vectorized=True, x0=x0)
+        search.step()
+    d, r, theta = rule.calls[0]
+    np.testing.assert_array_equal(d, [np.inf, np.inf])
+    np.testing.assert_array_equal(r, [0.1, 0.1])
+    np.testing.assert_array_equal(theta, [0.1, 0.1])
