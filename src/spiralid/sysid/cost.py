@@ -150,6 +150,7 @@ class PaperCost:
         self.yty = float(y @ y)
         self._y = np.ascontiguousarray(data.y)
         self._ulags = np.ascontiguousarray(arx.input_lags(data.u)[:, self.t0 :])
+        self._ulags_t = np.ascontiguousarray(self._ulags.T)
 
     @property
     def n_params(self) -> int:
@@ -179,24 +180,26 @@ class PaperCost:
     def sse_one_step(self, thetas) -> np.ndarray | float:
         """``sum e^2`` of the one-step error via the Gram matrix, O(p^2) each."""
         th, single = self._thetas(thetas)
-        quad = np.einsum("ij,jk,ik->i", th, self.gram, th, optimize=False)
-        sse = self.yty - 2.0 * (th @ self.phity) + quad
+        # y'y - 2 theta'Phi'y + theta'Phi'Phi theta, in one matmul.
+        sse = self.yty + np.sum(th * (th @ self.gram - 2.0 * self.phity), axis=1)
         # Rounding can leave a tiny negative where the fit is exact.
         sse = np.maximum(sse, 0.0)
         return float(sse[0]) if single else sse
 
     def _simulate_sse(self, th: np.ndarray, stable: np.ndarray) -> np.ndarray:
         sse = np.full(th.shape[0], np.inf)
-        if stable.any():
-            x = th[:, self.arx.na :] @ self._ulags
-            _ar_filter_sse(
-                x,
-                np.ascontiguousarray(th[:, : self.arx.na]),
-                self._y,
-                self.t0,
-                stable,
-                sse,
+        idx = np.flatnonzero(stable)
+        if idx.size:
+            sub = th if idx.size == th.shape[0] else th[idx]
+            na = self.arx.na
+            # Candidates along the fast axis: the recursion's dependency
+            # chain runs in time, so the kernel vectorises across candidates.
+            x = self._ulags_t @ sub[:, na:].T
+            out = np.empty(idx.size)
+            _ar_filter_sse_cols(
+                x, np.ascontiguousarray(sub[:, :na].T), self._y, self.t0, out
             )
+            sse[idx] = out
         return sse
 
     def sse_simulation(self, thetas) -> np.ndarray | float:
@@ -244,31 +247,37 @@ class PaperCost:
                 # Unstable: not simulated; the error term of eq. (3) is the
                 # (finite) one-step error term.
                 sse[~stable] = self.sse_one_step(th[~stable])
-        f = self.w * np.sqrt(sse) / self.K + np.where(stable, 0.0, self.penalty)
+        f = (self.w / self.K) * np.sqrt(sse)
+        f[~stable] += self.penalty
         return float(f[0]) if single else f
 
 
 @numba.njit(cache=True)
-def _ar_filter_sse(x, a, y, t0, mask, sse):  # pragma: no cover - compiled
-    """sse[r] = sum_{t >= t0} (y(t) - yhat_r(t))^2 for rows with mask[r].
+def _ar_filter_sse_cols(x, a, y, t0, sse):  # pragma: no cover - compiled
+    """sse[r] = sum_{t >= t0} (y(t) - yhat_r(t))^2, candidates in columns.
 
-    ``A_r(q) yhat = x[r]`` for ``t >= t0`` (``x[r, t - t0]`` is the numerator
-    part), with ``yhat(t) = y(t)`` for ``t < t0``; other rows are untouched.
+    ``x[t - t0, r]`` is candidate r's numerator part, ``a[i, r]`` its
+    ``a_(i+1)``; ``A_r(q) yhat = x`` for ``t >= t0`` with ``yhat(t) = y(t)``
+    for ``t < t0`` (the measured initial state).
     """
-    m, k = x.shape
-    na = a.shape[1]
-    buf = np.empty(k + na)
+    k, m = x.shape
+    na = a.shape[0]
+    buf = np.empty((k + na, m))
+    for i in range(na):
+        for r in range(m):
+            buf[i, r] = y[t0 - na + i]
+    acc = np.empty(m)
     for r in range(m):
-        if not mask[r]:
-            continue
+        sse[r] = 0.0
+    for t in range(k):
+        for r in range(m):
+            acc[r] = x[t, r]
         for i in range(na):
-            buf[i] = y[t0 - na + i]
-        acc_sse = 0.0
-        for t in range(k):
-            acc = x[r, t]
-            for i in range(na):
-                acc -= a[r, i] * buf[na + t - 1 - i]
-            buf[na + t] = acc
-            d = y[t0 + t] - acc
-            acc_sse += d * d
-        sse[r] = acc_sse
+            row = na + t - 1 - i
+            for r in range(m):
+                acc[r] -= a[i, r] * buf[row, r]
+        yt = y[t0 + t]
+        for r in range(m):
+            buf[na + t, r] = acc[r]
+            d = yt - acc[r]
+            sse[r] += d * d

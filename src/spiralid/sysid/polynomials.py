@@ -131,7 +131,6 @@ def _step_down_kernel(a):  # pragma: no cover - compiled
 def _schur_stable_kernel(a, out):  # pragma: no cover - compiled
     m, n = a.shape
     work = np.empty(n)
-    tmp = np.empty(n)
     for r in range(m):
         ok = True
         for i in range(n):
@@ -144,11 +143,13 @@ def _schur_stable_kernel(a, out):  # pragma: no cover - compiled
                 if not (abs(kj) < 1.0):
                     ok = False
                     break
-                den = 1.0 - kj * kj
-                for i in range(j):
-                    tmp[i] = (work[i] - kj * work[j - 1 - i]) / den
-                for i in range(j):
-                    work[i] = tmp[i]
+                inv = 1.0 / (1.0 - kj * kj)
+                # Update the pair (i, j-1-i) together: no scratch copy.
+                for i in range((j + 1) // 2):
+                    lo = work[i]
+                    hi = work[j - 1 - i]
+                    work[i] = (lo - kj * hi) * inv
+                    work[j - 1 - i] = (hi - kj * lo) * inv
         out[r] = ok
 
 
