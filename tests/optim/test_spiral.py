@@ -485,3 +485,30 @@ def test_costs_of_opposite_sign_beyond_float_range():
     np.testing.assert_array_equal(d, [np.inf, np.inf])
     np.testing.assert_array_equal(r, [0.1, 0.1])
     np.testing.assert_array_equal(theta, [0.1, 0.1])
+
+
+class _HalfTurn(SpiralRule):
+    """Scalar radius, one angle per point (mixed outputs are allowed)."""
+
+    def __init__(self, shape=None):
+        self.shape = shape
+
+    def __call__(self, d, rng):
+        return 0.5, np.full(self.shape or d.shape, np.pi)
+
+
+def test_custom_rule_mixed_scalar_and_per_point():
+    # R(pi) = -I in 2-D: every point goes to x* - 0.5 (x - x*).
+    rec = Recorder(sphere)
+    search = SpiralSearch(rec, B2, _HalfTurn(), n_points=4, rng=0, vectorized=True)
+    before = search.population
+    search.step()
+    expected = before[0] - 0.5 * (before[1:] - before[0])
+    np.testing.assert_allclose(rec.batches[-1], expected, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(search.mean_radius, [0.5])
+    np.testing.assert_array_equal(search.mean_angle, [np.pi])
+
+
+def test_custom_rule_wrong_shape():
+    with pytest.raises(ValueError, match=r"^`method` rule must return .*\(3,\); got"):
+        SpiralSearch(sphere, B2, _HalfTurn((2,)), n_points=4, vectorized=True).step()
