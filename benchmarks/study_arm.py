@@ -1,0 +1,111 @@
+"""What the spiral methods reach: a known ARX(2, 2, 1) and the real flexible arm.
+
+Prints two tables (issue 4's experiments):
+
+1. Noise-free ARX(2, 2, 1) (600 samples, white input, seed 11), 10 seeds:
+   SDA and Eb-SDA, both parametrisations, plain and refined.
+2. The real flexible arm (DaISy 96-009, ``ts = 0.01`` s, a documented choice:
+   the source gives none), ARX(8, 8, 0), simulation cost, 50 points x 500
+   iterations, 5 seeds: SDA and Eb-SDA, both parametrisations, with and
+   without ``refine``; least squares and output error for reference.
+
+Columns: the paper's cost eq. (2)-(3) on the estimation part (percent RMS
+error, ``gain="auto"``) and the validation fit (MATLAB ``compare`` NRMSE, %)
+of a free-run simulation of the whole record from rest, scored on the last
+third. Paper constants untouched. Run:
+``.venv/bin/python benchmarks/study_arm.py [n_seeds_arm]``.
+"""
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import sys
+from pathlib import Path
+
+import numpy as np
+from scipy.signal import lfilter
+
+from spiralid.sysid import ARX, IOData, identify
+
+ARM = (
+    Path(__file__).resolve().parents[1]
+    / ".."
+    / "shared"
+    / "data"
+    / "daisy_robot_arm.csv"
+)
+
+
+def fit_percent(y, yhat):
+    return 100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - np.mean(y)))
+
+
+def score(model, data):
+    est, val = data.split()
+    with np.errstate(all="ignore"):
+        yhat = model.simulate(data.u)[est.n :]
+    return model.cost, fit_percent(val.y, yhat) if np.all(
+        np.isfinite(yhat)
+    ) else -np.inf
+
+
+def fmt(values):
+    v = np.asarray(values, dtype=float)
+    return f"{np.median(v):9.2f} [{np.min(v):9.2f}, {np.max(v):9.2f}]"
+
+
+def table(title, data, arx, seeds, configs, **opts):
+    print(f"\n{title}")
+    est, _ = data.split()
+    for method in ("ls", "oe"):
+        cost, fit = score(identify(est, arx, method=method), data)
+        print(f"  {method:<34} cost {cost:9.3f}   val fit {fit:9.2f} %")
+    head = ("method / parametrisation / refine", "cost median [min, max]")
+    print(f"  {head[0]:<34} {head[1]:<33} val fit % median [min, max]")
+    for method, par, refine in configs:
+        costs, fits, stable = [], [], 0
+        for seed in seeds:
+            model = identify(
+                est, arx, method=method, parametrization=par, refine=refine,
+                rng=seed, **opts,
+            )  # fmt: skip
+            c, f = score(model, data)
+            costs.append(c)
+            fits.append(f)
+            stable += model.is_stable
+        label = f"{method} / {par} / {'refine' if refine else 'plain'}"
+        print(
+            f"  {label:<34} {fmt(costs)}   {fmt(fits)}   stable {stable}/{len(seeds)}"
+        )
+        print(f"  {'':<34} per seed fit: {' '.join(f'{x:.1f}' for x in fits)}")
+
+
+def main() -> None:
+    n_arm = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+    configs = [
+        (m, p, r)
+        for p in ("coefficients", "reflection")
+        for m in ("sda", "ebsda")
+        for r in (False, True)
+    ]
+    u = np.random.default_rng(11).standard_normal(600)
+    known = IOData(u, lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u), ts=0.01)
+    table(
+        "Known ARX(2, 2, 1), noise-free, 600 samples; 10 seeds; "
+        "50 points x 500 iterations",
+        known, ARX(2, 2, 1), range(10), configs,
+    )  # fmt: skip
+    if not ARM.exists():
+        print(f"\n(real arm data not found at {ARM})")
+        return
+    arm = IOData.from_csv(ARM, input="u", output="y", ts=0.01)
+    table(
+        f"Real flexible arm, ARX(8, 8, 0), simulation cost; {n_arm} seeds; "
+        "50 points x 500 iterations",
+        arm, ARX(8, 8, 0), range(n_arm), configs,
+    )  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()
