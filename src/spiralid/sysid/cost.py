@@ -150,7 +150,7 @@ class PaperCost:
         self.yty = float(y @ y)
         self._y = np.ascontiguousarray(data.y)
         self._ulags = np.ascontiguousarray(arx.input_lags(data.u)[:, self.t0 :])
-        self._ulags_t = np.ascontiguousarray(self._ulags.T)
+        self._u = np.ascontiguousarray(data.u)
 
     @property
     def n_params(self) -> int:
@@ -194,10 +194,15 @@ class PaperCost:
             na = self.arx.na
             # Candidates along the fast axis: the recursion's dependency
             # chain runs in time, so the kernel vectorises across candidates.
-            x = self._ulags_t @ sub[:, na:].T
             out = np.empty(idx.size)
-            _ar_filter_sse_cols(
-                x, np.ascontiguousarray(sub[:, :na].T), self._y, self.t0, out
+            _arx_sse_kernel(
+                self._u,
+                np.ascontiguousarray(sub[:, na:].T),
+                np.ascontiguousarray(sub[:, :na].T),
+                self._y,
+                self.t0,
+                self.arx.nk,
+                out,
             )
             sse[idx] = out
         return sse
@@ -253,31 +258,45 @@ class PaperCost:
 
 
 @numba.njit(cache=True)
-def _ar_filter_sse_cols(x, a, y, t0, sse):  # pragma: no cover - compiled
-    """sse[r] = sum_{t >= t0} (y(t) - yhat_r(t))^2, candidates in columns.
+def _arx_sse_kernel(u, b, a, y, t0, nk, sse):  # pragma: no cover - compiled
+    """sse[r] = sum_{t >= t0} (y(t) - yhat_r(t))^2 for candidates in columns.
 
-    ``x[t - t0, r]`` is candidate r's numerator part, ``a[i, r]`` its
-    ``a_(i+1)``; ``A_r(q) yhat = x`` for ``t >= t0`` with ``yhat(t) = y(t)``
-    for ``t < t0`` (the measured initial state).
+    ``b[j, r]`` is candidate r's ``b_j``, ``a[i, r]`` its ``a_(i+1)``;
+    ``A_r(q) yhat(t) = B_r(q) u(t)`` for ``t >= t0`` with ``yhat(t) = y(t)``
+    for ``t < t0`` (the measured initial state). The last ``na`` outputs
+    live in a ring buffer small enough for L1.
     """
-    k, m = x.shape
+    nb, m = b.shape
     na = a.shape[0]
-    buf = np.empty((k + na, m))
+    k = y.size - t0
+    ring = np.empty((max(na, 1), m))
     for i in range(na):
         for r in range(m):
-            buf[i, r] = y[t0 - na + i]
+            ring[i, r] = y[t0 - na + i]
     acc = np.empty(m)
     for r in range(m):
         sse[r] = 0.0
-    for t in range(k):
+    pos = 0  # ring row holding y(t - na)
+    for t in range(t0, t0 + k):
         for r in range(m):
-            acc[r] = x[t, r]
-        for i in range(na):
-            row = na + t - 1 - i
+            acc[r] = 0.0
+        for j in range(nb):
+            uj = u[t - nk - j]  # t0 >= nk + nb - 1, so never before 0
             for r in range(m):
-                acc[r] -= a[i, r] * buf[row, r]
-        yt = y[t0 + t]
+                acc[r] += b[j, r] * uj
+        for i in range(na):
+            row = pos + na - 1 - i  # y(t - 1 - i)
+            if row >= na:
+                row -= na
+            for r in range(m):
+                acc[r] -= a[i, r] * ring[row, r]
+        yt = y[t]
         for r in range(m):
-            buf[na + t, r] = acc[r]
             d = yt - acc[r]
             sse[r] += d * d
+        if na > 0:
+            for r in range(m):
+                ring[pos, r] = acc[r]
+            pos += 1
+            if pos == na:
+                pos = 0
