@@ -128,3 +128,10 @@ def test_npz_missing_variable_and_ts(tmp_path):
         IOData.from_npz(tmp_path / "r.npz", output="acc")
     with pytest.raises(ValueError, match="`ts` must be given"):
         IOData.from_npz(tmp_path / "r.npz")
+
+
+def test_csv_needs_ts(tmp_path):
+    p = tmp_path / "r.csv"
+    p.write_text("u,y\n1,2\n3,4\n")
+    with pytest.raises(ValueError, match="`ts` must be given for a CSV file"):
+        IOData.from_csv(p)

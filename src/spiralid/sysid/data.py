@@ -190,7 +190,7 @@ class IOData:
         path: str | os.PathLike,
         input: str | int = "u",
         output: str | int = "y",
-        ts: float = 1.0,
+        ts: float | None = None,
         delimiter: str = ",",
     ) -> IOData:
         """Read two columns of a delimited text file.
@@ -202,10 +202,15 @@ class IOData:
         input, output : str or int
             Column names (needs a header) or 0-based column indices.
         ts : float
-            Sample time in seconds (the file does not carry one).
+            Sample time in seconds; required, as a CSV file carries none.
         delimiter : str
             Field separator.
         """
+        if ts is None:
+            raise ValueError(
+                "`ts` must be given for a CSV file (the sample time in seconds); "
+                "got None"
+            )
         with open(path, newline="") as fh:
             rows = [r for r in csv.reader(fh, delimiter=delimiter) if r]
         if not rows:
