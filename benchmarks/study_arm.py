@@ -59,12 +59,16 @@ def table(title, data, arx, seeds, configs, **opts):
     print(f"\n{title}")
     est, _ = data.split()
     for method in ("ls", "oe"):
-        cost, fit = score(identify(est, arx, method=method), data)
-        print(f"  {method:<34} cost {cost:9.3f}   val fit {fit:9.2f} %")
+        ref = identify(est, arx, method=method)
+        cost, fit = score(ref, data)
+        print(
+            f"  {method:<34} cost {cost:9.3f}   val fit {fit:9.2f} %   "
+            f"max|pole| {np.abs(ref.poles).max():.6f}"
+        )
     head = ("method / parametrisation / refine", "cost median [min, max]")
     print(f"  {head[0]:<34} {head[1]:<33} val fit % median [min, max]")
     for method, par, refine in configs:
-        costs, fits, stable = [], [], 0
+        costs, fits, stable, radius = [], [], 0, []
         for seed in seeds:
             model = identify(
                 est, arx, method=method, parametrization=par, refine=refine,
@@ -74,11 +78,13 @@ def table(title, data, arx, seeds, configs, **opts):
             costs.append(c)
             fits.append(f)
             stable += model.is_stable
+            radius.append(np.abs(model.poles).max())
         label = f"{method} / {par} / {'refine' if refine else 'plain'}"
         print(
             f"  {label:<34} {fmt(costs)}   {fmt(fits)}   stable {stable}/{len(seeds)}"
         )
         print(f"  {'':<34} per seed fit: {' '.join(f'{x:.1f}' for x in fits)}")
+        print(f"  {'':<34} per seed max|pole|: {' '.join(f'{x:.6f}' for x in radius)}")
 
 
 def main() -> None:
