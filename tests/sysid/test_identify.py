@@ -175,3 +175,33 @@ def test_constant_input_is_rejected():
     d = IOData(np.ones(50), np.random.default_rng(0).standard_normal(50), ts=1.0)
     with pytest.raises(ValueError, match="does not excite the system"):
         identify(d, ARX(2, 2, 1), method="oe")
+
+
+def test_one_step_refine_reaches_least_squares(known):
+    # With noise the one-step optimum is not the truth; least squares is it.
+    rng = np.random.default_rng(12)
+    est, _ = known.split()
+    noisy = IOData(est.u, est.y + 0.3 * rng.standard_normal(est.n), ts=est.ts)
+    ls = identify(noisy, ARX(2, 2, 1), method="ls", predictor="one-step")
+    fit = identify(
+        noisy,
+        ARX(2, 2, 1),
+        method="sda",
+        predictor="one-step",
+        refine=True,
+        rng=0,
+        n_points=20,
+        max_iter=100,
+    )
+    assert fit.cost == pytest.approx(ls.cost, rel=1e-9)
+    np.testing.assert_allclose(fit.theta, ls.theta, rtol=1e-6)
+    assert fit.cost <= fit.history[-1]
+
+
+def test_user_bounds_are_the_search_box(known):
+    est, _ = known.split()
+    box = [[-2, 2], [-1, 1], [0.5, 1.5], [0.0, 1.0]]
+    fit = identify(est, ARX(2, 2, 1), method="sda", bounds=box, rng=0, max_iter=5)
+    np.testing.assert_array_equal(fit.bounds, box)
+    with pytest.raises(ValueError, match="`bounds` must be finite with lower < upper"):
+        identify(est, ARX(2, 2, 1), method="sda", bounds=[[0, 0]] * 4)
