@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from spiralid.sysid import ARX, IdentifiedModel, IOData, identify
+from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, step_up
 from spiralid.sysid.identify import default_bounds, feasible_initial_points
 
 ARM = (
@@ -205,3 +205,16 @@ def test_user_bounds_are_the_search_box(known):
     np.testing.assert_array_equal(fit.bounds, box)
     with pytest.raises(ValueError, match="`bounds` must be finite with lower < upper"):
         identify(est, ARX(2, 2, 1), method="sda", bounds=[[0, 0]] * 4)
+
+
+def test_unstable_start_is_reflected_inside():
+    from spiralid.sysid.identify import _stabilise
+
+    arx = ARX(3, 1, 0)
+    roots = np.array([1.25, 0.5 + 0.6j, 0.5 - 0.6j])  # |0.5 +- 0.6j| = 0.78
+    theta = np.r_[np.real(np.poly(roots))[1:], 2.0]
+    k_b = _stabilise(theta, arx)
+    assert np.all(np.abs(k_b[:3]) < 1) and k_b[3] == 2.0
+    a = step_up(k_b[:3])
+    expected = np.sort_complex(np.r_[1 / 1.25, roots[1:]])
+    np.testing.assert_allclose(np.sort_complex(np.roots(np.r_[1.0, a])), expected)

@@ -45,6 +45,8 @@ from typing import Any
 import numpy as np
 from scipy import optimize, signal
 
+from spiralid.optim import minimize
+
 from .arx import ARX, arx_least_squares
 from .cost import PaperCost
 from .data import IOData
@@ -526,8 +528,6 @@ def identify(
             timings={"search": t, "refine": 0.0, "total": t},
             **common,
         )
-
-    from spiralid.optim import minimize
 
     gen = np.random.default_rng(rng)
     box = (
