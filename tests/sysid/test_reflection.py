@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from spiralid.sysid import (
     fold_reflection,
@@ -95,3 +97,19 @@ def test_bad_shapes():
         step_up(np.zeros((2, 2, 2)))
     with pytest.raises(ValueError, match="`n` must be a non-negative integer; got -1"):
         random_stable_polynomial(-1)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.floats(-0.99, 0.99, allow_nan=False, allow_subnormal=False),
+        min_size=1,
+        max_size=10,
+    )
+)
+def test_round_trip_property(k):
+    k = np.asarray(k)
+    a = step_up(k)
+    assert is_stable_polynomial(a)
+    assert np.abs(np.roots(np.r_[1.0, a])).max() < 1.0
+    np.testing.assert_allclose(step_down(a), k, rtol=0, atol=1e-9)
