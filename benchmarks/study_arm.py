@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
-from spiralid.sysid import ARX, IOData, identify
+from spiralid.sysid import ARX, IOData, PaperCost, identify
 
 ARM = (
     Path(__file__).resolve().parents[1]
@@ -111,6 +111,30 @@ def main() -> None:
         "50 points x 500 iterations",
         arm, ARX(8, 8, 0), range(n_arm), configs,
     )  # fmt: skip
+    gain_table(arm, ARX(8, 8, 0), range(n_arm))
+
+
+def gain_table(data, arx, seeds):
+    """Eb-SDA's radius and angle see |f - min J| (eq. (4)), so the gain w of
+    eq. (2) changes the search itself (DESIGN.md item 13)."""
+    est, _ = data.split()
+    auto = PaperCost(arx, est, predictor="simulation")
+    print(
+        "\nEb-SDA sensitivity to the gain w (cost shown on the auto scale, "
+        "percent RMS error); plain search"
+    )
+    for par in ("coefficients", "reflection"):
+        for factor in (0.1, 1.0, 10.0):
+            costs, fits = [], []
+            for seed in seeds:
+                model = identify(
+                    est, arx, method="ebsda", parametrization=par,
+                    gain=factor * auto.w, rng=seed,
+                )  # fmt: skip
+                costs.append(auto(model.theta))
+                fits.append(score(model, data)[1])
+            label = f"ebsda / {par} / w = {factor:g} x auto"
+            print(f"  {label:<34} {fmt(costs)}   {fmt(fits)}")
 
 
 if __name__ == "__main__":
