@@ -5,9 +5,6 @@
 
 How we read it (DESIGN.md items 2-3):
 
-- ``gain="auto"`` sets ``w = 100 sqrt(K) / rms(y)``, so ``f`` is the RMS
-  error as a percentage of the RMS of the output *as given* (not detrended:
-  detrend the data first if an offset should not count).
 - Both predictors sum over the same ``K = N - t0`` samples ``t >= t0``,
   where ``t0 = max_lag = max(na, nk + nb - 1)``: the first ``t0`` samples
   are the initial conditions (see :mod:`spiralid.sysid.arx`).
@@ -23,8 +20,9 @@ How we read it (DESIGN.md items 2-3):
   ``K`` samples), so ``f`` is the RMS error as a percentage of the RMS of
   the output *as given* (not detrended: detrend the data first if an
   offset should not count). The zero model costs exactly 100.
-- Stability is decided from the denominator (Schur-Cohn test, exact for
-  ``|z| >= 1``) *before* any simulation. An unstable candidate is never
+- Stability is decided from the denominator by the Schur-Cohn test (all
+  reflection coefficients ``|k_j| < 1``; a pole on the circle counts as
+  unstable) *before* any simulation. An unstable candidate is never
   simulated: its error term in eq. (3) is the one-step error term, which
   is finite for every theta. So the penalty is present exactly when a pole
   has ``|z| >= 1``, and the cost is always finite.
