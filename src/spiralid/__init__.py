@@ -24,6 +24,7 @@ from .optim import minimize as minimize
 from . import fms as fms
 from .fms import FlexibleManipulator as FlexibleManipulator
 from .fms import Recording as Recording
+
 # --- sysid ---
 from .sysid import ARX as ARX
 from .sysid import IdentifiedModel as IdentifiedModel
