@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
-from spiralid.sysid import ARX, IOData, PaperCost, identify
+from spiralid.sysid import ARX, IOData, PaperCost, identify, is_stable_polynomial
 
 ARM = (
     Path(__file__).resolve().parents[1]
@@ -87,8 +87,22 @@ def table(title, data, arx, seeds, configs, **opts):
         print(f"  {'':<34} per seed max|pole|: {' '.join(f'{x:.6f}' for x in radius)}")
 
 
+def feasibility() -> None:
+    """How often is a uniform draw in a coefficient box stable (na = 8)?"""
+    from math import comb
+
+    rng = np.random.default_rng(0)
+    half = np.array([comb(8, i) for i in range(1, 9)], dtype=float)
+    n = 20000
+    print("\nStable fraction of uniform denominators, na = 8, 20000 draws (rng 0)")
+    for label, box in (("|a_i| <= binom(8, i)", half), ("[-1, 1]^8", np.ones(8))):
+        a = rng.uniform(-box, box, size=(n, 8))
+        print(f"  {label:<22} {100 * is_stable_polynomial(a).mean():6.2f} %")
+
+
 def main() -> None:
     n_arm = int(sys.argv[1]) if len(sys.argv) > 1 else 5
+    feasibility()
     configs = [
         (m, p, r)
         for p in ("coefficients", "reflection")
