@@ -30,7 +30,9 @@ def convergence(rep: Reproduction, labels=PAPER_PAIR) -> Figure:
     hist = {label: [r.history for r in rep.runs[label]] for label in labels}
     times = {label: [r.times for r in rep.runs[label]] for label in labels}
     fig = plots.plot_convergence(hist, times=times)
-    fig.suptitle(f"Convergence over {len(rep.seeds)} seeds (median, IQR)")
+    fig.axes[0].set_title(
+        f"Convergence over {len(rep.seeds)} seeds (median and interquartile band)"
+    )
     return fig
 
 

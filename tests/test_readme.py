@@ -1,0 +1,24 @@
+"""The README's API example runs as written (on the shared real data)."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+ARM = ROOT / ".." / "shared" / "data" / "daisy_robot_arm.csv"
+
+
+@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
+def test_readme_api_example_runs(monkeypatch, capsys):
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    assert blocks, "README has no python example"
+    monkeypatch.chdir(ARM.parent)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    exec(compile(blocks[0], "README.md", "exec"), {})
+    lines = capsys.readouterr().out.splitlines()
+    methods = [line.split()[0] for line in lines[:4]]
+    assert methods == ["ls", "oe", "ebsda", "ebsda"]
+    # The data README's reference: least squares validates at about 95 %.
+    assert abs(float(lines[0].split()[1]) - 95.0) <= 1.0
