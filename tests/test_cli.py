@@ -121,6 +121,38 @@ def test_identify_then_validate(rig_csv, tmp_path):
     )
 
 
+def test_identify_reads_mat_files(tmp_path):
+    from scipy.io import savemat
+    from scipy.signal import lfilter
+
+    u = np.random.default_rng(0).standard_normal(400)
+    y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    savemat(tmp_path / "rec.mat", {"torque": u, "accel": y, "ts": 0.01})
+    proc = run(
+        "identify",
+        "rec.mat",
+        "--input",
+        "torque",
+        "--output",
+        "accel",
+        "--na",
+        "2",
+        "--nb",
+        "2",
+        "--nk",
+        "1",
+        "--method",
+        "ls",
+        "--out",
+        "m",
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    model = json.loads((tmp_path / "m" / "model.json").read_text())
+    # Noise-free data from a model of the same structure: exact recovery.
+    np.testing.assert_allclose(model["theta"], [-1.5, 0.7, 1.0, 0.5], atol=1e-9)
+
+
 @pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
 def test_identify_least_squares_on_the_real_arm(tmp_path):
     proc = run(
@@ -160,6 +192,9 @@ def _reproduce_ok(tmp_path, *extra):
 def test_reproduce_on_the_simulated_rig(tmp_path):
     results = _reproduce_ok(tmp_path)
     assert results["seeds"] == [0, 1]
+    assert results["data"]["kind"] == "simulated rig"
+    assert results["data"]["rig"]["length"] == 0.9
+    assert results["data"]["n_samples"] == 3000 and results["data"]["ts"] == 0.002
     assert results["structure"] == {"na": 8, "nb": 8, "nk": 0}
     labels = [row["label"] for row in results["table2"]]
     assert labels[:2] == ["SDA", "Eb-SDA"] and {"LS", "OE"} <= set(labels)
@@ -179,6 +214,7 @@ def test_reproduce_on_the_real_arm(tmp_path):
         tmp_path, "--data", ARM, "--input", "u", "--output", "y", "--ts", "0.01"
     )
     assert results["data"]["n_samples"] == 1024
+    assert results["data"]["path"] == str(ARM.resolve())
     assert results["data"]["n_estimation"] == round(1024 * 2 / 3)
     ls = next(r for r in results["table2"] if r["label"] == "LS")
     assert abs(ls["fit_validation_percent"] - 95.0) <= 1.0

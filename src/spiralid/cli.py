@@ -360,6 +360,8 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
         )
     finally:
         bar.close()
+    if args.data is not None:
+        rep.source["path"] = str(Path(args.data).resolve())
     command = "spiralid " + shlex.join(argv)
     write_reproduction(rep, args.out, force=args.force, command=command)
     if not args.quiet:

@@ -28,6 +28,7 @@ __all__ = [
     "Reproduction",
     "Run",
     "default_data",
+    "default_data_source",
     "reproduce",
 ]
 
@@ -129,6 +130,7 @@ class Reproduction:
     runs: dict[str, list[Run]]
     baselines: dict[str, Run]
     validations: dict[str, tuple[Validation, Validation]] = field(repr=False)
+    source: dict = field(default_factory=dict)
     elapsed: float = 0.0
 
     def best(self, label: str) -> Run:
@@ -194,11 +196,27 @@ def default_data(seed: int = 0) -> IOData:
     """The default record: the simulated rig's bang-bang experiment.
 
     End-point acceleration against hub torque, sampled at 500 Hz, from
-    :func:`spiralid.fms.paper_experiment` with sensor noise seeded by `seed`.
+    :func:`spiralid.fms.paper_experiment` on the default
+    :class:`~spiralid.fms.FlexibleManipulator`, sensor noise seeded by `seed`.
     """
     from spiralid.fms import paper_experiment
 
     return paper_experiment().run(rng=seed).iodata("end_acceleration")
+
+
+def default_data_source(seed: int = 0) -> dict:
+    """What :func:`default_data` simulates: every rig and experiment setting."""
+    from dataclasses import asdict
+
+    from spiralid.fms import FlexibleManipulator, paper_experiment
+
+    return {
+        "kind": "simulated rig",
+        "rig": asdict(FlexibleManipulator()),
+        "rig_modes_hz": FlexibleManipulator().modes(5).tolist(),
+        "experiment": asdict(paper_experiment()),
+        "noise_seed": seed,
+    }
 
 
 def _fit_on_validation(model: IdentifiedModel, data: IOData, n_est: int) -> float:
@@ -277,8 +295,9 @@ def reproduce(
     Reproduction
     """
     t0 = time.perf_counter()
+    source = {"kind": "user data"}
     if data is None:
-        data = default_data()
+        data, source = default_data(), default_data_source()
     if not isinstance(data, IOData):
         raise ValueError(f"`data` must be an IOData or None; got {type(data)!r}")
     arx = ARX(8, 8, 0) if arx is None else arx
@@ -351,6 +370,7 @@ def reproduce(
         runs=runs,
         baselines=baselines,
         validations={},
+        source=source,
     )
     for label in [*runs, *baselines]:
         model = rep.best(label).model

@@ -104,6 +104,7 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
         "versions": _versions(),
         "elapsed_seconds": rep.elapsed,
         "data": {
+            **rep.source,
             "input": data.input_name,
             "output": data.output_name,
             "n_samples": data.n,
