@@ -347,8 +347,7 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
     data = None
     if args.data is not None:
         data = _load(args.data, args.input, args.output, args.ts)
-    n_configs = 7
-    bar = _progress(args, args.seeds * n_configs + 2, "reproduce")
+    bar = _progress(args, 1, "reproduce")
     try:
         rep = reproduce(
             data,
@@ -356,7 +355,7 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
             max_nfev=args.budget,
             n_points=args.points,
             workers=args.workers,
-            progress=lambda done, total: bar(done),
+            progress=bar,
         )
     finally:
         bar.close()

@@ -18,7 +18,7 @@ class ProgressBar:
     Parameters
     ----------
     total : int
-        Number of steps in the run.
+        Number of steps in the run (a call may update it).
     label : str
         Text in front of the bar.
     stream : file-like, optional
@@ -49,7 +49,9 @@ class ProgressBar:
         self._start = time.perf_counter()
         self._drawn = False
 
-    def __call__(self, done: int) -> None:
+    def __call__(self, done: int, total: int | None = None) -> None:
+        if total is not None:
+            self.total = max(int(total), 1)
         if not self.enabled:
             return
         elapsed = time.perf_counter() - self._start
