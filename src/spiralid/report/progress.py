@@ -12,8 +12,8 @@ class ProgressBar:
 
     The bar draws only when ``enabled`` and the stream is a terminal, and
     only once the run has lasted ``delay`` seconds, so short runs stay
-    silent. Call it with the number of finished steps; ``close()`` ends
-    the line.
+    silent. Call it with the number of finished steps (and the total, if
+    known); ``close()`` ends the line.
 
     Parameters
     ----------
