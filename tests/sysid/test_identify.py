@@ -8,7 +8,11 @@ import pytest
 from scipy import signal
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, step_up
-from spiralid.sysid.identify import default_bounds, feasible_initial_points
+from spiralid.sysid.identify import (
+    default_bounds,
+    feasible_initial_points,
+    steiglitz_mcbride,
+)
 
 ARM = (
     Path(__file__).resolve().parents[2]
@@ -143,8 +147,49 @@ def test_real_arm_output_error(arm, arm_ls):
     assert oe.is_stable
     # OE minimises the simulation cost, so it must not lose to LS there...
     assert oe.cost <= arm_ls.cost
-    # ...and it validates within a point of 95 % too.
+    # ...and it validates within a point of 95 % too. Issue 4 asks for at
+    # least the LS fit (95.36); OE reaches 95.21: its lowest simulation cost
+    # puts a pole pair at the stability limit (12.9 Hz, nearly cancelled by
+    # a zero) that only the measured initial state excites, which a
+    # validation run from rest cannot use. Not selectable on estimation
+    # data without looking at validation, so the bar stays "within 1 point".
     assert abs(_validation_fit(oe, arm) - 95.0) <= 1.0
+    assert oe.result.start in ("ls", "steiglitz-mcbride")
+
+
+def test_steiglitz_mcbride_removes_the_output_noise_bias():
+    # Output (not equation) noise biases least squares; the Steiglitz-
+    # McBride fixed point is the output-error estimate, close to the truth.
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(2000)
+    clean = signal.lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    data = IOData(u, clean + 1.0 * rng.standard_normal(u.size), ts=1.0)
+    arx = ARX(2, 2, 1)
+    ls = identify(data, arx, method="ls").theta
+    sm = steiglitz_mcbride(data, arx)
+    assert np.linalg.norm(sm - TRUE) < 0.3 * np.linalg.norm(ls - TRUE)
+    # Without noise the first iteration already lands on the truth.
+    exact = steiglitz_mcbride(IOData(u, clean, ts=1.0), arx, n_iter=1)
+    np.testing.assert_allclose(exact, TRUE, atol=1e-9)
+
+
+def test_oe_keeps_the_start_with_the_lower_cost():
+    from spiralid.sysid.cost import PaperCost
+    from spiralid.sysid.identify import _local_polish
+
+    rng = np.random.default_rng(4)
+    u = rng.standard_normal(400)
+    y = signal.lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    data = IOData(u, y + 0.5 * rng.standard_normal(u.size), ts=1.0)
+    arx = ARX(2, 2, 1)
+    cost = PaperCost(arx, data)
+    ls = identify(data, arx, method="ls").theta
+    polished = [
+        cost(_local_polish(s, arx, data, "simulation")[0])
+        for s in (ls, steiglitz_mcbride(data, arx))
+    ]
+    oe = identify(data, arx, method="oe")
+    assert oe.cost == pytest.approx(min(polished), rel=1e-12)
 
 
 @pytest.mark.parametrize(
