@@ -125,3 +125,17 @@ def test_rotate_bad_shapes():
         rotate(np.zeros(3), np.zeros(1))
     with pytest.raises(ValueError, match=r"^`theta` must be finite"):
         rotate(np.zeros((2, 2)), [0.0, np.nan])
+
+
+def test_rotate_rejects_non_finite_and_non_real_input():
+    # NaN would otherwise come back as NaN rows without a word.
+    with pytest.raises(ValueError, match=r"^`v` must be finite"):
+        rotate([[np.nan, 1.0]], 0.1)
+    with pytest.raises(ValueError, match=r"^`v` must be finite"):
+        rotate([1.0, np.inf], 0.1)
+    with pytest.raises(ValueError, match=r"^`v` must be an array of real numbers"):
+        rotate("ab", 0.1)
+    with pytest.raises(ValueError, match=r"^`v` must be an array of real numbers"):
+        rotate(np.ones((2, 3)) + 1j, 0.1)
+    with pytest.raises(ValueError, match=r"^`theta` must be an array of real numbers"):
+        rotate(np.zeros((2, 3)), "a")

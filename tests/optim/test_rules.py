@@ -190,3 +190,36 @@ def test_exponential_rule_keeps_shape():
         out[:, :1].ravel(), literal_eq4(d[:, 0], 0.1, 1, 100, 1.5)
     )
     assert np.ndim(exponential_rule(0.5, 0.1, 1.0, 100.0, 1.5)) == 0
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        # ln(0) and ln(nan) used to give a math-domain error or NaN values.
+        ((0.1, 1.0, 0.0, 1.5), r"^`c1` must be a finite number > 0; got 0\.0"),
+        ((0.1, 1.0, np.nan, 1.5), r"^`c1` must be a finite real number; got nan"),
+        # A negative c2 would make the rule rise with d, silently.
+        ((0.1, 1.0, 100.0, -1.0), r"^`c2` must be a finite number > 0; got -1\.0"),
+        ((None, 1.0, 100.0, 1.5), r"^`lower` must be a finite real number; got None"),
+        ((1.0, 0.1, 100.0, 1.5), r"^`lower` and `upper` must satisfy lower < upper"),
+    ],
+)
+def test_exponential_rule_bad_constants(args, match):
+    with pytest.raises(ValueError, match=match):
+        exponential_rule(np.array([1.0]), *args)
+
+
+def test_exponential_rule_bad_d_types():
+    with pytest.raises(ValueError, match=r"^`d` must be an array of real numbers"):
+        exponential_rule("a", 0.1, 1.0, 100.0, 1.5)
+    with pytest.raises(ValueError, match=r"^`d` must be an array of real numbers"):
+        exponential_rule([[1.0], [2.0, 3.0]], 0.1, 1.0, 100.0, 1.5)
+
+
+@pytest.mark.parametrize("rule", [ExponentialSpiral(), LinearSpiral()])
+@pytest.mark.parametrize(
+    "d", [np.array([0.5, np.nan]), np.array([-1.0]), np.zeros((2, 2)), 0.5]
+)
+def test_rules_reject_bad_deviations(rule, d):
+    with pytest.raises(ValueError, match=r"^`d` must be a 1-D array of deviations"):
+        rule(d, np.random.default_rng(0))

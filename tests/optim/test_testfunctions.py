@@ -75,3 +75,15 @@ def test_bad_input():
         tf.PROBLEMS["rosenbrock"].bounds(1)
     with pytest.raises(ValueError, match=r"^`n` must be an integer >= 1 for sphere"):
         tf.PROBLEMS["sphere"].optimum(2.0)
+
+
+@pytest.mark.parametrize("p", PROBLEMS, ids=lambda p: p.name)
+def test_bad_values_are_named(p):
+    with pytest.raises(ValueError, match=rf"^`x` must be finite for {p.name}"):
+        p.fun([1.0, np.nan])
+    with pytest.raises(ValueError, match=rf"^`x` must be finite for {p.name}"):
+        p.fun(np.full((2, 3), np.inf))
+    with pytest.raises(ValueError, match=r"^`x` must be an array of real numbers"):
+        p.fun("ab")
+    with pytest.raises(ValueError, match=r"^`x` must be an array of real numbers"):
+        p.fun([[1.0, 2.0], [3.0]])

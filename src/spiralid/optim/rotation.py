@@ -17,26 +17,9 @@ from functools import lru_cache
 import numpy as np
 
 from spiralid.optim import _kernels
+from spiralid.optim._checks import integer, real, real_array
 
 __all__ = ["planes", "rotate", "rotation_matrix"]
-
-
-def _check_n(n) -> int:
-    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
-        raise ValueError(f"`n` must be an integer >= 1; got {n!r}")
-    return int(n)
-
-
-def _check_angle(theta, name: str = "theta") -> float:
-    try:
-        t = float(theta)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"`{name}` must be a finite real number; got {theta!r}"
-        ) from None
-    if not np.isfinite(t):
-        raise ValueError(f"`{name}` must be a finite real number; got {theta!r}")
-    return t
 
 
 @lru_cache(maxsize=64)
@@ -74,7 +57,7 @@ def planes(n: int) -> np.ndarray:
     >>> planes(3).tolist()
     [[1, 2], [0, 2], [0, 1]]
     """
-    return _planes(_check_n(n))
+    return _planes(integer(n, "n", 1))
 
 
 def rotation_matrix(n: int, theta: float) -> np.ndarray:
@@ -100,8 +83,8 @@ def rotation_matrix(n: int, theta: float) -> np.ndarray:
     array([[ 0., -1.],
            [ 1.,  0.]])
     """
-    n = _check_n(n)
-    theta = _check_angle(theta)
+    n = integer(n, "n", 1)
+    theta = real(theta, "theta")
     c, s = np.cos(theta), np.sin(theta)
     out = np.eye(n)
     # Right-multiplying by R_pq mixes columns p and q only: O(n) per factor.
@@ -140,14 +123,16 @@ def rotate(v, theta) -> np.ndarray:
     >>> np.allclose(out[0], rotation_matrix(3, np.pi / 2) @ v[0])
     True
     """
-    arr = np.asarray(v, dtype=np.float64)
+    arr = real_array(v, "v")
     if arr.ndim not in (1, 2) or arr.shape[-1] < 1:
         raise ValueError(
             f"`v` must have shape (m, n) or (n,) with n >= 1; got shape {arr.shape}"
         )
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("`v` must be finite; got NaN or infinite entries")
     batch = np.ascontiguousarray(arr.reshape(-1, arr.shape[-1]))
     m, n = batch.shape
-    t = np.asarray(theta, dtype=np.float64)
+    t = real_array(theta, "theta")
     if t.ndim == 0:
         t = np.full(m, float(t))
     elif t.shape != (m,) or arr.ndim != 2:

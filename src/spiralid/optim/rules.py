@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from spiralid.optim import _kernels
+from spiralid.optim._checks import positive, real, real_array
 
 __all__ = [
     "ConstantSpiral",
@@ -60,21 +61,9 @@ class SpiralRule(ABC):
         """
 
 
-def _real(value, name: str) -> float:
-    try:
-        out = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"`{name}` must be a finite real number; got {value!r}"
-        ) from None
-    if not math.isfinite(out):
-        raise ValueError(f"`{name}` must be a finite real number; got {value!r}")
-    return out
-
-
 def _check_interval(lo, hi, lo_name, hi_name, radius: bool):
-    lo = _real(lo, lo_name)
-    hi = _real(hi, hi_name)
+    lo = real(lo, lo_name)
+    hi = real(hi, hi_name)
     if radius and not 0.0 < lo < hi <= 1.0:
         raise ValueError(
             f"`{lo_name}` and `{hi_name}` must satisfy 0 < {lo_name} < {hi_name} <= 1; "
@@ -88,11 +77,15 @@ def _check_interval(lo, hi, lo_name, hi_name, radius: bool):
     return lo, hi
 
 
-def _positive(value, name: str) -> float:
-    out = _real(value, name)
-    if out <= 0.0:
-        raise ValueError(f"`{name}` must be a finite number > 0; got {value!r}")
-    return out
+def _deviations(d) -> np.ndarray:
+    """``d`` as a 1-D float array of deviations >= 0 (``inf`` allowed)."""
+    d = real_array(d, "d")
+    # One comparison catches NaN and negative values alike.
+    if d.ndim != 1 or not np.all(d >= 0.0):
+        raise ValueError(
+            f"`d` must be a 1-D array of deviations >= 0 (inf allowed); got {d!r}"
+        )
+    return d
 
 
 @dataclass(frozen=True)
@@ -117,11 +110,11 @@ class ConstantSpiral(SpiralRule):
     angle: float = math.pi / 4
 
     def __post_init__(self):
-        r = _real(self.radius, "radius")
+        r = real(self.radius, "radius")
         if not 0.0 < r <= 1.0:
             raise ValueError(f"`radius` must be in (0, 1]; got {self.radius!r}")
         object.__setattr__(self, "radius", r)
-        object.__setattr__(self, "angle", _real(self.angle, "angle"))
+        object.__setattr__(self, "angle", real(self.angle, "angle"))
 
     def __call__(self, d, rng):
         return self.radius, self.angle
@@ -157,10 +150,11 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
     >>> exponential_rule(np.array([0.0, np.inf]), 0.1, 1.0, 100.0, 1.5).round(6)
     array([0.991089, 0.1     ])
     """
-    d = np.asarray(d, dtype=np.float64)
-    if np.isnan(d).any() or (d < 0).any():
+    d = real_array(d, "d")
+    if not np.all(d >= 0.0):  # NaN fails the comparison too
         raise ValueError(f"`d` must be >= 0 (inf allowed); got {d!r}")
-    lower, upper, c1, c2 = (float(v) for v in (lower, upper, c1, c2))
+    lower, upper = _check_interval(lower, upper, "lower", "upper", radius=False)
+    c1, c2 = positive(c1, "c1"), positive(c2, "c2")
     cap = max((_Z_CAP + math.log(c1)) / c2, 0.0)
     out, _ = _kernels.exponential(
         d.ravel(),
@@ -211,7 +205,7 @@ class ExponentialSpiral(SpiralRule):
         th_l, th_u = _check_interval(self.th_l, self.th_u, "th_l", "th_u", radius=False)
         values = {"r_l": r_l, "r_u": r_u, "th_l": th_l, "th_u": th_u}
         for name in ("r_c1", "r_c2", "th_c1", "th_c2"):
-            values[name] = _positive(getattr(self, name), name)
+            values[name] = positive(getattr(self, name), name)
         for name, value in values.items():
             object.__setattr__(self, name, value)
         # Radius and angle evaluated together, as `exponential_rule` does.
@@ -239,7 +233,7 @@ class ExponentialSpiral(SpiralRule):
         return exponential_rule(d, self.th_l, self.th_u, self.th_c1, self.th_c2)
 
     def __call__(self, d, rng):
-        d = np.asarray(d, dtype=np.float64)
+        d = _deviations(d)
         (r, theta), zeros = _kernels.exponential(d, *self._consts)
         if zeros:
             zero = d == 0.0
@@ -289,7 +283,7 @@ class LinearSpiral(SpiralRule):
         for name, value in {"r_l": r_l, "r_u": r_u, "th_l": th_l, "th_u": th_u}.items():
             object.__setattr__(self, name, value)
         if self.d_max is not None:
-            object.__setattr__(self, "d_max", _positive(self.d_max, "d_max"))
+            object.__setattr__(self, "d_max", positive(self.d_max, "d_max"))
 
     def _fraction(self, d: np.ndarray) -> np.ndarray:
         d_max = self.d_max
@@ -302,8 +296,7 @@ class LinearSpiral(SpiralRule):
         return np.minimum(d, d_max) / d_max
 
     def __call__(self, d, rng):
-        d = np.asarray(d, dtype=np.float64)
-        g = 1.0 - self._fraction(d)
+        g = 1.0 - self._fraction(_deviations(d))
         r = self.r_l + (self.r_u - self.r_l) * g
         theta = self.th_l + (self.th_u - self.th_l) * g
         return r, theta

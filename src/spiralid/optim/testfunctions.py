@@ -25,6 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spiralid.optim._checks import real_array
+
 __all__ = [
     "PROBLEMS",
     "Problem",
@@ -44,12 +46,16 @@ _SCHWEFEL_C = 418.98288727243374
 
 
 def _points(x, name: str, min_n: int = 1) -> np.ndarray:
-    arr = np.asarray(x, dtype=np.float64)
+    arr = real_array(x, "x")
     if arr.ndim not in (1, 2) or arr.shape[-1] < min_n:
         raise ValueError(
             f"`x` must have shape (n,) or (m, n) with n >= {min_n} for {name}; "
             f"got shape {arr.shape}"
         )
+    # The search never proposes non-finite points; a NaN here is a caller's
+    # bug, better named than returned as a NaN cost.
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"`x` must be finite for {name}; got NaN or infinite entries")
     return arr
 
 
