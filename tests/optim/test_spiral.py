@@ -181,15 +181,35 @@ def test_2d_sphere_sda_default_budget(seed):
     assert res.fun < 1e-12
 
 
+# Issue 2 asks both methods to reach 1e-12 on the 2-D sphere within the
+# default budget. Eb-SDA with the paper's constants does not: a point whose
+# cost is close to the centre's (d -> 0) keeps r -> 1 - 0.9 / 101 ~ 0.991, so
+# near the optimum, where every d is tiny, the swarm contracts by under 1 %
+# per iteration. Measured over seeds 0-19 on [-5, 5]^2 (m = 50, 500
+# iterations): final cost 1.5e-9 .. 8.3e-7, median 8.8e-8; 1e-12 is reached
+# after 916 .. 1259 iterations. The constants are the paper's and are not
+# retuned; the strict xfail below records the unmet item and fails the suite
+# if it ever starts to pass, so this note cannot go stale silently.
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 2 acceptance item not met by Eb-SDA with the paper's "
+    "constants: 1.5e-9..8.3e-7 after 500 iterations",
+)
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_2d_sphere_ebsda_default_budget_below_1e12(seed):
+    res = minimize(sphere, [(-5, 5)] * 2, "ebsda", rng=seed, vectorized=True)
+    assert res.fun < 1e-12
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_2d_sphere_ebsda(seed):
-    # With the paper's constants, points near the centre keep r ~ 0.991, so
-    # Eb-SDA converges slowly at tiny costs: at the default 500 iterations it
-    # reaches 1e-9..1e-6 (20 seeds), and needs ~1500 for 1e-12.
+    # What Eb-SDA does reach (see the note above): below 1e-6 in the default
+    # budget (these seeds: 2.8e-8, 1.1e-7, 3.1e-8), below 1e-12 within 1500
+    # iterations (these seeds: 1063, 1157, 1080).
     res = minimize(sphere, [(-5, 5)] * 2, "ebsda", rng=seed, vectorized=True)
-    assert res.success and res.fun < 1e-5
+    assert res.success and res.nit == 500 and res.fun < 1e-6
     res = minimize(
-        sphere, [(-5, 5)] * 2, "ebsda", rng=seed, vectorized=True, max_iter=2000
+        sphere, [(-5, 5)] * 2, "ebsda", rng=seed, vectorized=True, max_iter=1500
     )
     assert res.fun < 1e-12
 
@@ -274,6 +294,44 @@ def test_callback_receives_results_and_stops():
     assert [s[2] for s in seen] == list(range(2, 9))
     assert res.nit == 7 and not res.success
     assert res.message == "The callback requested a stop."
+
+
+def test_callback_sees_the_iteration_that_reaches_the_target():
+    # Callers time-stamp `history` from the callback: one call per iteration.
+    seen = []
+    res = minimize(
+        sphere,
+        [(-5, 5)] * 2,
+        "sda",
+        rng=0,
+        vectorized=True,
+        target=1e-3,
+        callback=lambda r: seen.append(r.fun) or True,
+    )
+    # The callback asked to stop after the first iteration, target unmet.
+    assert len(seen) == 1 and res.nit == 1 and not res.success
+    assert res.message.startswith("The callback requested a stop.")
+    seen.clear()
+    res = minimize(
+        sphere,
+        [(-5, 5)] * 2,
+        "sda",
+        rng=0,
+        vectorized=True,
+        target=1e-3,
+        callback=lambda r: seen.append(r.fun),
+    )
+    assert res.message == "Target cost reached."
+    assert len(seen) == res.nit == len(res.history) - 1
+    np.testing.assert_array_equal(seen, res.history[1:])
+    # Target met in the very iteration the callback asks to stop: target wins.
+    kw = dict(n_points=10, rng=0, vectorized=True)
+    h = minimize(sphere, [(-5, 5)] * 2, "sda", max_iter=1, **kw).history
+    assert h[1] < h[0]
+    both = minimize(
+        sphere, [(-5, 5)] * 2, "sda", target=h[1], callback=lambda r: True, **kw
+    )
+    assert both.nit == 1 and both.success and both.message == "Target cost reached."
 
 
 @pytest.mark.parametrize("method", ["sda", "ebsda"])
@@ -433,6 +491,11 @@ B2 = [(-1, 1)] * 2
         (dict(x0=np.zeros((4, 2)), n_points=3), r"^`x0` must have shape .*n_points=3"),
         (dict(x0=[[0.5, 2.0]]), r"^`x0` must lie within `bounds`.*row 0"),
         (dict(x0=[np.nan, 0.0]), r"^`x0` must be finite"),
+        (dict(rng="seed"), r"^`rng` must be None, a non-negative integer.*'seed'"),
+        (dict(rng=1.5), r"^`rng` must be None, a non-negative integer.*1\.5"),
+        (dict(rng=-1), r"^`rng` must be None, a non-negative integer.*-1"),
+        # bool("no") is True: a string must not switch on batch evaluation.
+        (dict(vectorized="no"), r"^`vectorized` must be True or False; got 'no'"),
     ],
 )
 def test_bad_input(kwargs, match):
@@ -456,8 +519,15 @@ def test_objective_wrong_shape():
         ValueError, match=r"^`fun` must return a scalar .*got shape \(2,\)"
     ):
         minimize(lambda x: x, B2, n_points=4)
-    with pytest.raises(ValueError, match=r"^`fun` must return a real scalar; got str"):
+    with pytest.raises(ValueError, match=r"^`fun` must return real numbers; got 'a'"):
         minimize(lambda x: "a", B2, n_points=4)
+    # None would otherwise become NaN and rank worst without a word.
+    with pytest.raises(ValueError, match=r"^`fun` must return real numbers; got None"):
+        minimize(lambda x: None, B2, n_points=4)
+    with pytest.raises(ValueError, match=r"^`fun` must return real numbers; got \["):
+        minimize(lambda X: [None] * len(X), B2, n_points=4, vectorized=True)
+    with pytest.raises(ValueError, match=r"^`fun` must return real numbers; got 1j"):
+        minimize(lambda x: 1j, B2, n_points=4)
     # A shape error later in the run (not only on the initial batch) is caught too.
     calls = []
 
@@ -512,3 +582,29 @@ def test_custom_rule_mixed_scalar_and_per_point():
 def test_custom_rule_wrong_shape():
     with pytest.raises(ValueError, match=r"^`method` rule must return .*\(3,\); got"):
         SpiralSearch(sphere, B2, _HalfTurn((2,)), n_points=4, vectorized=True).step()
+
+
+class _Returns(SpiralRule):
+    def __init__(self, out):
+        self.out = out
+
+    def __call__(self, d, rng):
+        return self.out
+
+
+@pytest.mark.parametrize(
+    ("out", "match"),
+    [
+        (0.5, r"must return \(radius, angle\).*got 0\.5"),
+        (None, r"must return \(radius, angle\).*got None"),
+        ((0.5, 0.1, 0.2), r"must return \(radius, angle\)"),
+        (("a", 0.1), r"^`method` must be an array of real numbers; got 'a'"),
+        # A NaN radius would silently send every moving point to NaN.
+        ((np.nan, 0.1), r"must return \(radius, angle\).*non-finite"),
+        ((0.5, np.array([0.1, np.inf, 0.1])), r"non-finite"),
+    ],
+)
+def test_custom_rule_bad_output(out, match):
+    search = SpiralSearch(sphere, B2, _Returns(out), n_points=4, vectorized=True)
+    with pytest.raises(ValueError, match=match):
+        search.step()

@@ -18,7 +18,6 @@ until a finite cost turns up (every deviation is then ``inf``).
 """
 
 import math
-import operator
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -27,6 +26,7 @@ import numpy as np
 from scipy.optimize import Bounds
 
 from spiralid.optim import _kernels
+from spiralid.optim._checks import generator, integer, real_array
 from spiralid.optim.rotation import _sweep_order, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,
@@ -103,20 +103,6 @@ class SpiralResult:
     mean_angle: np.ndarray
 
 
-def _index(value, name: str, minimum: int) -> int:
-    try:
-        if isinstance(value, bool):
-            raise TypeError
-        out = operator.index(value)
-    except TypeError:
-        raise ValueError(
-            f"`{name}` must be an integer >= {minimum}; got {value!r}"
-        ) from None
-    if out < minimum:
-        raise ValueError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
-    return out
-
-
 def _parse_bounds(bounds) -> tuple[np.ndarray, np.ndarray]:
     what = (
         "`bounds` must be a sequence of (low, high) pairs, an (n, 2) array or "
@@ -170,16 +156,38 @@ def _parse_method(method) -> SpiralRule:
     )
 
 
-def _per_point(value, k: int, what: str) -> np.ndarray:
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.shape == (k,):
-        return arr
-    if arr.ndim == 0:
-        return np.full(k, float(arr))
-    raise ValueError(
-        f"`method` rule must return a scalar {what} or one per moving point, "
-        f"shape ({k},); got shape {arr.shape}"
+def _rule_output(out, k: int) -> tuple:
+    """Check a rule's ``(r, theta)``: scalars or one finite value per mover."""
+    what = (
+        "`method` rule must return (radius, angle), each a finite scalar or "
+        f"shape ({k},)"
     )
+    try:
+        r, theta = out
+    except (TypeError, ValueError):
+        raise ValueError(f"{what}; got {out!r}") from None
+    checked = []
+    for value in (r, theta):
+        arr = real_array(value, "method")
+        if arr.ndim != 0 and arr.shape != (k,):
+            raise ValueError(f"{what}; got shape {arr.shape}")
+        # A NaN radius or angle would turn every mover into NaN silently.
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"{what}; got non-finite values {value!r}")
+        checked.append(arr)
+    return tuple(checked)
+
+
+def _costs(raw, shape: tuple, what: str) -> np.ndarray:
+    """Check what the objective returned: real numbers of the given shape."""
+    arr = np.asarray(raw)
+    # None or strings (object arrays) would turn into NaN or fail deep in
+    # NumPy; complex costs cannot be ranked.
+    if arr.dtype.kind not in "biuf":
+        raise ValueError(f"`fun` must return real numbers; got {raw!r:.80}")
+    if arr.shape != shape:
+        raise ValueError(f"`fun` must return {what}; got shape {arr.shape}")
+    return arr
 
 
 class SpiralSearch:
@@ -222,16 +230,18 @@ class SpiralSearch:
         self._fun = fun
         self._lo, self._hi = _parse_bounds(bounds)
         self.rule = _parse_method(method)
-        m = _index(n_points, "n_points", 2)
+        m = integer(n_points, "n_points", 2)
         if bounds_policy not in _POLICIES:
             raise ValueError(
                 f"`bounds_policy` must be one of {_POLICIES}; got {bounds_policy!r}"
             )
         self.bounds_policy = bounds_policy
+        if not isinstance(vectorized, bool | np.bool_):
+            raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
         self.vectorized = bool(vectorized)
         n = self._lo.size
         seeds = self._parse_x0(x0, m, n)
-        self._rng = np.random.default_rng(rng)
+        self._rng = generator(rng)
         x = np.empty((m, n))
         k = seeds.shape[0]
         x[:k] = seeds
@@ -278,36 +288,16 @@ class SpiralSearch:
     def _evaluate(self, pts: np.ndarray) -> np.ndarray:
         k = pts.shape[0]
         if self.vectorized:
-            raw = self._fun(pts.copy())
-            try:
-                # A copy: the search reorders its costs in place, and the
-                # caller may keep the array it returned.
-                out = np.array(raw, dtype=np.float64)
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"`fun` must return real numbers; got {type(raw).__name__}"
-                ) from None
-            if out.shape != (k,):
-                raise ValueError(
-                    f"`fun` must return shape ({k},) for a ({k}, {pts.shape[1]}) "
-                    f"batch when vectorized=True; got shape {out.shape}"
-                )
-            return out
+            what = (
+                f"shape ({k},) for a ({k}, {pts.shape[1]}) batch when vectorized=True"
+            )
+            # A copy: the search reorders its costs in place, and the caller
+            # may keep the array it returned.
+            return np.array(_costs(self._fun(pts.copy()), (k,), what), np.float64)
+        what = "a scalar when vectorized=False (pass vectorized=True for batches)"
         out = np.empty(k)
         for i in range(k):
-            raw = self._fun(pts[i].copy())
-            try:
-                val = np.asarray(raw, dtype=np.float64)
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"`fun` must return a real scalar; got {type(raw).__name__}"
-                ) from None
-            if val.shape != ():
-                raise ValueError(
-                    "`fun` must return a scalar when vectorized=False (pass "
-                    f"vectorized=True for batches); got shape {val.shape}"
-                )
-            out[i] = val
+            out[i] = _costs(self._fun(pts[i].copy()), (), what)
         return out
 
     def _promote(self) -> None:
@@ -347,8 +337,8 @@ class SpiralSearch:
         """Perform one iteration; return the best point and cost."""
         x = self._x
         k = x.shape[0] - 1
-        r, theta = self.rule(self._deviations(), self._rng)
-        if np.ndim(theta) == 0 and np.ndim(r) == 0:
+        r, theta = _rule_output(self.rule(self._deviations(), self._rng), k)
+        if theta.ndim == 0 and r.ndim == 0:
             # One angle for all points: one dense product beats the sweep.
             r = float(r)
             theta = float(theta)
@@ -359,8 +349,8 @@ class SpiralSearch:
             self.mean_radius.append(r)
             self.mean_angle.append(theta)
         else:
-            r = _per_point(r, k, "radius")
-            theta = _per_point(theta, k, "angle")
+            r = np.full(k, r) if r.ndim == 0 else r
+            theta = np.full(k, theta) if theta.ndim == 0 else theta
             _kernels.spiral_step(x, r, theta, self._planes)
             self.mean_radius.append(float(r.sum()) / k)
             self.mean_angle.append(float(theta.sum()) / k)
@@ -475,8 +465,10 @@ def minimize(
         Seeds the first ``k <= n_points`` initial points (inside
         ``bounds``); the rest are drawn uniformly.
     callback : callable, optional
-        ``callback(intermediate_result)`` after every iteration with a
-        :class:`SpiralResult`; returning True stops the search.
+        ``callback(intermediate_result)`` after every iteration (the last
+        one included) with a :class:`SpiralResult`; returning True stops the
+        search. If ``target`` is reached in the same iteration, the stop is
+        reported as reaching the target.
     bounds_policy : {"none", "clip", "reflect"}
         What to do with points that leave the box. The paper has no bound
         handling, so ``"none"`` (the default) lets them go.
@@ -497,10 +489,10 @@ def minimize(
     ('Target cost reached.', True)
     """
     start = time.perf_counter()
-    max_iter = _index(max_iter, "max_iter", 1)
-    m = _index(n_points, "n_points", 2)
+    max_iter = integer(max_iter, "max_iter", 1)
+    m = integer(n_points, "n_points", 2)
     if max_nfev is not None:
-        max_nfev = _index(max_nfev, "max_nfev", m)
+        max_nfev = integer(max_nfev, "max_nfev", m)
     if target is not None:
         try:
             target = float(target)
@@ -533,10 +525,13 @@ def minimize(
             status = "max_nfev"
             break
         search.step()
+        # The callback sees every iteration, the last one included, so that
+        # callers can time-stamp each entry of `history`.
+        stop = callback is not None and callback(
+            search.result("running", time.perf_counter() - start)
+        )
         if target is not None and search.history[-1] <= target:
             status = "target"
-        elif callback is not None and callback(
-            search.result("running", time.perf_counter() - start)
-        ):
+        elif stop:
             status = "callback"
     return search.result(status, time.perf_counter() - start, target)
