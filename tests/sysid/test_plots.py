@@ -196,3 +196,16 @@ def test_plot_validations_overlays_models_on_one_record():
         plots.plot_validations([vals["SDA"], other])
     with pytest.raises(ValueError, match="`validations` must hold at least one"):
         plots.plot_validations([])
+
+
+def test_importing_the_library_does_not_import_matplotlib():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, spiralid, spiralid.sysid as s\n"
+        "assert not any(m.startswith('matplotlib') for m in sys.modules)\n"
+        "s.plots\n"
+        "assert 'matplotlib' in sys.modules\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

@@ -17,7 +17,6 @@ from .polynomials import step_up as step_up
 
 # --- validation (validate, plots) ---
 # isort: split
-from . import plots as plots
 from .correlation import CorrelationTest as CorrelationTest
 from .correlation import independence_test as independence_test
 from .correlation import whiteness_test as whiteness_test
@@ -29,3 +28,13 @@ from .validate import Validation as Validation
 from .validate import fit_percent as fit_percent
 from .validate import realization_tests as realization_tests
 from .validate import validate as validate
+
+
+def __getattr__(name: str):
+    # `plots` needs matplotlib, which is slow to import and not needed to
+    # identify or validate a model: load it on first use only.
+    if name == "plots":
+        import importlib
+
+        return importlib.import_module(".plots", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
