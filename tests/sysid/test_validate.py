@@ -120,6 +120,7 @@ def test_true_model_validates_perfectly():
     assert v.realization.minimal and v.realization.order == 2
     # the model's own mode is the continuous system's
     np.testing.assert_allclose(v.modes.frequency, [FN], rtol=1e-9)
+    np.testing.assert_allclose(v.modes_hz, [FN], rtol=1e-9)
     np.testing.assert_allclose(v.modes.damping, [ZETA], rtol=1e-8)
     # and the measured spectrum peaks at its resonance
     (peak,) = v.peaks_measured.frequency[:1]
@@ -256,3 +257,5 @@ def test_validate_bad_input():
         validate(m, data, warmup=IOData(data.u, data.y, ts=0.5))
     with pytest.raises(ValueError, match="`data` must be an IOData"):
         validate(m, (data.u, data.y))
+    with pytest.raises(ValueError, match="`warmup` must be an IOData"):
+        validate(m, data, warmup=(data.u, data.y))

@@ -347,6 +347,12 @@ class Validation:
         return self.y - self.y_sim
 
     @property
+    def modes_hz(self) -> np.ndarray:
+        """Natural frequencies in Hz of the model's lightly damped modes
+        (``modes.frequency``; DESIGN.md's ``rep.modes_hz``)."""
+        return self.modes.frequency
+
+    @property
     def error_one_step(self) -> np.ndarray:
         """One-step prediction error ``y - y_pred``."""
         return self.y - self.y_pred
@@ -482,18 +488,18 @@ def _attr(obj, name):
     return val() if callable(val) else val
 
 
-def _signals_of(data):
+def _signals_of(data, name: str = "data"):
     for attr in ("u", "y", "ts"):
         if not hasattr(data, attr):
             raise ValueError(
-                f"`data` must be an IOData (with .u, .y, .ts); "
+                f"`{name}` must be an IOData (with .u, .y, .ts); "
                 f"got {type(data).__name__}"
             )
     u = np.asarray(data.u, dtype=float).ravel()
     y = np.asarray(data.y, dtype=float).ravel()
     if u.size != y.size:
         raise ValueError(
-            f"`data` must have input and output of the same length; "
+            f"`{name}` must have input and output of the same length; "
             f"got {u.size} and {y.size}"
         )
     return u, y, float(data.ts)
@@ -661,7 +667,7 @@ def validate(
         y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
         y_pred = np.asarray(model.predict(data), dtype=float).ravel()
     else:
-        wu, wy, wts = _signals_of(warmup)
+        wu, wy, wts = _signals_of(warmup, "warmup")
         if not np.isclose(wts, ts, rtol=1e-9):
             raise ValueError(
                 f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
