@@ -151,3 +151,17 @@ def test_modes_are_ascending_and_all_flexible():
     lam = np.linalg.eigvals(np.linalg.solve(rig.mass_matrix, rig.stiffness_matrix))
     ref = np.sort(np.sqrt(np.abs(lam.real)))[1:] / (2 * np.pi)
     np.testing.assert_allclose(f, ref, rtol=1e-7)
+
+
+def test_bad_matrix_arguments_raise():
+    # Used to fail with ZeroDivisionError or return NaN matrices.
+    with pytest.raises(ValueError, match=r"^`n_elements` must be an integer >= 1"):
+        assemble(0, L, EI, RHO_A, IH)
+    with pytest.raises(ValueError, match=r"^`length` must be a finite number > 0"):
+        assemble(3, np.nan, EI, RHO_A, IH)
+    with pytest.raises(ValueError, match=r"^`payload_mass` must be a finite number"):
+        assemble(3, L, EI, RHO_A, IH, payload_mass=-1.0)
+    with pytest.raises(ValueError, match=r"^`le` must be a finite number > 0"):
+        element_matrices(0.0, EI, RHO_A, 0.0)
+    with pytest.raises(ValueError, match=r"^`x0` must be a finite number >= 0"):
+        element_matrices(0.1, EI, RHO_A, -1.0)

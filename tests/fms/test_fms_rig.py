@@ -280,6 +280,14 @@ def test_paper_experiment_returns_hub_and_shows_three_modes():
         ({"damping_ratio": 1.0}, r"`damping_ratio` must be in \[0, 1\)"),
         ({"n_elements": 0}, "`n_elements` must be an integer >= 1; got 0"),
         ({"n_elements": 2.5}, "`n_elements` must be an integer >= 1"),
+        # Wrong types used to escape as TypeErrors from float().
+        ({"length": "a"}, r"^`length` must be a finite number > 0; got 'a'"),
+        ({"length": None}, r"^`length` must be a finite number > 0; got None"),
+        ({"width": [0.02]}, r"^`width` must be a finite number > 0; got \[0\.02\]"),
+        ({"thickness": 1j}, r"^`thickness` must be a finite number > 0; got 1j"),
+        ({"payload_mass": "x"}, r"^`payload_mass` must be a finite number >= 0"),
+        ({"damping_ratio": None}, r"^`damping_ratio` must be in \[0, 1\); got None"),
+        ({"damping_ratio": -0.1}, r"^`damping_ratio` must be in \[0, 1\)"),
     ],
 )
 def test_bad_rig_parameters_raise(kwargs, match):
@@ -303,6 +311,26 @@ def test_bad_rig_parameters_raise(kwargs, match):
         (lambda r: r.simulate([1.0], x0=[1.0, 2.0]), "`x0` must hold 10 finite"),
         (lambda r: r.simulate([1.0], sensors="ideal"), "`sensors` must be a Sensors"),
         (lambda r: r.modes(0), "`n` must be a positive integer"),
+        (lambda r: r.simulate("abc"), r"^`torque` must be an array of real numbers"),
+        (lambda r: r.simulate([[1], [2, 3]]), r"^`torque` must be an array of real"),
+        (lambda r: r.simulate(np.ones(3) + 1j), r"^`torque` must be an array of real"),
+        (lambda r: r.simulate([1.0], fs="abc"), r"^`fs` must be a finite number > 0"),
+        (lambda r: r.simulate([1.0], fs="500"), r"^`fs` must be a finite number > 0"),
+        (lambda r: r.simulate([1.0], rng="a"), r"^`rng` must be None, a non-negative"),
+        (lambda r: r.simulate([1.0], rng=1.5), r"^`rng` must be None, a non-negative"),
+        (
+            lambda r: r.simulate([1.0], x0=np.zeros((2, 5))),
+            r"^`x0` must hold 10 finite numbers \(q, q'\), shape \(10,\)",
+        ),
+        (lambda r: r.simulate([1.0], x0="abcdefghij"), r"^`x0` must be an array"),
+        (
+            lambda r: r.simulate([1.0], return_state="no"),
+            r"^`return_state` must be True or False; got 'no'",
+        ),
+        (
+            lambda r: r.simulate([1.0, 1.0, 1.0], fs=1e-300),
+            r"^`torque` and `fs` drive the model beyond the float range",
+        ),
     ],
 )
 def test_bad_simulate_arguments_raise(call, match):
@@ -319,6 +347,12 @@ def test_bad_simulate_arguments_raise(call, match):
         ({"accel_noise": np.nan}, "`accel_noise` must be"),
         ({"antialias_order": -1}, r"`antialias_order` must be an integer in \[0, 12\]"),
         ({"antialias_cutoff": 1.5}, r"`antialias_cutoff` must be in \(0, 1\]"),
+        ({"antialias_cutoff": None}, r"^`antialias_cutoff` must be in \(0, 1\]"),
+        ({"antialias_cutoff": "a"}, r"^`antialias_cutoff` must be in \(0, 1\]"),
+        ({"tach_noise": None}, r"^`tach_noise` must be a finite number >= 0"),
+        ({"accel_noise": "a"}, r"^`accel_noise` must be a finite number >= 0"),
+        ({"encoder_lines": 2048.0}, r"^`encoder_lines` must be a positive integer"),
+        ({"antialias_order": 2.0}, r"^`antialias_order` must be an integer"),
     ],
 )
 def test_bad_sensor_parameters_raise(kwargs, match):

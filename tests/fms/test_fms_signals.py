@@ -6,7 +6,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
-from spiralid.fms import Sensors, bang_bang, chirp, paper_experiment, prbs
+from spiralid.fms import (
+    Experiment,
+    Sensors,
+    bang_bang,
+    chirp,
+    paper_experiment,
+    prbs,
+)
 from spiralid.fms.sensors import butterworth_ss, quantise
 
 
@@ -101,6 +108,18 @@ def test_paper_experiment_defaults_are_consistent():
         (lambda: chirp(1, 0, 10, 1, 100, "logarithmic"), "`f0` and `f1` must be > 0"),
         (lambda: paper_experiment().__class__(n_pulses=0), "`n_pulses` must be"),
         (lambda: paper_experiment().__class__(period=0.01), "`period` must be"),
+        (lambda: bang_bang("a", 0.1, 0, 1, 100), r"^`amplitude` must be a finite"),
+        (lambda: bang_bang("1", 0.1, 0, 1, 100), r"^`amplitude` must be a finite"),
+        (lambda: chirp(1, "a", 10, 1, 100), r"^`f0` must be a finite number"),
+        (lambda: prbs(1, 1, 10, n_bits=5.0), r"^`n_bits` must be an integer"),
+        # These used to fail inside arithmetic (TypeError, round(nan)).
+        (lambda: Experiment(period=None), r"^`period` must be a finite number > 0"),
+        (lambda: Experiment(width="a"), r"^`width` must be a finite number > 0"),
+        (lambda: Experiment(fs=np.nan), r"^`fs` must be a finite number > 0"),
+        (
+            lambda: Experiment().run(rig="x"),
+            r"^`rig` must be a FlexibleManipulator or None",
+        ),
     ],
 )
 def test_bad_signal_arguments_raise(call, match):

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spiralid.fms._checks import is_integer, positive
 from spiralid.fms.rig import FlexibleManipulator, Recording
 from spiralid.fms.sensors import Sensors
 from spiralid.fms.signals import bang_bang
@@ -57,9 +58,13 @@ class Experiment:
 
     def __post_init__(self) -> None:
         n = self.n_pulses
-        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+        if not is_integer(n) or n < 1:
             raise ValueError(f"`n_pulses` must be a positive integer; got {n!r}")
-        if not (np.isfinite(self.period) and self.period >= 2 * self.width):
+        # The scalars first, so that a bad one is named before arithmetic on
+        # it fails (round(nan) in torque(), say).
+        for name in ("width", "period", "duration", "fs"):
+            positive(name, getattr(self, name))
+        if not self.period >= 2 * self.width:
             raise ValueError(
                 f"`period` must be finite and >= 2 * width = {2 * self.width:g}; "
                 f"got {self.period!r}"
@@ -103,6 +108,10 @@ class Experiment:
         """
         if rig is None:
             rig = FlexibleManipulator()
+        elif not isinstance(rig, FlexibleManipulator):
+            raise ValueError(
+                f"`rig` must be a FlexibleManipulator or None; got {rig!r}"
+            )
         return rig.simulate(self.torque(), fs=self.fs, rng=rng, sensors=self.sensors())
 
 

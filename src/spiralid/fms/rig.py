@@ -23,6 +23,7 @@ from functools import cached_property, lru_cache
 import numpy as np
 from scipy.linalg import eigh
 
+from spiralid.fms._checks import generator, is_integer, nonneg, positive, real_array
 from spiralid.fms._zoh import discretise_zoh, simulate_discrete
 from spiralid.fms.beam import assemble
 from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
@@ -30,20 +31,6 @@ from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
 __all__ = ["FlexibleManipulator", "Recording"]
 
 _OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
-
-
-def _positive(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v > 0.0):
-        raise ValueError(f"`{name}` must be a finite number > 0; got {value!r}")
-    return v
-
-
-def _nonneg(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v >= 0.0):
-        raise ValueError(f"`{name}` must be a finite number >= 0; got {value!r}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -178,17 +165,20 @@ class FlexibleManipulator:
             "density",
             "hub_inertia",
         ):
-            object.__setattr__(self, name, _positive(name, getattr(self, name)))
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
         for name in ("payload_mass", "payload_inertia", "hub_friction"):
-            object.__setattr__(self, name, _nonneg(name, getattr(self, name)))
-        z = float(self.damping_ratio)
-        if not (math.isfinite(z) and 0.0 <= z < 1.0):
+            object.__setattr__(self, name, nonneg(name, getattr(self, name)))
+        try:
+            z = nonneg("damping_ratio", self.damping_ratio)
+        except ValueError:
+            z = math.nan
+        if not z < 1.0:
             raise ValueError(
                 f"`damping_ratio` must be in [0, 1); got {self.damping_ratio!r}"
             )
         object.__setattr__(self, "damping_ratio", z)
         ne = self.n_elements
-        if isinstance(ne, bool) or not isinstance(ne, int | np.integer) or ne < 1:
+        if not is_integer(ne) or ne < 1:
             raise ValueError(f"`n_elements` must be an integer >= 1; got {ne!r}")
         object.__setattr__(self, "n_elements", int(ne))
 
@@ -291,7 +281,7 @@ class FlexibleManipulator:
         f = self._modal[0][1:] / (2.0 * math.pi)
         if n is None:
             return f
-        if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+        if not is_integer(n) or n < 1:
             raise ValueError(f"`n` must be a positive integer or None; got {n!r}")
         return f[:n]
 
@@ -380,10 +370,8 @@ class FlexibleManipulator:
         >>> round(float(rec.hub_angle[-1]) / (0.3 * 0.1**2 / rig.total_inertia), 2)
         1.0
         """
-        fs_v = float(fs) if np.isscalar(fs) else math.nan
-        if not (math.isfinite(fs_v) and fs_v > 0.0):
-            raise ValueError(f"`fs` must be a finite number > 0; got {fs!r}")
-        u = np.asarray(torque, dtype=float)
+        fs_v = positive("fs", fs)
+        u = real_array("torque", torque)
         if u.ndim == 2 and u.shape[1] == 1:
             u = u[:, 0]
         if u.ndim != 1 or u.size == 0:
@@ -404,13 +392,18 @@ class FlexibleManipulator:
         if x0 is None:
             x0v = np.zeros(2 * n)
         else:
-            x0v = np.asarray(x0, dtype=float).ravel()
-            if x0v.size != 2 * n or not np.all(np.isfinite(x0v)):
+            x0v = real_array("x0", x0)
+            if x0v.shape != (2 * n,) or not np.all(np.isfinite(x0v)):
                 raise ValueError(
-                    f"`x0` must hold {2 * n} finite numbers (q, q'); "
-                    f"got shape {np.shape(x0)}"
+                    f"`x0` must hold {2 * n} finite numbers (q, q'), shape "
+                    f"({2 * n},); got {x0!r:.80}"
                 )
-        gen = np.random.default_rng(rng)
+        if not isinstance(return_state, bool | np.bool_):
+            raise ValueError(
+                f"`return_state` must be True or False; got {return_state!r}"
+            )
+        # Checked even without noise, so a bad seed never goes unnoticed.
+        gen = generator(rng)
 
         ts = 1.0 / fs_v
         Ad, Bd, C, D, scale = _discrete(
@@ -423,6 +416,14 @@ class FlexibleManipulator:
         s0[:n] = phi.T @ (M @ x0v[:n])
         s0[n : 2 * n] = (phi.T @ (M @ x0v[n:])) / scale
         y, s = simulate_discrete(Ad, Bd, C, D, u, s0, return_state)
+        if not np.all(np.isfinite(y)):
+            # Only absurd inputs get here (a sample time of 1e300 s, torques
+            # near the float limit): say so rather than return NaN.
+            raise ValueError(
+                "`torque` and `fs` drive the model beyond the float range "
+                f"(non-finite samples); got fs={fs!r}, "
+                f"max |torque|={float(np.max(np.abs(u))):g}"
+            )
 
         hub_velocity = y[:, 1]
         acc = y[:, 2]

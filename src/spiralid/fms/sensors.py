@@ -14,14 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spiralid.fms._checks import is_integer, nonneg, real
+
 __all__ = ["Sensors", "butterworth_ss", "quantise"]
-
-
-def _check_nonneg(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v >= 0.0):
-        raise ValueError(f"`{name}` must be a finite number >= 0; got {value!r}")
-    return v
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -78,44 +73,28 @@ class Sensors:
     antialias_cutoff: float = 0.35
 
     def __post_init__(self) -> None:
-        if self.encoder_lines is not None:
-            if isinstance(self.encoder_lines, bool) or not isinstance(
-                self.encoder_lines, int | np.integer
-            ):
-                raise ValueError(
-                    "`encoder_lines` must be a positive integer or None; "
-                    f"got {self.encoder_lines!r}"
-                )
-            if self.encoder_lines < 1:
-                raise ValueError(
-                    "`encoder_lines` must be a positive integer or None; "
-                    f"got {self.encoder_lines!r}"
-                )
-        if (
-            isinstance(self.quadrature, bool)
-            or not isinstance(self.quadrature, int | np.integer)
-            or self.quadrature < 1
-        ):
+        lines = self.encoder_lines
+        if lines is not None and (not is_integer(lines) or lines < 1):
+            raise ValueError(
+                f"`encoder_lines` must be a positive integer or None; got {lines!r}"
+            )
+        if not is_integer(self.quadrature) or self.quadrature < 1:
             raise ValueError(
                 f"`quadrature` must be a positive integer; got {self.quadrature!r}"
             )
-        object.__setattr__(
-            self, "tach_noise", _check_nonneg("tach_noise", self.tach_noise)
-        )
-        object.__setattr__(
-            self, "accel_noise", _check_nonneg("accel_noise", self.accel_noise)
-        )
-        if (
-            isinstance(self.antialias_order, bool)
-            or not isinstance(self.antialias_order, int | np.integer)
-            or not 0 <= self.antialias_order <= 12
-        ):
+        for name in ("tach_noise", "accel_noise"):
+            object.__setattr__(self, name, nonneg(name, getattr(self, name)))
+        order = self.antialias_order
+        if not is_integer(order) or not 0 <= order <= 12:
             raise ValueError(
                 "`antialias_order` must be an integer in [0, 12]; "
                 f"got {self.antialias_order!r}"
             )
-        c = float(self.antialias_cutoff)
-        if not (math.isfinite(c) and 0.0 < c <= 1.0):
+        try:
+            c = real("antialias_cutoff", self.antialias_cutoff)
+        except ValueError:
+            c = math.nan
+        if not 0.0 < c <= 1.0:
             raise ValueError(
                 f"`antialias_cutoff` must be in (0, 1]; got {self.antialias_cutoff!r}"
             )

@@ -5,31 +5,17 @@ Sample ``k`` is the torque held on ``[k / fs, (k + 1) / fs)``.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from scipy import signal as _signal
+
+from spiralid.fms._checks import is_integer, positive, real
 
 __all__ = ["bang_bang", "chirp", "prbs"]
 
 
-def _finite(name: str, value: float) -> float:
-    v = float(value) if np.isscalar(value) else math.nan
-    if not math.isfinite(v):
-        raise ValueError(f"`{name}` must be a finite number; got {value!r}")
-    return v
-
-
-def _positive(name: str, value: float) -> float:
-    v = float(value) if np.isscalar(value) else math.nan
-    if not (math.isfinite(v) and v > 0.0):
-        raise ValueError(f"`{name}` must be a finite number > 0; got {value!r}")
-    return v
-
-
 def _nsamples(duration: float, fs: float) -> int:
-    duration = _positive("duration", duration)
-    fs = _positive("fs", fs)
+    duration = positive("duration", duration)
+    fs = positive("fs", fs)
     n = round(duration * fs)
     if n < 1:
         raise ValueError(
@@ -65,9 +51,9 @@ def bang_bang(
     >>> bang_bang(1.0, 0.2, 0.1, 0.6, 10.0)
     array([ 0.,  1.,  1., -1., -1.,  0.])
     """
-    amplitude = _finite("amplitude", amplitude)
-    width = _positive("width", width)
-    start = _finite("start", start)
+    amplitude = real("amplitude", amplitude)
+    width = positive("width", width)
+    start = real("start", start)
     if start < 0.0:
         raise ValueError(f"`start` must be >= 0; got {start!r}")
     n = _nsamples(duration, fs)
@@ -107,13 +93,11 @@ def prbs(
     >>> prbs(2.0, 0.7, 10.0, n_bits=3)
     array([ 2.,  2.,  2., -2.,  2., -2., -2.])
     """
-    amplitude = _finite("amplitude", amplitude)
+    amplitude = real("amplitude", amplitude)
     n = _nsamples(duration, fs)
-    if isinstance(n_bits, bool) or not isinstance(n_bits, int | np.integer):
+    if not is_integer(n_bits) or not 2 <= n_bits <= 32:
         raise ValueError(f"`n_bits` must be an integer in [2, 32]; got {n_bits!r}")
-    if not 2 <= n_bits <= 32:
-        raise ValueError(f"`n_bits` must be an integer in [2, 32]; got {n_bits!r}")
-    if isinstance(hold, bool) or not isinstance(hold, int | np.integer) or hold < 1:
+    if not is_integer(hold) or hold < 1:
         raise ValueError(f"`hold` must be a positive integer; got {hold!r}")
     nbits_needed = -(-n // hold)
     period = 2**n_bits - 1
@@ -140,12 +124,12 @@ def chirp(
     >>> chirp(1.0, 0.0, 1.0, 1.0, 4.0).round(3)
     array([ 1.   ,  0.981,  0.707, -0.195])
     """
-    amplitude = _finite("amplitude", amplitude)
+    amplitude = real("amplitude", amplitude)
     n = _nsamples(duration, fs)
     fs = float(fs)
     nyq = 0.5 * fs
     for name, f in (("f0", f0), ("f1", f1)):
-        v = _finite(name, f)
+        v = real(name, f)
         if not 0.0 <= v <= nyq:
             raise ValueError(f"`{name}` must be in [0, fs/2 = {nyq:g}] Hz; got {f!r}")
     methods = ("linear", "quadratic", "logarithmic", "hyperbolic")
