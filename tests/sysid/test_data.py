@@ -135,3 +135,13 @@ def test_csv_needs_ts(tmp_path):
     p.write_text("u,y\n1,2\n3,4\n")
     with pytest.raises(ValueError, match="`ts` must be given for a CSV file"):
         IOData.from_csv(p)
+
+
+def test_signals_are_private_read_only_copies():
+    u, y = np.arange(5.0), np.ones(5)
+    d = IOData(u, y, ts=1.0)
+    assert u.flags.writeable and y.flags.writeable  # the caller's arrays untouched
+    u[0] = 99.0
+    assert d.u[0] == 0.0
+    with pytest.raises(ValueError, match="read-only"):
+        d.u[0] = 1.0

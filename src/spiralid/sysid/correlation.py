@@ -25,6 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg, stats
 
+from .data import check_signal
+
 __all__ = [
     "CorrelationTest",
     "correlation",
@@ -107,23 +109,6 @@ class CorrelationTest:
         }
 
 
-def _as_signal(x, name: str) -> np.ndarray:
-    arr = np.asarray(x, dtype=float)
-    if arr.ndim == 2 and arr.shape[1] == 1:
-        arr = arr[:, 0]
-    if arr.ndim != 1:
-        raise ValueError(
-            f"`{name}` must be a 1-D signal of shape (N,) or (N, 1); "
-            f"got shape {arr.shape}"
-        )
-    bad = np.flatnonzero(~np.isfinite(arr))
-    if bad.size:
-        raise ValueError(
-            f"`{name}` must be finite; got {float(arr[bad[0]])!r} at sample {bad[0]}"
-        )
-    return arr
-
-
 def _check_lags(lags, n: int) -> int:
     if isinstance(lags, bool) or not isinstance(lags, int | np.integer):
         raise ValueError(f"`lags` must be an integer; got {lags!r}")
@@ -174,8 +159,8 @@ def correlation(a, b, max_lag: int) -> np.ndarray:
     >>> np.round(r, 4).tolist()
     [0.25, 1.0, 0.25]
     """
-    a = _as_signal(a, "a")
-    b = _as_signal(b, "b")
+    a = check_signal(a, "a")
+    b = check_signal(b, "b")
     if a.shape != b.shape:
         raise ValueError(
             f"`a` and `b` must have the same length; got {a.size} and {b.size}"
@@ -254,7 +239,7 @@ def whiteness_test(e, lags: int = 25, levels=_DEFAULT_LEVELS) -> CorrelationTest
     >>> t.passed[0.95], round(t.bands[0.95], 4)
     (True, 0.062)
     """
-    e = _as_signal(e, "e")
+    e = check_signal(e, "e")
     n = e.size
     lags = _check_lags(lags, n)
     levels = _check_levels(levels)
@@ -311,8 +296,8 @@ def independence_test(
     >>> independence_test(u, np.convolve(u, [0.0, 1.0, 0.5])[:1000]).passed[0.99]
     False
     """
-    u = _as_signal(u, "u")
-    e = _as_signal(e, "e")
+    u = check_signal(u, "u")
+    e = check_signal(e, "e")
     if u.shape != e.shape:
         raise ValueError(
             f"`u` and `e` must have the same length; got {u.size} and {e.size}"

@@ -11,8 +11,14 @@ import numpy as np
 __all__ = ["IOData"]
 
 
-def _signal(x, name: str) -> np.ndarray:
-    """A finite 1-D float signal from a list, (N,) or (N, 1) array."""
+def check_signal(x, name: str, min_size: int = 1) -> np.ndarray:
+    """A finite 1-D float signal from a list, (N,) or (N, 1) array.
+
+    The one check every signal of sysid goes through, so bad input gives
+    the same message everywhere: the argument's name, what is allowed and,
+    for a non-finite value, the first bad sample. Not a copy when `x` is
+    already a float array.
+    """
     try:
         arr = np.asarray(x, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -24,16 +30,25 @@ def _signal(x, name: str) -> np.ndarray:
             f"`{name}` must be a 1-D signal of shape (N,) or (N, 1); "
             f"got shape {arr.shape}"
         )
-    if arr.size == 0:
-        raise ValueError(f"`{name}` must not be empty; got 0 samples")
+    if arr.size < min_size:
+        raise ValueError(
+            f"`{name}` must have at least {min_size} sample"
+            f"{'s' if min_size > 1 else ''}; got {arr.size}"
+        )
     bad = ~np.isfinite(arr)
     if bad.any():
         i = int(np.argmax(bad))
         raise ValueError(
-            f"`{name}` must be finite; got {arr[i]!r} at sample {i} "
+            f"`{name}` must be finite; got {float(arr[i])!r} at sample {i} "
             f"({int(bad.sum())} non-finite samples in all)"
         )
-    arr = np.ascontiguousarray(arr)
+    return arr
+
+
+def _frozen_signal(x, name: str) -> np.ndarray:
+    # A private read-only copy: IOData is immutable, and freezing the
+    # caller's own array instead would make it read-only behind their back.
+    arr = np.array(check_signal(x, name), dtype=float, order="C", copy=True)
     arr.flags.writeable = False
     return arr
 
@@ -85,8 +100,8 @@ class IOData:
     y_offset: float = field(default=0.0)
 
     def __post_init__(self) -> None:
-        u = _signal(self.u, "u")
-        y = _signal(self.y, "y")
+        u = _frozen_signal(self.u, "u")
+        y = _frozen_signal(self.y, "y")
         if u.size != y.size:
             raise ValueError(
                 f"`u` and `y` must have the same length; got {u.size} and {y.size}"

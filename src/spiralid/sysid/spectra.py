@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+from .data import check_signal
+
 __all__ = [
     "PSD",
     "Modes",
@@ -162,16 +164,7 @@ def psd(x, fs: float, *, nperseg: int | None = None) -> PSD:
     >>> s.resolution, round(float(s.f[np.argmax(s.p)]), 2)
     (0.48828125, 62.5)
     """
-    x = np.asarray(x, dtype=float)
-    if x.ndim == 2 and x.shape[1] == 1:
-        x = x[:, 0]
-    if x.ndim != 1:
-        raise ValueError(f"`x` must be a 1-D signal; got shape {x.shape}")
-    if x.size < 2:
-        raise ValueError(f"`x` must have at least 2 samples; got {x.size}")
-    if not np.all(np.isfinite(x)):
-        bad = int(np.flatnonzero(~np.isfinite(x))[0])
-        raise ValueError(f"`x` must be finite; got {float(x[bad])!r} at sample {bad}")
+    x = check_signal(x, "x", min_size=2)
     fs = _check_fs(fs)
     if nperseg is None:
         nperseg = default_nperseg(x.size)

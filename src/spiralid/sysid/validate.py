@@ -25,6 +25,7 @@ import numpy as np
 from scipy import signal
 
 from .correlation import CorrelationTest, independence_test, whiteness_test
+from .data import check_signal
 from .spectra import PSD, Modes, Peaks, find_resonances, modes_from_poles, psd
 
 __all__ = [
@@ -40,28 +41,13 @@ _RESIDUALS = ("one-step", "simulation")
 
 
 def _pair(y, yhat, name_y="y", name_yhat="yhat") -> tuple[np.ndarray, np.ndarray]:
-    a, b = np.asarray(y, dtype=float), np.asarray(yhat, dtype=float)
-    # (N, 1) columns are accepted like everywhere else in sysid.
-    a = a[:, 0] if a.ndim == 2 and a.shape[1] == 1 else a
-    b = b[:, 0] if b.ndim == 2 and b.shape[1] == 1 else b
-    if a.ndim != 1 or b.ndim != 1:
-        raise ValueError(
-            f"`{name_y}` and `{name_yhat}` must be 1-D signals; "
-            f"got shapes {a.shape} and {b.shape}"
-        )
+    a = check_signal(y, name_y)
+    b = check_signal(yhat, name_yhat)
     if a.size != b.size:
         raise ValueError(
             f"`{name_y}` and `{name_yhat}` must have the same length; "
             f"got {a.size} and {b.size}"
         )
-    if a.size == 0:
-        raise ValueError(f"`{name_y}` must not be empty; got {a.size} samples")
-    for arr, nm in ((a, name_y), (b, name_yhat)):
-        if not np.all(np.isfinite(arr)):
-            i = int(np.flatnonzero(~np.isfinite(arr))[0])
-            raise ValueError(
-                f"`{nm}` must be finite; got {float(arr[i])!r} at sample {i}"
-            )
     return a, b
 
 
