@@ -190,6 +190,10 @@ def test_oe_keeps_the_start_with_the_lower_cost():
     ]
     oe = identify(data, arx, method="oe")
     assert oe.cost == pytest.approx(min(polished), rel=1e-12)
+    # The saved summary holds scalars, not least_squares' residual vector.
+    summary = json.loads(json.dumps(oe.to_dict()))["result"]
+    assert "fun" not in summary and summary["start"] == oe.result.start
+    assert summary["nfev"] == oe.result.nfev
 
 
 @pytest.mark.parametrize(

@@ -174,10 +174,12 @@ class IdentifiedModel:
         res = self.result
         summary = None
         if res is not None:
+            # Scalars only: least_squares' `fun` is the whole residual vector,
+            # which would bloat a saved model by a record's worth of numbers.
             summary = {
                 k: _jsonable(getattr(res, k))
-                for k in ("fun", "nit", "nfev", "success", "message")
-                if hasattr(res, k)
+                for k in ("fun", "nit", "nfev", "success", "message", "start")
+                if hasattr(res, k) and np.ndim(getattr(res, k)) == 0
             }
         return {
             "theta": [float(v) for v in self.theta],
