@@ -449,6 +449,8 @@ def test_search_is_an_iterator():
     res = search.result("max_iter")
     assert res.success and res.nit == 1 and res.history.shape == (2,)
     np.testing.assert_array_equal(res.mean_radius, [0.95])
+    with pytest.raises(ValueError, match=r"^`status` must be one of .*got 'done'"):
+        search.result("done")
 
 
 B2 = [(-1, 1)] * 2

@@ -124,11 +124,11 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
     """Eq. (4): ``(lower - upper) / (1 + c1 / exp(c2 d)) + upper``.
 
     Evaluated as ``lower + (upper - lower) * expit(ln c1 - c2 d)`` (compiled,
-    with a sign-split logistic), which is
-    the same function but finite and warning-free for any ``d >= 0``,
-    ``inf`` included (penalised costs make ``d`` huge). It falls
-    monotonically from ``upper + (lower - upper) / (1 + c1)`` at ``d = 0``
-    to ``lower`` as ``d -> inf``.
+    with a sign-split logistic), which is the same function but finite and
+    warning-free for any ``d >= 0``, ``inf`` included (penalised costs make
+    ``d`` huge; DESIGN.md item 4). It falls monotonically from
+    ``upper + (lower - upper) / (1 + c1)`` at ``d = 0`` to ``lower`` as
+    ``d -> inf``.
 
     Parameters
     ----------
@@ -138,6 +138,12 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
         ``r_l, r_u`` (or ``theta_l, theta_u``).
     c1, c2 : float
         Positive constants of eq. (4).
+
+    Raises
+    ------
+    ValueError
+        If ``d`` has NaN or negative entries, ``lower >= upper``, or ``c1``
+        or ``c2`` is not a finite positive number.
 
     Returns
     -------

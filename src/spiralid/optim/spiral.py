@@ -390,7 +390,15 @@ class SpiralSearch:
         return self._f.copy()
 
     def result(self, status: str = "running", elapsed: float = 0.0, target=None):
-        """Package the current state as a :class:`SpiralResult`."""
+        """Package the current state as a :class:`SpiralResult`.
+
+        ``status`` is a key of the stop-message table: "max_iter",
+        "max_nfev", "target", "callback" or "running".
+        """
+        if status not in _STATUS:
+            raise ValueError(
+                f"`status` must be one of {tuple(_STATUS)}; got {status!r}"
+            )
         fun = self.fun
         finite = math.isfinite(fun)
         reached = target is None or (finite and fun <= target)
