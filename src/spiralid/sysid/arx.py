@@ -30,7 +30,7 @@ import numba
 import numpy as np
 from scipy import signal
 
-from .data import IOData
+from .data import IOData, check_signal
 from .polynomials import is_stable_polynomial
 
 __all__ = ["ARX", "arx_least_squares"]
@@ -155,6 +155,8 @@ class ARX:
         -------
         ndarray, shape (N, n_params)
         """
+        if not isinstance(data, IOData):
+            raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
         u, y = data.u, data.y
         n = u.size
         phi = np.zeros((n, self.n_params))
@@ -182,7 +184,7 @@ class ARX:
 
     def input_lags(self, u) -> np.ndarray:
         """Lagged inputs ``U[j, t] = u(t - nk - j)``, shape (nb, N), zero before 0."""
-        u = np.asarray(u, dtype=float)
+        u = check_signal(u, "u")
         n = u.size
         lags = np.zeros((self.nb, n))
         for j in range(self.nb):
@@ -208,14 +210,7 @@ class ARX:
         ndarray, shape (N,) or (m, N)
         """
         th, single = self._theta(theta)
-        if isinstance(u, IOData):
-            u = u.u
-        else:
-            u = np.asarray(u, dtype=float)
-            if u.ndim == 2 and u.shape[1] == 1:
-                u = u[:, 0]
-            if u.ndim != 1:
-                raise ValueError(f"`u` must be a 1-D signal; got shape {u.shape}")
+        u = u.u if isinstance(u, IOData) else check_signal(u, "u")
         if single:
             num, den = self.polynomials(th[0])
             return signal.lfilter(num, den, u)
