@@ -9,7 +9,10 @@ Prints: cost evaluations per second for each predictor (targets >= 1e6/s
 one-step, >= 2e4/s simulation), a per-candidate ``lfilter`` loop for
 comparison, and one Eb-SDA identification (50 points x 500 iterations) per
 predictor: wall time, final cost, and the ratio to the best known cost
-(least squares for one-step, output error for simulation).
+(least squares for one-step, output error for simulation). Then the
+output-error method itself: wall time on this record and, on the real arm
+(ARX(8, 8, 0), first 2/3, free run of the whole record from rest scored on
+the last 1/3), least squares and output error side by side.
 
 Run: ``.venv/bin/python benchmarks/bench_sysid.py``. BLAS is pinned to one
 thread: on a shared 2-core machine OpenBLAS threads oversubscribe and
@@ -27,7 +30,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
-from spiralid.sysid import ARX, IOData, PaperCost, identify
+from spiralid.sysid import ARX, IOData, PaperCost, identify, validate
 from spiralid.sysid.identify import (
     default_bounds,
     feasible_initial_points,
@@ -114,6 +117,30 @@ def main() -> None:
                 f"  {predictor:<10} {par:<12} wall {wall:6.2f} s  "
                 f"cost {fit.cost:10.4f}  best known ({ref.method}) {ref.cost:8.4f}  "
                 f"ratio {fit.cost / ref.cost:8.3f}  nfev {fit.result.nfev}"
+            )
+
+    print("\noutput error (least squares and Steiglitz-McBride starts)")
+    walls = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        oe = identify(est, arx, method="oe")
+        walls.append(time.perf_counter() - t0)
+    print(
+        f"  this record: wall median {np.median(walls):.2f} s  cost {oe.cost:.4f}  "
+        f"start kept {oe.result.start!r}  nfev {oe.result.nfev}"
+    )
+    if ARM.exists():
+        arm = IOData.from_csv(ARM, ts=0.01)
+        a_est, a_val = arm.split(2 / 3)
+        for method in ("ls", "oe"):
+            t0 = time.perf_counter()
+            fit = identify(a_est, arx, method=method)
+            wall = time.perf_counter() - t0
+            rep = validate(fit, a_val, warmup=a_est)
+            print(
+                f"  real arm {method:<3} wall {wall:5.2f} s  estimation cost "
+                f"{fit.cost:7.4f}  validation fit {rep.fit_percent:6.2f} %  "
+                f"max |pole| {rep.max_pole_radius:.7f}"
             )
 
 
