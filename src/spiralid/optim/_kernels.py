@@ -101,15 +101,20 @@ def deviations(f):  # pragma: no cover - compiled
 def exponential(d, lower, span, c2, log_c1, cap):  # pragma: no cover - compiled
     """Eq. (4) for each row's constants: ``lower + span * expit(ln c1 - c2 d)``.
 
-    Returns the (rows, k) values and how many ``d`` are exactly 0.
+    Returns the (rows, k) values, how many ``d`` are exactly 0 and how many
+    are invalid (NaN or negative), so that the caller can check its input
+    without another pass in NumPy.
     """
     rows = lower.size
     k = d.size
     out = np.empty((rows, k))
     zeros = 0
+    invalid = 0
     for i in range(k):
         if d[i] == 0.0:
             zeros += 1
+        elif not d[i] >= 0.0:
+            invalid += 1
     for j in range(rows):
         for i in range(k):
             u = log_c1[j] - min(d[i], cap[j]) * c2[j]
@@ -120,4 +125,4 @@ def exponential(d, lower, span, c2, log_c1, cap):  # pragma: no cover - compiled
                 t = np.exp(u)
                 e = t / (1.0 + t)
             out[j, i] = lower[j] + span[j] * e
-    return out, zeros
+    return out, zeros, invalid

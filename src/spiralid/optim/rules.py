@@ -77,14 +77,17 @@ def _check_interval(lo, hi, lo_name, hi_name, radius: bool):
     return lo, hi
 
 
+def _bad_deviations(d) -> ValueError:
+    return ValueError(
+        f"`d` must be a 1-D array of deviations >= 0 (inf allowed); got {d!r}"
+    )
+
+
 def _deviations(d) -> np.ndarray:
-    """``d`` as a 1-D float array of deviations >= 0 (``inf`` allowed)."""
+    """``d`` as a 1-D float array (values are checked by the caller)."""
     d = real_array(d, "d")
-    # One comparison catches NaN and negative values alike.
-    if d.ndim != 1 or not np.all(d >= 0.0):
-        raise ValueError(
-            f"`d` must be a 1-D array of deviations >= 0 (inf allowed); got {d!r}"
-        )
+    if d.ndim != 1:
+        raise _bad_deviations(d)
     return d
 
 
@@ -157,12 +160,10 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
     array([0.991089, 0.1     ])
     """
     d = real_array(d, "d")
-    if not np.all(d >= 0.0):  # NaN fails the comparison too
-        raise ValueError(f"`d` must be >= 0 (inf allowed); got {d!r}")
     lower, upper = _check_interval(lower, upper, "lower", "upper", radius=False)
     c1, c2 = positive(c1, "c1"), positive(c2, "c2")
     cap = max((_Z_CAP + math.log(c1)) / c2, 0.0)
-    out, _ = _kernels.exponential(
+    out, _, invalid = _kernels.exponential(
         d.ravel(),
         np.array([lower]),
         np.array([upper - lower]),
@@ -170,6 +171,8 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
         np.array([math.log(c1)]),
         np.array([cap]),
     )
+    if invalid:
+        raise ValueError(f"`d` must be >= 0 (inf allowed); got {d!r}")
     return out[0].reshape(d.shape)
 
 
@@ -240,7 +243,9 @@ class ExponentialSpiral(SpiralRule):
 
     def __call__(self, d, rng):
         d = _deviations(d)
-        (r, theta), zeros = _kernels.exponential(d, *self._consts)
+        (r, theta), zeros, invalid = _kernels.exponential(d, *self._consts)
+        if invalid:
+            raise _bad_deviations(d)
         if zeros:
             zero = d == 0.0
             r[zero] = rng.uniform(self.r_l, self.r_u, zeros)
@@ -302,7 +307,11 @@ class LinearSpiral(SpiralRule):
         return np.minimum(d, d_max) / d_max
 
     def __call__(self, d, rng):
-        g = 1.0 - self._fraction(_deviations(d))
+        d = _deviations(d)
+        # min() propagates NaN, which then fails the comparison as well.
+        if d.size and not d.min() >= 0.0:
+            raise _bad_deviations(d)
+        g = 1.0 - self._fraction(d)
         r = self.r_l + (self.r_u - self.r_l) * g
         theta = self.th_l + (self.th_u - self.th_l) * g
         return r, theta
