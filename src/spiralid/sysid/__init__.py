@@ -9,6 +9,7 @@ from .data import IOData as IOData
 from .identify import IdentifiedModel as IdentifiedModel
 from .identify import default_bounds as default_bounds
 from .identify import identify as identify
+from .identify import steiglitz_mcbride as steiglitz_mcbride
 from .polynomials import fold_reflection as fold_reflection
 from .polynomials import is_stable_polynomial as is_stable_polynomial
 from .polynomials import random_stable_polynomial as random_stable_polynomial
