@@ -121,6 +121,12 @@ def test_to_dlti_and_dict_round_trip(known):
     assert back.arx == fit.arx and back.ts == 0.01 and back.method == "sda"
     assert back.cost == fit.cost
     np.testing.assert_array_equal(back.predict(est), fit.predict(est))
+    for method in ("ls", "oe"):  # no history, no bounds
+        other = identify(est, ARX(2, 2, 1), method=method)
+        back = IdentifiedModel.from_dict(json.loads(json.dumps(other.to_dict())))
+        np.testing.assert_array_equal(back.theta, other.theta)
+        assert back.method == method and back.history is None and back.bounds is None
+        assert back.cost == other.cost and back.gain == other.gain
 
 
 @pytest.fixture(scope="module")
