@@ -128,6 +128,9 @@ def test_npz_missing_variable_and_ts(tmp_path):
         IOData.from_npz(tmp_path / "r.npz", output="acc")
     with pytest.raises(ValueError, match="`ts` must be given"):
         IOData.from_npz(tmp_path / "r.npz")
+    np.savez(tmp_path / "s.npz", u=np.array(["a", "b"]), y=np.ones(2), ts=1.0)
+    with pytest.raises(ValueError, match="`input` variable 'u' must be numeric"):
+        IOData.from_npz(tmp_path / "s.npz")
 
 
 def test_csv_needs_ts(tmp_path):

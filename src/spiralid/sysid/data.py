@@ -329,18 +329,20 @@ class IOData:
                 )
             ts = float(ts[0])
 
-        def arr(key):
+        def arr(key, arg):
             a = np.asarray(mapping[key])
             if a.dtype.kind not in "fiub":
                 raise ValueError(
-                    f"variable {key!r} must be numeric; got dtype {a.dtype} "
+                    f"`{arg}` variable {key!r} must be numeric; got dtype {a.dtype} "
                     f"in {str(path)!r}"
                 )
             a = a.astype(float)
             # MATLAB stores vectors as (1, N) or (N, 1).
             return a.ravel() if a.ndim == 2 and 1 in a.shape else a
 
-        return cls(arr(input), arr(output), ts, str(input), str(output))
+        return cls(
+            arr(input, "input"), arr(output, "output"), ts, str(input), str(output)
+        )
 
 
 def _is_number(text: str) -> bool:
