@@ -90,8 +90,9 @@ class IdentifiedModel:
         The paper's cost, eq. (2)-(3), of ``theta`` on the estimation data.
     result : object or None
         The optimiser's result (``SpiralResult`` for spiral methods,
-        ``scipy.optimize.OptimizeResult`` for ``"oe"``); ``None`` for ``"ls"``
-        and after :meth:`from_dict`.
+        ``scipy.optimize.OptimizeResult`` for ``"oe"``, whose ``start`` says
+        which start was kept); ``None`` for ``"ls"`` and after
+        :meth:`from_dict`.
     refine_result : object or None
         The local polish's result when ``refine=True``.
     history : ndarray or None
