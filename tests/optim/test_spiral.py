@@ -425,6 +425,25 @@ def test_bounds_policies_by_hand():
     np.testing.assert_allclose(_one_step_from(x0, "reflect"), [0.1, 0.5], atol=1e-14)
 
 
+def test_reflect_unfolds_an_overshoot_of_several_widths():
+    # A custom rule with r = 5 and theta = pi sends x to c - 5 (x - c):
+    # (-0.95, -0.95) about c = (0.9, 0) lands at (10.15, 4.75). Bouncing
+    # between -1 and 1 by hand: 10.15 -> -8.15 -> 6.15 -> -4.15 -> 2.15
+    # -> -0.15, and 4.75 -> -2.75 -> 0.75.
+    rec = Recorder(sphere)
+    minimize(
+        rec,
+        B2,
+        _Returns((5.0, np.pi)),
+        n_points=2,
+        max_iter=1,
+        vectorized=True,
+        x0=[[0.9, 0.0], [-0.95, -0.95]],
+        bounds_policy="reflect",
+    )
+    np.testing.assert_allclose(rec.batches[1][0], [-0.15, 0.75], atol=1e-13)
+
+
 def test_reflect_and_clip_keep_every_point_inside():
     for policy in ("clip", "reflect"):
         rec = Recorder(lambda X: np.sin(5 * X).sum(1))
