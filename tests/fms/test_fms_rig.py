@@ -68,6 +68,21 @@ def test_matches_scipy_zoh_of_the_physical_model(kwargs):
     assert _rel_err(rec.state, x) < 1e-8
 
 
+@pytest.mark.parametrize("n_samples", [1, 5, 16, 17, 257])
+def test_block_simulation_matches_scipy_for_any_record_length(n_samples):
+    # The lifted simulation works in blocks of max(16, sqrt(N)) samples (at
+    # most 256): lengths below, at and just past a block edge, and one sample.
+    rig = FlexibleManipulator(n_elements=3)
+    rng = np.random.default_rng(n_samples)
+    u = rng.normal(size=n_samples)
+    x0 = rng.normal(size=2 * rig.ndof) * 1e-2
+    rec = rig.simulate(u, sensors=Sensors.ideal(), x0=x0, return_state=True)
+    y, x = _dlsim(rig, u, 500.0, x0=x0)
+    y, x = y.reshape(n_samples, -1), x.reshape(n_samples, -1)
+    assert _rel_err(rec.end_acceleration, y[:, 2]) < 1e-10
+    assert _rel_err(rec.state, x) < 1e-10
+
+
 def test_antialias_filter_matches_scipy_butterworth_in_series():
     rig = FlexibleManipulator(n_elements=4)
     fs = 500.0
