@@ -326,6 +326,7 @@ def test_bad_rig_parameters_raise(kwargs, match):
         (lambda r: r.simulate([1.0], x0=[1.0, 2.0]), "`x0` must hold 10 finite"),
         (lambda r: r.simulate([1.0], sensors="ideal"), "`sensors` must be a Sensors"),
         (lambda r: r.modes(0), "`n` must be a positive integer"),
+        (lambda r: r.modes(5), r"^`n` must be at most 2 n_elements = 4 .*got 5"),
         (lambda r: r.simulate("abc"), r"^`torque` must be an array of real numbers"),
         (lambda r: r.simulate([[1], [2, 3]]), r"^`torque` must be an array of real"),
         (lambda r: r.simulate(np.ones(3) + 1j), r"^`torque` must be an array of real"),

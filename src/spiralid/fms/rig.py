@@ -271,7 +271,8 @@ class FlexibleManipulator:
         Parameters
         ----------
         n : int, optional
-            Return only the first ``n``; default all ``2 n_elements``.
+            Return only the first ``n`` (at most ``2 n_elements``); default
+            all ``2 n_elements``.
 
         Examples
         --------
@@ -283,6 +284,12 @@ class FlexibleManipulator:
             return f
         if not is_integer(n) or n < 1:
             raise ValueError(f"`n` must be a positive integer or None; got {n!r}")
+        if n > f.size:
+            # Fewer frequencies than asked for would go unnoticed downstream.
+            raise ValueError(
+                f"`n` must be at most 2 n_elements = {f.size} (the model's "
+                f"flexible modes); got {n!r}"
+            )
         return f[:n]
 
     def _plant(self) -> tuple[np.ndarray, ...]:
