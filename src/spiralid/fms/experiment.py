@@ -32,7 +32,7 @@ class Experiment:
     - ``amplitude = 0.3`` N m, ``width = 0.04`` s: a bang-bang of width T
       excites frequency f in proportion to ``sin^2(pi f T)``; T = 0.04 s puts
       the default rig's first three modes (13.3, 35.1, 64.8 Hz) near maxima
-      of that pattern (0.99, 0.90, 0.93), away from its nulls at k/T.  Each
+      of that pattern (0.99, 0.91, 0.92), away from its nulls at k/T.  Each
       pulse turns the hub by ``amplitude width^2 / J``, about 0.7 degrees.
     - ``period = 1.0`` s, ``n_pulses = 6``, ``duration = 6.0`` s at
       ``fs = 500`` Hz (3000 samples): one pulse per second, so that the
