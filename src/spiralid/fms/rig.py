@@ -204,7 +204,7 @@ class FlexibleManipulator:
         return float(self.mass_matrix[0, 0])
 
     @cached_property
-    def _mk(self) -> tuple[np.ndarray, np.ndarray]:
+    def _mass_and_stiffness(self) -> tuple[np.ndarray, np.ndarray]:
         M, K = assemble(
             self.n_elements,
             self.length,
@@ -221,12 +221,12 @@ class FlexibleManipulator:
     @property
     def mass_matrix(self) -> np.ndarray:
         """Consistent mass matrix (read-only), coordinates as in ``beam``."""
-        return self._mk[0]
+        return self._mass_and_stiffness[0]
 
     @property
     def stiffness_matrix(self) -> np.ndarray:
         """Stiffness matrix (read-only); zero row/column for the hub angle."""
-        return self._mk[1]
+        return self._mass_and_stiffness[1]
 
     @cached_property
     def _modal(self) -> tuple[np.ndarray, np.ndarray]:
@@ -238,7 +238,7 @@ class FlexibleManipulator:
         complement mass ``M_ww - m_tw m_tw^T / J``), so no eigenvalue has to
         be recognised as a numerical zero.
         """
-        M, K = self._mk
+        M, K = self._mass_and_stiffness
         J = M[0, 0]
         mtw = M[0, 1:]
         meff = M[1:, 1:] - np.outer(mtw, mtw) / J
