@@ -174,6 +174,22 @@ def test_per_point_and_vectorised_identical(method):
     np.testing.assert_array_equal(a.history, b.history)
 
 
+def test_per_point_and_vectorised_identical_with_zero_deviation_draws():
+    # A plateau (cost 0 inside the unit ball) makes many d exactly 0, so
+    # Eb-SDA draws radii and angles from rng every iteration.
+    def plateau(x):
+        return np.maximum(np.sum(x * x, axis=-1) - 1.0, 0.0)
+
+    rule = RecordingRule(ExponentialSpiral())
+    kw = dict(n_points=12, max_iter=40, rng=8)
+    a = minimize(plateau, [(-2, 2)] * 3, rule, vectorized=True, **kw)
+    b = minimize(lambda x: float(plateau(x)), [(-2, 2)] * 3, "ebsda", **kw)
+    assert sum(int(np.sum(d == 0)) for d, _, _ in rule.calls) > 50
+    np.testing.assert_array_equal(a.x, b.x)
+    np.testing.assert_array_equal(a.mean_radius, b.mean_radius)
+    np.testing.assert_array_equal(a.mean_angle, b.mean_angle)
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_2d_sphere_sda_default_budget(seed):
     res = minimize(sphere, [(-5, 5)] * 2, "sda", rng=seed, vectorized=True)
