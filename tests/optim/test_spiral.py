@@ -521,6 +521,11 @@ B2 = [(-1, 1)] * 2
         (dict(method="pso"), r"^`method` must be 'sda', 'ebsda', 'lasda' .*got 'pso'"),
         (dict(method=ConstantSpiral), r"^`method` must be"),
         (dict(bounds_policy="wrap"), r"^`bounds_policy` must be one of .*got 'wrap'"),
+        # An array would make `in` ambiguous (NumPy's own ValueError).
+        (
+            dict(bounds_policy=np.array(["clip", "none"])),
+            r"^`bounds_policy` must be one of",
+        ),
         (dict(target=np.nan), r"^`target` must be a real number or None"),
         (dict(callback=3), r"^`callback` must be callable or None; got 3"),
         (dict(fun=3), r"^`fun` must be callable; got 3"),

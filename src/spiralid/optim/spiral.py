@@ -233,7 +233,7 @@ class SpiralSearch:
         # Exact types: a subclass may override __call__.
         self._builtin_rule = type(self.rule) in _METHODS.values()
         m = integer(n_points, "n_points", 2)
-        if bounds_policy not in _POLICIES:
+        if not isinstance(bounds_policy, str) or bounds_policy not in _POLICIES:
             raise ValueError(
                 f"`bounds_policy` must be one of {_POLICIES}; got {bounds_policy!r}"
             )
