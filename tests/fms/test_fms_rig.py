@@ -254,6 +254,8 @@ def test_iodata_wraps_the_chosen_channel():
     assert d.ts == pytest.approx(0.01) and d.output_name == "hub_velocity"
     with pytest.raises(ValueError, match="`name` must be one of"):
         rec.iodata("tip_velocity")
+    with pytest.raises(ValueError, match="`name` must be one of"):
+        rec.iodata(np.array(["hub_angle", "u"]))
 
 
 def test_recording_time_axis_and_top_level_exports():

@@ -105,6 +105,10 @@ def test_paper_experiment_defaults_are_consistent():
         (lambda: chirp(1, 0, 80, 1, 100), r"`f1` must be in \[0, fs/2 = 50\] Hz"),
         (lambda: chirp(1, -1, 10, 1, 100), "`f0` must be in"),
         (lambda: chirp(1, 1, 10, 1, 100, method="cubic"), "`method` must be one of"),
+        (
+            lambda: chirp(1, 1, 10, 1, 100, method=np.array(["linear", "linear"])),
+            r"^`method` must be one of",
+        ),
         (lambda: chirp(1, 0, 10, 1, 100, "logarithmic"), "`f0` and `f1` must be > 0"),
         (lambda: paper_experiment().__class__(n_pulses=0), "`n_pulses` must be"),
         (lambda: paper_experiment().__class__(period=0.01), "`period` must be"),

@@ -92,7 +92,7 @@ class Recording:
         """
         from spiralid.sysid.data import IOData
 
-        if name not in _OUTPUTS:
+        if not isinstance(name, str) or name not in _OUTPUTS:
             raise ValueError(f"`name` must be one of {_OUTPUTS}; got {name!r}")
         return IOData(
             self.u,

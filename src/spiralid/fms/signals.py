@@ -133,7 +133,7 @@ def chirp(
         if not 0.0 <= v <= nyq:
             raise ValueError(f"`{name}` must be in [0, fs/2 = {nyq:g}] Hz; got {f!r}")
     methods = ("linear", "quadratic", "logarithmic", "hyperbolic")
-    if method not in methods:
+    if not isinstance(method, str) or method not in methods:
         raise ValueError(f"`method` must be one of {methods}; got {method!r}")
     if method in ("logarithmic", "hyperbolic") and (float(f0) <= 0 or float(f1) <= 0):
         raise ValueError(
