@@ -177,6 +177,10 @@ def test_steiglitz_mcbride_removes_the_output_noise_bias():
     # Without noise the first iteration already lands on the truth.
     exact = steiglitz_mcbride(IOData(u, clean, ts=1.0), arx, n_iter=1)
     np.testing.assert_allclose(exact, TRUE, atol=1e-9)
+    with pytest.raises(ValueError, match=r"`theta0` must be a finite vector of sh"):
+        steiglitz_mcbride(data, arx, theta0=[1.0, 2.0])
+    with pytest.raises(ValueError, match="`n_iter` must be an integer >= 0; got -1"):
+        steiglitz_mcbride(data, arx, n_iter=-1)
 
 
 def test_oe_keeps_the_start_with_the_lower_cost():

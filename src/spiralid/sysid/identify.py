@@ -470,9 +470,25 @@ def steiglitz_mcbride(
     >>> bool(np.linalg.norm(sm - true) < np.linalg.norm(ls - true))
     True
     """
+    if not isinstance(data, IOData):
+        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    if not isinstance(arx, ARX):
+        raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+    if isinstance(n_iter, bool) or not isinstance(n_iter, int | np.integer):
+        raise ValueError(f"`n_iter` must be an integer >= 0; got {n_iter!r}")
+    if n_iter < 0:
+        raise ValueError(f"`n_iter` must be an integer >= 0; got {n_iter!r}")
     na, t0 = arx.na, arx.max_lag
-    theta = arx_least_squares(data, arx) if theta0 is None else np.asarray(theta0)
-    theta = np.asarray(theta, dtype=float).copy()
+    if theta0 is None:
+        theta = arx_least_squares(data, arx)
+    else:
+        arx.check_length(data)
+        theta = np.array(theta0, dtype=float)
+        if theta.shape != (arx.n_params,) or not np.all(np.isfinite(theta)):
+            raise ValueError(
+                f"`theta0` must be a finite vector of shape ({arx.n_params},) for "
+                f"{arx}; got {theta0!r}"
+            )
     if na == 0:
         # No denominator to filter by: the output error is the equation error.
         return theta
