@@ -109,7 +109,7 @@ class CorrelationTest:
         }
 
 
-def _check_lags(lags, n: int) -> int:
+def check_lags(lags, n: int) -> int:
     if isinstance(lags, bool) or not isinstance(lags, int | np.integer):
         raise ValueError(f"`lags` must be an integer; got {lags!r}")
     if not 1 <= lags < n:
@@ -166,7 +166,7 @@ def correlation(a, b, max_lag: int) -> np.ndarray:
             f"`a` and `b` must have the same length; got {a.size} and {b.size}"
         )
     n = a.size
-    max_lag = _check_lags(max_lag, n)
+    max_lag = check_lags(max_lag, n)
     a = a - a.mean()
     b = b - b.mean()
     scale = np.sqrt(np.dot(a, a) * np.dot(b, b))
@@ -241,7 +241,7 @@ def whiteness_test(e, lags: int = 25, levels=_DEFAULT_LEVELS) -> CorrelationTest
     """
     e = check_signal(e, "e")
     n = e.size
-    lags = _check_lags(lags, n)
+    lags = check_lags(lags, n)
     levels = _check_levels(levels)
     r = correlation(e, e, lags)[lags + 1 :]
     k = np.arange(1, lags + 1)
@@ -303,7 +303,7 @@ def independence_test(
             f"`u` and `e` must have the same length; got {u.size} and {e.size}"
         )
     n = e.size
-    lags = _check_lags(lags, n)
+    lags = check_lags(lags, n)
     levels = _check_levels(levels)
     if not (np.isfinite(rtol) and 0.0 < rtol < 1.0):
         raise ValueError(f"`rtol` must be in (0, 1); got {rtol!r}")

@@ -24,7 +24,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from .correlation import CorrelationTest, independence_test, whiteness_test
+from .correlation import (
+    CorrelationTest,
+    check_lags,
+    independence_test,
+    whiteness_test,
+)
 from .data import check_signal
 from .spectra import PSD, Modes, Peaks, find_resonances, modes_from_poles, psd
 
@@ -596,13 +601,9 @@ def validate(
     """
     u, y, ts = _signals_of(data)
     n = y.size
-    if isinstance(lags, bool) or not isinstance(lags, int | np.integer):
-        raise ValueError(f"`lags` must be an integer; got {lags!r}")
-    if not 1 <= lags < n:
-        raise ValueError(
-            f"`lags` must be in [1, N - 1] = [1, {n - 1}] for a record of "
-            f"N = {n} samples; got {lags!r}"
-        )
+    # Checked here too (the correlation tests would) so a bad `lags` fails
+    # before the simulation and spectra are computed.
+    lags = check_lags(lags, n)
     if residuals not in _RESIDUALS:
         raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
     model_ts = getattr(model, "ts", None)
