@@ -52,7 +52,9 @@ def test_ls_recovers_theta(known):
     "kwargs",
     [
         dict(method="oe"),
+        dict(method="oe", initial="measured"),
         dict(method="ebsda", refine=True, rng=0),
+        dict(method="ebsda", refine=True, rng=0, initial="measured"),
         dict(method="ebsda", refine=True, rng=1, parametrization="reflection"),
     ],
 )
@@ -119,14 +121,22 @@ def test_to_dlti_and_dict_round_trip(known):
     np.testing.assert_array_equal(back.theta, fit.theta)
     np.testing.assert_array_equal(back.history, fit.history)
     assert back.arx == fit.arx and back.ts == 0.01 and back.method == "sda"
-    assert back.cost == fit.cost
+    assert back.cost == fit.cost and back.initial == fit.initial == "rest"
     np.testing.assert_array_equal(back.predict(est), fit.predict(est))
     for method in ("ls", "oe"):  # no history, no bounds
-        other = identify(est, ARX(2, 2, 1), method=method)
-        back = IdentifiedModel.from_dict(json.loads(json.dumps(other.to_dict())))
-        np.testing.assert_array_equal(back.theta, other.theta)
-        assert back.method == method and back.history is None and back.bounds is None
-        assert back.cost == other.cost and back.gain == other.gain
+        for initial in ("rest", "measured"):
+            other = identify(est, ARX(2, 2, 1), method=method, initial=initial)
+            back = IdentifiedModel.from_dict(json.loads(json.dumps(other.to_dict())))
+            np.testing.assert_array_equal(back.theta, other.theta)
+            assert back.method == method and back.history is None
+            assert back.bounds is None and back.initial == initial
+            assert back.cost == other.cost and back.gain == other.gain
+    # A dict saved before `initial` existed was made by the measured-past rule.
+    old = fit.to_dict()
+    del old["initial"]
+    assert IdentifiedModel.from_dict(old).initial == "measured"
+    with pytest.raises(ValueError, match=r"`initial` must be one of .*; got 'zero'"):
+        IdentifiedModel.from_dict({**old, "initial": "zero"})
 
 
 @pytest.fixture(scope="module")
@@ -147,12 +157,18 @@ def test_real_arm_least_squares_about_95(arm, arm_ls):
     assert abs(_validation_fit(arm_ls, arm) - 95.0) <= 1.0
 
 
-def test_real_arm_output_error(arm, arm_ls):
+def test_real_arm_output_error(arm):
     est, _ = arm.split()
-    oe = identify(est, ARX(8, 8, 0), method="oe")
-    assert oe.is_stable
+    # The arm record is a slice of a periodic sine sweep: it starts in
+    # motion, so the simulation must start from the measured past outputs
+    # (initial="measured"). From rest (the default, right for records that
+    # start at rest) OE validates at only ~89.7 % here: the start-up
+    # transient of a lightly damped model is not in the data.
+    oe = identify(est, ARX(8, 8, 0), method="oe", initial="measured")
+    ls = identify(est, ARX(8, 8, 0), method="ls", initial="measured")
+    assert oe.is_stable and oe.initial == "measured"
     # OE minimises the simulation cost, so it must not lose to LS there...
-    assert oe.cost <= arm_ls.cost
+    assert oe.cost <= ls.cost
     # ...and it validates within a point of 95 % too. Issue 4 asks for at
     # least the LS fit (95.36); OE reaches 95.21: its lowest simulation cost
     # puts a pole pair at the stability limit (12.9 Hz, nearly cancelled by
@@ -183,7 +199,8 @@ def test_steiglitz_mcbride_removes_the_output_noise_bias():
         steiglitz_mcbride(data, arx, n_iter=-1)
 
 
-def test_oe_keeps_the_start_with_the_lower_cost():
+@pytest.mark.parametrize("initial", ["rest", "measured"])
+def test_oe_keeps_the_start_with_the_lower_cost(initial):
     from spiralid.sysid.cost import PaperCost
     from spiralid.sysid.identify import _local_polish
 
@@ -192,13 +209,13 @@ def test_oe_keeps_the_start_with_the_lower_cost():
     y = signal.lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
     data = IOData(u, y + 0.5 * rng.standard_normal(u.size), ts=1.0)
     arx = ARX(2, 2, 1)
-    cost = PaperCost(arx, data)
+    cost = PaperCost(arx, data, initial=initial)
     ls = identify(data, arx, method="ls").theta
     polished = [
-        cost(_local_polish(s, arx, data, "simulation")[0])
+        cost(_local_polish(s, arx, data, "simulation", initial)[0])
         for s in (ls, steiglitz_mcbride(data, arx))
     ]
-    oe = identify(data, arx, method="oe")
+    oe = identify(data, arx, method="oe", initial=initial)
     assert oe.cost == pytest.approx(min(polished), rel=1e-12)
     # The saved summary holds scalars, not least_squares' residual vector.
     summary = json.loads(json.dumps(oe.to_dict()))["result"]
@@ -219,6 +236,7 @@ def test_oe_keeps_the_start_with_the_lower_cost():
             "`optimiser_options` apply to the spiral methods",
         ),
         (dict(predictor="two-step"), "`predictor` must be one of .*; got 'two-step'"),
+        (dict(method="oe", initial="zero"), "`initial` must be one of .*; got 'zero'"),
         (
             dict(bounds=np.zeros((3, 2))),
             r"`bounds` must have shape \(4, 2\); got shape \(3, 2\)",
@@ -277,3 +295,63 @@ def test_unstable_start_is_reflected_inside():
     a = step_up(k_b[:3])
     expected = np.sort_complex(np.r_[1 / 1.25, roots[1:]])
     np.testing.assert_allclose(np.sort_complex(np.roots(np.r_[1.0, a])), expected)
+
+
+def test_oe_from_rest_is_a_prediction_error_method():
+    # Output (not equation) noise on a known ARX(2, 2, 1) record that starts
+    # at rest. At the OE optimum the Jacobian least_squares used (analytic,
+    # sensitivities filtered from rest) equals central finite differences of
+    # the residual written out here with scipy.signal.lfilter from rest over
+    # all N samples, and the gradient J' r of the criterion vanishes.
+    from spiralid.sysid.identify import _KMAX
+
+    rng = np.random.default_rng(21)
+    u = rng.standard_normal(500)
+    clean = signal.lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    data = IOData(u, clean + 0.5 * rng.standard_normal(u.size), ts=1.0)
+    arx = ARX(2, 2, 1)
+    oe = identify(data, arx, method="oe")
+    assert oe.initial == "rest" and oe.result.success
+
+    def residual(x):
+        a = step_up(_KMAX * np.tanh(x[:2]))
+        return signal.lfilter([0.0, *x[2:]], np.r_[1.0, a], u) - data.y
+
+    x = oe.result.x
+    r = residual(x)
+    np.testing.assert_allclose(r, oe.result.fun, rtol=1e-9, atol=1e-12)
+    h = 1e-6
+    fd = np.column_stack(
+        [(residual(x + h * e) - residual(x - h * e)) / (2 * h) for e in np.eye(x.size)]
+    )
+    np.testing.assert_allclose(oe.result.jac, fd, rtol=1e-5, atol=1e-6)
+    assert np.linalg.norm(fd.T @ r) <= 1e-6 * np.linalg.norm(fd) * np.linalg.norm(r)
+    # Output noise biases least squares; OE from rest lands near the truth.
+    ls = identify(data, arx, method="ls").theta
+    assert np.linalg.norm(oe.theta - TRUE) < 0.5 * np.linalg.norm(ls - TRUE)
+
+
+def test_rig_rest_criterion_validates_better_than_measured():
+    # The simulated rig's record starts at rest and its accelerometer is
+    # noisy. The measured-past start maps the noise of the 8 measured past
+    # outputs into the initial state (gain up to ~1e4 for these lightly
+    # damped models), so its optimum validates worse than the from-rest one.
+    # Both polished from the Steiglitz-McBride start, the start "oe" keeps
+    # for either rule on this record (identify itself also polishes the
+    # least-squares start, ~3 s more from rest); identify's figures are in
+    # the benchmarks. Validation: free run from rest over the whole record.
+    from spiralid.report import default_data
+    from spiralid.sysid import validate
+    from spiralid.sysid.identify import _local_polish
+
+    est, val = default_data().split()
+    arx = ARX(8, 8, 0)
+    start = steiglitz_mcbride(est, arx)
+    fits = {}
+    for initial in ("rest", "measured"):
+        theta, _ = _local_polish(start, arx, est, "simulation", initial)
+        model = IdentifiedModel(theta, arx, est.ts, "oe", initial=initial)
+        fits[initial] = validate(model, val, warmup=est).fit_percent
+    # Measured: rest 95.85 %, measured 92.55 %.
+    assert fits["rest"] > fits["measured"] + 2.0
+    assert fits["rest"] > 95.0

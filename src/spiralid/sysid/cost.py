@@ -5,17 +5,34 @@
 
 How we read it (DESIGN.md items 2-3):
 
-- Both predictors sum over the same ``K = N - t0`` samples ``t >= t0``,
-  where ``t0 = max_lag = max(na, nk + nb - 1)``: the first ``t0`` samples
-  are the initial conditions (see :mod:`spiralid.sysid.arx`).
-  ``predictor="one-step"``: ``e`` is the equation (one-step prediction)
-  error ``y - Phi theta``. ``predictor="simulation"``: ``e`` is the free-run
-  simulation error from the input alone, the model's own past outputs
-  fed back, started at ``t0`` from the measured past (so the first
-  simulated sample equals the first one-step prediction). Starting from
-  the measured state rather than from rest matters for a lightly damped
-  plant whose record starts in motion: a zero initial state leaves a
-  transient no parameter can remove.
+- ``predictor="simulation"`` (the paper's): ``e`` is the free-run
+  simulation error, the model driven by the input alone with its own past
+  outputs fed back. Where the run starts is ``initial``:
+
+  ``initial="rest"`` (default, paper-faithful: "the actual input applied
+  to the estimated model")
+      zero initial conditions at ``t = 0`` (``u`` and the output are zero
+      before the record), so ``e = y - lfilter(b, a, u)`` over *all* ``N``
+      samples and ``K = N``. Use it for records that start at rest, such as
+      the simulated rig's bang-bang experiments, and whenever the model will
+      be validated or used from rest.
+  ``initial="measured"``
+      the free run starts at ``t0 = max_lag = max(na, nk + nb - 1)`` from
+      the *measured* past outputs ``y(t0-na)..y(t0-1)`` (the first simulated
+      sample equals the first one-step prediction) and ``K = N - t0``
+      samples count. Use it only for a record that starts in motion, e.g.
+      the real arm (a slice of a periodic sweep), where a zero start leaves
+      a transient no parameter can remove. On noisy data it is harmful for
+      lightly damped models: the map from the ``na`` measured past outputs
+      to the initial state can amplify their noise by orders of magnitude
+      (largest singular value ~1.3e4 for ARX(8, 8, 0) models of the rig),
+      so the cost then favours models whose start-up transient happens to
+      cancel that noise over models that simulate well from rest.
+
+- ``predictor="one-step"``: ``e`` is the equation (one-step prediction)
+  error ``y - Phi theta`` over the ``K = N - t0`` samples ``t >= t0``,
+  whose regressors are all measured (see :mod:`spiralid.sysid.arx`);
+  least squares is its exact minimiser. ``initial`` does not affect it.
 - ``gain="auto"`` sets ``w = 100 sqrt(K) / rms(y)`` (rms over the same
   ``K`` samples), so ``f`` is the RMS error as a percentage of the RMS of
   the output *as given* (not detrended: detrend the data first if an
@@ -23,9 +40,10 @@ How we read it (DESIGN.md items 2-3):
 - Stability is decided from the denominator by the Schur-Cohn test (all
   reflection coefficients ``|k_j| < 1``; a pole on the circle counts as
   unstable) *before* any simulation. An unstable candidate is never
-  simulated: its error term in eq. (3) is the one-step error term, which
-  is finite for every theta. So the penalty is present exactly when a pole
-  has ``|z| >= 1``, and the cost is always finite.
+  simulated: its error term in eq. (3) is the one-step error term (the sum
+  over ``t >= max_lag``, divided by the cost's ``K``), which is finite for
+  every theta. So the penalty is present exactly when a pole has
+  ``|z| >= 1``, and the cost is always finite.
 """
 
 from __future__ import annotations
@@ -38,9 +56,10 @@ from .arx import ARX
 from .data import IOData
 from .polynomials import is_stable_polynomial
 
-__all__ = ["PaperCost"]
+__all__ = ["INITIAL_CONDITIONS", "PaperCost"]
 
 _PREDICTORS = ("simulation", "one-step")
+INITIAL_CONDITIONS = ("rest", "measured")
 
 
 class PaperCost:
@@ -51,13 +70,21 @@ class PaperCost:
     arx : ARX
         Model structure.
     data : IOData
-        Estimation record (``K = data.n - arx.max_lag`` samples count).
+        Estimation record.
     predictor : {"simulation", "one-step"}
         Which output error ``e`` the cost measures.
     gain : "auto" or float
         The gain ``w``; ``"auto"`` is ``100 sqrt(K) / rms(y)`` (percent RMS error).
     penalty : float
         Added when any pole has ``|z| >= 1`` (eq. (3)); >= 0.
+    initial : {"rest", "measured"}, default "rest"
+        Initial condition of the simulation (ignored by ``"one-step"``).
+        ``"rest"``: zero initial conditions, all ``N`` samples scored
+        (``K = N``), the paper's reading; right for records that start at
+        rest. ``"measured"``: start at ``t0 = max_lag`` from the measured
+        past outputs, ``K = N - t0``; only for records that start in motion
+        (it amplifies output noise for lightly damped models, see the module
+        docstring).
 
     Attributes
     ----------
@@ -66,7 +93,10 @@ class PaperCost:
     K : int
         Number of samples in the sums, ``data.n - t0``.
     t0 : int
-        First sample of the sums, ``arx.max_lag``.
+        First sample of the sums: ``0`` for a simulation from rest,
+        ``arx.max_lag`` otherwise.
+    initial : str
+        The initial condition of the simulation.
     gram, phity, yty
         ``Phi' Phi``, ``Phi' y`` and ``y' y``: the one-step error is
         ``y'y - 2 theta' Phi'y + theta' Phi'Phi theta``, O(p^2) per candidate.
@@ -94,6 +124,7 @@ class PaperCost:
         predictor: str = "simulation",
         gain: str | float = "auto",
         penalty: float = 1e6,
+        initial: str = "rest",
     ) -> None:
         if not isinstance(arx, ARX):
             raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
@@ -102,6 +133,10 @@ class PaperCost:
         if predictor not in _PREDICTORS:
             raise ValueError(
                 f"`predictor` must be one of {_PREDICTORS}; got {predictor!r}"
+            )
+        if not isinstance(initial, str) or initial not in INITIAL_CONDITIONS:
+            raise ValueError(
+                f"`initial` must be one of {INITIAL_CONDITIONS}; got {initial!r}"
             )
         arx.check_length(data)
         try:
@@ -116,7 +151,10 @@ class PaperCost:
         self.data = data
         self.predictor = predictor
         self.penalty = pen
-        self.t0 = arx.max_lag
+        self.initial = initial
+        lag = arx.max_lag
+        from_rest = predictor == "simulation" and initial == "rest"
+        self.t0 = 0 if from_rest else lag
         self.K = data.n - self.t0
         y = data.y[self.t0 :]
         if isinstance(gain, str):
@@ -142,13 +180,24 @@ class PaperCost:
                     f"`gain` must be 'auto' or a positive number; got {gain!r}"
                 )
             self.w = w
-        phi = arx.regressors(data)[self.t0 :]
+        # The one-step error always sums over t >= max_lag (all regressors
+        # measured); a simulation from rest only uses it for unstable
+        # candidates.
+        phi = arx.regressors(data)[lag:]
+        y_lag = data.y[lag:]
         self.gram = phi.T @ phi
-        self.phity = phi.T @ y
-        self.yty = float(y @ y)
-        self._y = np.ascontiguousarray(data.y)
+        self.phity = phi.T @ y_lag
+        self.yty = float(y_lag @ y_lag)
+        if from_rest:
+            # Rest is the measured-past recursion on a record preceded by
+            # max_lag zeros: one compiled kernel serves both, and the padded
+            # first t0 samples are exactly the zero initial conditions.
+            self._y = np.r_[np.zeros(lag), data.y]
+            self._u = np.r_[np.zeros(lag), data.u]
+        else:
+            self._y = np.ascontiguousarray(data.y)
+            self._u = np.ascontiguousarray(data.u)
         self._ulags = np.ascontiguousarray(arx.input_lags(data.u)[:, self.t0 :])
-        self._u = np.ascontiguousarray(data.u)
 
     @property
     def n_params(self) -> int:
@@ -157,7 +206,7 @@ class PaperCost:
     def __repr__(self) -> str:
         return (
             f"PaperCost({self.arx}, K={self.K}, predictor={self.predictor!r}, "
-            f"w={self.w:.6g}, penalty={self.penalty:g})"
+            f"initial={self.initial!r}, w={self.w:.6g}, penalty={self.penalty:g})"
         )
 
     def _thetas(self, thetas):
@@ -198,7 +247,7 @@ class PaperCost:
                 np.ascontiguousarray(sub[:, na:].T),
                 np.ascontiguousarray(sub[:, :na].T),
                 self._y,
-                self.t0,
+                self.arx.max_lag,
                 self.arx.nk,
                 out,
             )
@@ -215,7 +264,8 @@ class PaperCost:
     def simulate(self, theta) -> np.ndarray:
         """The simulated output the simulation error compares with ``y[t0:]``.
 
-        Free run for ``t >= t0`` started from the measured past (not from rest).
+        ``initial="rest"``: ``lfilter(num, den, u)`` over all ``N`` samples;
+        ``"measured"``: free run for ``t >= t0`` from the measured past.
         """
         th, single = self._thetas(theta)
         if not single:
@@ -223,6 +273,8 @@ class PaperCost:
         na = self.arx.na
         den = np.r_[1.0, th[0, :na]]
         x = th[0, na:] @ self._ulags
+        if self.t0 == 0:
+            return lfilter([1.0], den, x)
         past = self._y[self.t0 - na : self.t0][::-1]
         zi = lfiltic([1.0], den, past) if na else None
         if zi is None:
