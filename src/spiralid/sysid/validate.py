@@ -593,11 +593,18 @@ def validate(
     when a pole has ``|z| >= 1``, with ``e`` the error of the model's own
     predictor (``model.predictor``) computed exactly as for the fit and error
     range (zero initial conditions, or after ``warmup``). It therefore equals
-    ``100 rms(e) / rms(y)`` with ``gain="auto"``. It can differ slightly from
-    :class:`~spiralid.sysid.PaperCost` on the same record, which starts its
-    free run from the measured first samples (see :mod:`spiralid.sysid.cost`);
-    for poles very close to the unit circle the difference can be large,
-    because the start-up transient then hardly decays.
+    ``100 rms(e) / rms(y)`` with ``gain="auto"``. For a simulation-predictor
+    model estimated with ``initial="rest"`` (the default) and no ``warmup``
+    this is exactly :class:`~spiralid.sysid.PaperCost` with
+    ``initial="rest"`` on ``data``, the criterion the model was fitted with.
+    The validation run always starts from rest (or after ``warmup``),
+    whatever the model's ``initial``: a model estimated with
+    ``initial="measured"`` (for records that start in motion) is scored on
+    the same free run as its fit and error range, so its cost here can
+    differ from ``PaperCost(..., initial="measured")`` on the same record,
+    a lot for poles close to the unit circle, whose start-up transient
+    hardly decays. Pass ``warmup`` to validate such a model from the state
+    it has reached.
     """
     u, y, ts = _signals_of(data)
     n = y.size
