@@ -7,12 +7,15 @@ Prints two tables (issue 4's experiments):
 2. The real flexible arm (DaISy 96-009, ``ts = 0.01`` s, a documented choice:
    the source gives none), ARX(8, 8, 0), simulation cost, 50 points x 500
    iterations, 5 seeds: SDA and Eb-SDA, both parametrisations, with and
-   without ``refine``; least squares and output error for reference.
+   without ``refine``; least squares and output error for reference. Once
+   with the simulation started from rest (``initial="rest"``, the default)
+   and once from the measured past (``initial="measured"``, the rule for a
+   record that starts in motion, as this one does).
 
 Columns: the paper's cost eq. (2)-(3) on the estimation part (percent RMS
-error, ``gain="auto"``) and the validation fit (MATLAB ``compare`` NRMSE, %)
-of a free-run simulation of the whole record from rest, scored on the last
-third. Paper constants untouched. Run:
+error, ``gain="auto"``, under the table's ``initial``) and the validation
+fit (MATLAB ``compare`` NRMSE, %) of a free-run simulation of the whole
+record from rest, scored on the last third. Paper constants untouched. Run:
 ``.venv/bin/python benchmarks/study_arm.py [n_seeds_arm]``;
 ``.venv/bin/python benchmarks/study_arm.py oe`` instead prints the
 output-error initial-state study (:func:`oe_initial_state_study`).
@@ -57,11 +60,11 @@ def fmt(values):
     return f"{np.median(v):9.2f} [{np.min(v):9.2f}, {np.max(v):9.2f}]"
 
 
-def table(title, data, arx, seeds, configs, **opts):
-    print(f"\n{title}")
+def table(title, data, arx, seeds, configs, initial="rest", **opts):
+    print(f"\n{title}; initial={initial!r}")
     est, _ = data.split()
     for method in ("ls", "oe"):
-        ref = identify(est, arx, method=method)
+        ref = identify(est, arx, method=method, initial=initial)
         cost, fit = score(ref, data)
         print(
             f"  {method:<34} cost {cost:9.3f}   val fit {fit:9.2f} %   "
@@ -74,7 +77,7 @@ def table(title, data, arx, seeds, configs, **opts):
         for seed in seeds:
             model = identify(
                 est, arx, method=method, parametrization=par, refine=refine,
-                rng=seed, **opts,
+                rng=seed, initial=initial, **opts,
             )  # fmt: skip
             c, f = score(model, data)
             costs.append(c)
@@ -122,11 +125,12 @@ def main() -> None:
         print(f"\n(real arm data not found at {ARM})")
         return
     arm = IOData.from_csv(ARM, input="u", output="y", ts=0.01)
-    table(
-        f"Real flexible arm, ARX(8, 8, 0), simulation cost; {n_arm} seeds; "
-        "50 points x 500 iterations",
-        arm, ARX(8, 8, 0), range(n_arm), configs,
-    )  # fmt: skip
+    for initial in ("rest", "measured"):
+        table(
+            f"Real flexible arm, ARX(8, 8, 0), simulation cost; {n_arm} seeds; "
+            "50 points x 500 iterations",
+            arm, ARX(8, 8, 0), range(n_arm), configs, initial=initial,
+        )  # fmt: skip
     gain_table(arm, ARX(8, 8, 0), range(n_arm))
 
 
@@ -137,7 +141,7 @@ def gain_table(data, arx, seeds):
     auto = PaperCost(arx, est, predictor="simulation")
     print(
         "\nEb-SDA sensitivity to the gain w (cost shown on the auto scale, "
-        "percent RMS error); plain search"
+        "percent RMS error); plain search; initial='rest'"
     )
     for par in ("coefficients", "reflection"):
         for factor in (0.1, 1.0, 10.0):
@@ -158,9 +162,10 @@ def _oe_variant(data, arx, theta0, initial, kmax=1.0 - 1e-6):
     a study, not the library's method).
 
     ``"estimated"``: the na outputs before ``t0`` are free parameters
-    (MATLAB's ``InitialCondition='estimate'``); ``"rest"``: zero state at
-    ``t = 0``, scored from ``t0`` on. Returns (theta, rms of the criterion's
-    error)."""
+    (MATLAB's ``InitialCondition='estimate'``); ``"rest-from-t0"``: zero
+    state at ``t = 0``, scored from ``t0`` on (the library's
+    ``initial="rest"`` scores all N samples). Returns (theta, rms of the
+    criterion's error)."""
     from scipy import optimize, signal
 
     from spiralid.sysid import step_up
@@ -176,7 +181,7 @@ def _oe_variant(data, arx, theta0, initial, kmax=1.0 - 1e-6):
     def residual(x):
         a, b = unpack(x)
         den = np.r_[1.0, a]
-        if initial == "rest":
+        if initial == "rest-from-t0":
             return signal.lfilter([1.0], den, b @ ulags)[t0:] - y[t0:]
         zi = signal.lfiltic([1.0], den, x[arx.n_params :])
         return signal.lfilter([1.0], den, b @ ulags[:, t0:], zi=zi)[0] - y[t0:]
@@ -198,12 +203,14 @@ def oe_initial_state_study() -> None:
     """Why "oe" validates below least squares on the real arm (issue 4).
 
     For the arm and the simulated rig (``spiralid.report.default_data()``),
-    ARX(8, 8, 0): output error under three initial-state rules, each from
-    the least-squares and the Steiglitz-McBride start, and the reflection
-    bound kmax of the library's (measured-past) criterion. Columns: the
-    paper's cost (measured past, what "oe" minimises), the criterion's own
-    RMS error, the validation fit (from rest over the whole record, last
-    third) and the largest pole radius.
+    ARX(8, 8, 0): output error under four initial-state rules, each from
+    the least-squares and the Steiglitz-McBride start: the library's
+    ``initial="rest"`` and ``"measured"``, and two study variants
+    (:func:`_oe_variant`); then the reflection bound kmax of the library's
+    measured-past criterion. Columns: the paper's cost from rest and from
+    the measured past, the criterion's own RMS error, the validation fit
+    (from rest over the whole record, last third) and the largest pole
+    radius.
     """
     import spiralid.sysid.identify  # noqa: F401 - the module, not the function
     from spiralid.sysid import (
@@ -226,22 +233,26 @@ def oe_initial_state_study() -> None:
         pass
     print("\nOutput error: initial-state rule x start (ARX(8, 8, 0))")
     for name, (est, val) in records.items():
-        cost = PaperCost(arx, est)
+        rest = PaperCost(arx, est, initial="rest")
+        measured = PaperCost(arx, est, initial="measured")
         ls = arx_least_squares(est, arx)
         starts = {"ls": ls, "sm": steiglitz_mcbride(est, arx, ls)}
         for sname, start in starts.items():
-            for initial in ("measured", "estimated", "rest"):
-                if initial == "measured":
-                    theta, res = mod._local_polish(start, arx, est, "simulation")
+            for initial in ("rest", "measured", "estimated", "rest-from-t0"):
+                if initial in ("rest", "measured"):
+                    theta, res = mod._local_polish(
+                        start, arx, est, "simulation", initial
+                    )
                     own = float(np.sqrt(np.mean(res.fun**2)))
                 else:
                     theta, own = _oe_variant(est, arx, start, initial)
                 model = IdentifiedModel(theta, arx, est.ts, "oe")
                 fit = validate(model, val, warmup=est).fit_percent
                 print(
-                    f"  {name} start {sname:<2} initial {initial:<9} paper cost "
-                    f"{cost(theta):9.4f}  criterion rms {own:10.5g}  val fit "
-                    f"{fit:6.2f} %  max|pole| {np.abs(model.poles).max():.7f}"
+                    f"  {name} start {sname:<2} initial {initial:<12} paper cost "
+                    f"rest {rest(theta):9.4f} measured {measured(theta):9.4f}  "
+                    f"criterion rms {own:10.5g}  val fit {fit:6.2f} %  "
+                    f"max|pole| {np.abs(model.poles).max():.7f}"
                 )
     if "arm" in records:
         est, val = records["arm"]
@@ -251,13 +262,14 @@ def oe_initial_state_study() -> None:
             for kmax in (1 - 1e-6, 1 - 1e-4, 1 - 1e-3, 1 - 1e-2):
                 mod._KMAX = kmax
                 theta, _ = mod._local_polish(
-                    arx_least_squares(est, arx), arx, est, "simulation"
+                    arx_least_squares(est, arx), arx, est, "simulation", "measured"
                 )
                 model = IdentifiedModel(theta, arx, est.ts, "oe")
                 fit = validate(model, val, warmup=est).fit_percent
                 print(
                     f"    kmax 1 - {1 - kmax:.0e}: paper cost "
-                    f"{PaperCost(arx, est)(theta):.4f}  val fit {fit:.2f} %  "
+                    f"{PaperCost(arx, est, initial='measured')(theta):.4f}  "
+                    f"val fit {fit:.2f} %  "
                     f"max|pole| {np.abs(model.poles).max():.7f}"
                 )
         finally:
