@@ -193,6 +193,7 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
     results = _reproduce_ok(tmp_path)
     assert results["seeds"] == [0, 1]
     assert results["data"]["kind"] == "simulated rig"
+    assert results["options"]["initial"] == "rest"
     assert results["data"]["rig"]["length"] == 0.9
     assert results["data"]["n_samples"] == 3000 and results["data"]["ts"] == 0.002
     assert results["structure"] == {"na": 8, "nb": 8, "nk": 0}
@@ -210,9 +211,13 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
 
 @pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
 def test_reproduce_on_the_real_arm(tmp_path):
+    # The arm's record is a slice of a periodic sweep: it starts in motion.
     results = _reproduce_ok(
-        tmp_path, "--data", ARM, "--input", "u", "--output", "y", "--ts", "0.01"
+        tmp_path,
+        *("--data", ARM, "--input", "u", "--output", "y", "--ts", "0.01"),
+        *("--initial", "measured"),
     )
+    assert results["options"]["initial"] == "measured"
     assert results["data"]["n_samples"] == 1024
     assert results["data"]["path"] == str(ARM.resolve())
     assert results["data"]["n_estimation"] == round(1024 * 2 / 3)

@@ -72,7 +72,18 @@ def _fraction(text: str) -> float:
     return value
 
 
-def _add_data_options(p: argparse.ArgumentParser, required_ts: bool = False) -> None:
+def _add_initial_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--initial",
+        choices=["rest", "measured"],
+        default="rest",
+        help="initial condition of the simulation error: 'rest' (the paper's free "
+        "run; records that start at rest, default) or 'measured' (start from the "
+        "first measured samples; records that start in motion)",
+    )
+
+
+def _add_data_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--input",
         type=_column,
@@ -271,6 +282,7 @@ def _cmd_identify(args) -> int:
         arx,
         method=args.method,
         predictor=args.predictor,
+        initial=args.initial,
         parametrization=args.parametrization,
         refine=args.refine,
         rng=args.seed,
@@ -354,6 +366,7 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
             seeds=range(args.first_seed, args.first_seed + args.seeds),
             max_nfev=args.budget,
             n_points=args.points,
+            initial=args.initial,
             workers=args.workers,
             progress=bar,
         )
@@ -445,6 +458,7 @@ def build_parser() -> argparse.ArgumentParser:
         choices=["coefficients", "reflection"],
         default="coefficients",
     )
+    _add_initial_option(p)
     p.add_argument(
         "--refine", action="store_true", help="polish a spiral result locally"
     )
@@ -500,6 +514,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=_positive_int, default=None, help="processes")
     p.add_argument("--data", default=None, help="your own CSV/NPZ/MAT record")
     _add_data_options(p)
+    _add_initial_option(p)
     p.add_argument("--out", default="spiralid-reproduce", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")

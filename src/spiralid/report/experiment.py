@@ -227,7 +227,7 @@ def _fit_on_validation(model: IdentifiedModel, data: IOData, n_est: int) -> floa
 
 def _run_one(job) -> tuple[str, int, IdentifiedModel, np.ndarray]:
     """Worker: one configuration, one seed (module level so it pickles)."""
-    config, seed, est, arx, options, gain = job
+    config, seed, est, arx, options, gain, initial = job
     stamps: list[float] = []
 
     def clock(_intermediate) -> bool:
@@ -240,6 +240,7 @@ def _run_one(job) -> tuple[str, int, IdentifiedModel, np.ndarray]:
         arx,
         method=config.method,
         predictor="simulation",
+        initial=initial,
         parametrization=config.parametrization,
         refine=config.refine,
         gain=gain * config.gain_scale,
@@ -260,6 +261,7 @@ def reproduce(
     n_points: int = 50,
     arx: ARX | None = None,
     fraction: float = 2 / 3,
+    initial: str = "rest",
     configurations: Sequence[Configuration] = CONFIGURATIONS,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
@@ -282,6 +284,12 @@ def reproduce(
         Eq. (6) (DESIGN.md item 1).
     fraction : float, default 2/3
         Estimation share of the record.
+    initial : {"rest", "measured"}, default "rest"
+        Initial condition of the simulation error in the cost (see
+        :func:`spiralid.sysid.identify`): ``"rest"`` is the paper's free run
+        from the input alone and suits records that start at rest (the rig);
+        ``"measured"`` starts from the measured first samples, for records
+        that start in motion (the real arm, a slice of a periodic sweep).
     configurations : sequence of Configuration
         Default :data:`CONFIGURATIONS`.
     workers : int, optional
@@ -308,14 +316,14 @@ def reproduce(
         raise ValueError(f"`max_nfev` must be an integer >= 2; got {max_nfev!r}")
     est, val = data.split(fraction)
     arx.check_length(est, "data")
-    gain = PaperCost(arx, est, predictor="simulation").w
+    gain = PaperCost(arx, est, predictor="simulation", initial=initial).w
     options = {
         "n_points": n_points,
         "max_nfev": max_nfev,
         "max_iter": 10 * max_nfev,
     }
     jobs = [
-        (config, seed, est, arx, options, gain)
+        (config, seed, est, arx, options, gain, initial)
         for seed in seed_list
         for config in configurations
     ]
@@ -328,7 +336,7 @@ def reproduce(
         if progress is not None:
             progress(done, total)
 
-    scorer = PaperCost(arx, est, predictor="simulation", gain=gain)
+    scorer = PaperCost(arx, est, predictor="simulation", gain=gain, initial=initial)
 
     def as_run(label, seed, model, times=None) -> Run:
         return Run(
@@ -342,7 +350,8 @@ def reproduce(
 
     baselines = {}
     for label, method in (("LS", "ls"), ("OE", "oe")):
-        baselines[label] = as_run(label, None, identify(est, arx, method=method))
+        model = identify(est, arx, method=method, initial=initial)
+        baselines[label] = as_run(label, None, model)
         tick()
 
     n_workers = (os.cpu_count() or 1) if workers is None else int(workers)
@@ -365,7 +374,12 @@ def reproduce(
         validation=val,
         arx=arx,
         seeds=seed_list,
-        options={**options, "predictor": "simulation", "gain": gain},
+        options={
+            **options,
+            "predictor": "simulation",
+            "initial": initial,
+            "gain": gain,
+        },
         configurations=tuple(configurations),
         runs=runs,
         baselines=baselines,

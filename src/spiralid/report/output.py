@@ -282,7 +282,9 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         f"Data: {e(rep.data.input_name)} &rarr; {e(rep.data.output_name)}, "
         f"{rep.data.n} samples at ts = {rep.data.ts:g} s; first "
         f"{rep.estimation.n} to estimate, last {rep.validation.n} to validate.<br>"
-        f"Model: {e(str(rep.arx))}, predictor: free-run simulation, gain w = "
+        f"Model: {e(str(rep.arx))}, predictor: free-run simulation from "
+        f"{'rest' if d['initial'] == 'rest' else 'the measured first samples'}, "
+        "gain w = "
         f"{d['gain']:.4g} (cost = 100 rms(e)/rms(y)).<br>"
         f"Budget: {d['max_nfev']} cost evaluations per run, {d['n_points']} "
         f"points, seeds {rep.seeds}. Wall time {rep.elapsed:.1f} s.</p>",
