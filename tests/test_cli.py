@@ -99,7 +99,9 @@ def test_identify_then_validate(rig_csv, tmp_path):
         json.loads((tmp_path / "m" / "model.json").read_text())
     )
     assert model.method == "ebsda" and model.theta.shape == (16,)
-    assert model.result is None or model.result.nfev <= 400
+    saved_model = json.loads((tmp_path / "m" / "model.json").read_text())
+    # --budget, not the default 500 iterations, stops the search.
+    assert 350 < saved_model["result"]["nfev"] <= 400
     assert (tmp_path / "m" / "validation_time.png").stat().st_size > 1000
     assert (tmp_path / "m" / "convergence.png").exists()
     # The saved model reproduces the same validation on the same data.
@@ -153,6 +155,33 @@ def test_identify_reads_mat_files(tmp_path):
     np.testing.assert_allclose(model["theta"], [-1.5, 0.7, 1.0, 0.5], atol=1e-9)
 
 
+def test_validate_refuses_data_at_another_sample_time(rig_csv, tmp_path):
+    proc = run("identify", rig_csv, "--method", "ls", "--out", "m", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    fast = tmp_path / "fast.csv"
+    proc = run("simulate", "--fs", "1000", "--out", fast, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    proc = run("validate", "m/model.json", fast, cwd=tmp_path)
+    assert proc.returncode == 2
+    assert "sample time" in proc.stderr
+
+
+def test_reproduce_force_keeps_the_users_files(tmp_path):
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    (out / "results.json").write_text("stale")
+    proc = run(
+        "reproduce",
+        *("--seeds", "1", "--budget", "100", "--points", "10", "--workers", "1"),
+        *("--quiet", "--force", "--out", out),
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert (out / "notes.txt").read_text() == "mine"
+    assert json.loads((out / "results.json").read_text())["seeds"] == [0]
+
+
 @pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
 def test_identify_least_squares_on_the_real_arm(tmp_path):
     proc = run(
@@ -172,6 +201,8 @@ def _reproduce_ok(tmp_path, *extra):
         "2",
         "--budget",
         "300",
+        "--points",
+        "10",
         "--workers",
         "1",
         "--quiet",
@@ -198,10 +229,28 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
     assert results["data"]["n_samples"] == 3000 and results["data"]["ts"] == 0.002
     assert results["structure"] == {"na": 8, "nb": 8, "nk": 0}
     labels = [row["label"] for row in results["table2"]]
-    assert labels[:2] == ["SDA", "Eb-SDA"] and {"LS", "OE"} <= set(labels)
+    assert labels == [
+        "SDA",
+        "Eb-SDA",
+        "SDA (reflection)",
+        "Eb-SDA (reflection)",
+        "Eb-SDA + refine",
+        "Eb-SDA (w x 0.1)",
+        "Eb-SDA (w x 10)",
+        "LS",
+        "OE",
+    ]
     for runs in results["runs"].values():
         assert [r["seed"] for r in runs] == [0, 1]
         assert all(r["nfev"] <= 300 for r in runs)
+        assert all(len(r["history"]) == r["nit"] + 1 for r in runs)
+    # The gain-scaled arms search at w x 10 but are scored at the default w.
+    w = results["options"]["gain"]
+    for run in results["runs"]["Eb-SDA (w x 10)"]:
+        assert run["gain"] == pytest.approx(10 * w)
+        assert run["search_cost"] == pytest.approx(10 * run["cost_estimation"])
+    assert results["rules"]["ebsda"]["r_c1"] == 100.0
+    assert results["rules"]["sda"]["radius"] == 0.95
     stats = results["statistics"]["SDA"]
     costs = [r["cost_estimation"] for r in results["runs"]["SDA"]]
     assert stats["cost_median"] == pytest.approx(np.median(costs))
@@ -234,12 +283,16 @@ def test_reproduce_on_the_real_arm(tmp_path):
         (["identify", "ARM", "--na", "-2"], "--na"),
         (["reproduce", "--data", "ARM", "--ts", "0.01", "--out", "."], "not empty"),
         (["validate", "nothing.json", "ARM"], "does not exist"),
+        (["validate", "garbage.json", "ARM"], "not a valid spiralid model"),
+        (["reproduce", "--ts", "0.01"], "give --data"),
+        (["reproduce", "--budget", "10"], "max_nfev"),
         (["simulate", "--fs", "0"], "--fs"),
         (["frobnicate"], "invalid choice"),
     ],
 )
 def test_bad_arguments_exit_2_with_one_line(tmp_path, args, message):
     (tmp_path / "keep.txt").write_text("user data")
+    (tmp_path / "garbage.json").write_text('{"theta": ["a"], "na": 1}')
     args = [str(ARM) if a == "ARM" else a for a in args]
     proc = run(*args, cwd=tmp_path)
     assert proc.returncode == 2

@@ -107,8 +107,12 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _load(path: str, input, output, ts):
-    """Read CSV, NPZ or MAT into IOData, with the defaults of `simulate` files."""
+def _load(path: str, input, output, ts, default_ts: float | None = None):
+    """Read CSV, NPZ or MAT into IOData, with the defaults of `simulate` files.
+
+    The sample time is `ts` if given, else the file's own (a ``time_s`` CSV
+    column, a ``ts`` variable), else `default_ts`.
+    """
     from spiralid.sysid import IOData
 
     file = Path(path)
@@ -122,6 +126,8 @@ def _load(path: str, input, output, ts):
             input = "torque_Nm" if written_by_us else "u"
         if output is None:
             output = "end_acceleration_m_s2" if written_by_us else "y"
+        if ts is None and "time_s" not in header:
+            ts = default_ts
         if ts is None:
             if "time_s" not in header:
                 raise UsageError(
@@ -146,7 +152,13 @@ def _load(path: str, input, output, ts):
                 f"--input/--output must be variable names for {suffix} files"
             )
         loader = IOData.from_npz if suffix == ".npz" else IOData.from_mat
-        return loader(file, input=input, output=output, ts=ts)
+        try:
+            return loader(file, input=input, output=output, ts=ts)
+        except ValueError:
+            if ts is not None or default_ts is None:
+                raise
+            # The file carries no `ts`: fall back to the caller's default.
+            return loader(file, input=input, output=output, ts=default_ts)
     raise UsageError(f"data file {path!r} must end in .csv, .npz or .mat")
 
 
@@ -200,17 +212,23 @@ def _cmd_simulate(args) -> int:
 
     rig = FlexibleManipulator(payload_mass=args.payload)
     fs = args.fs
+    paper = Experiment()
     if args.signal == "paper":
+        # One pulse per period, as many as the duration holds (even count: the
+        # hub returns to where it started).
+        n_pulses = max(2 * int(args.duration // (2 * paper.period)), 1)
         exp = Experiment(
-            amplitude=args.amplitude if args.amplitude is not None else 0.3,
+            amplitude=paper.amplitude if args.amplitude is None else args.amplitude,
+            width=paper.width if args.width is None else args.width,
             duration=args.duration,
             fs=fs,
-            n_pulses=max(int(args.duration // 1.0), 1),
+            n_pulses=n_pulses,
         )
         torque = exp.torque()
     elif args.signal == "bang-bang":
-        amp = 0.3 if args.amplitude is None else args.amplitude
-        torque = bang_bang(amp, args.width, 0.1, args.duration, fs)
+        amp = paper.amplitude if args.amplitude is None else args.amplitude
+        width = paper.width if args.width is None else args.width
+        torque = bang_bang(amp, width, paper.start, args.duration, fs)
     elif args.signal == "prbs":
         amp = 0.1 if args.amplitude is None else args.amplitude
         torque = prbs(amp, args.duration, fs)
@@ -272,9 +290,14 @@ def _cmd_identify(args) -> int:
     out = _out_dir(args.out, args.force)
     options = {}
     if args.method in ("sda", "ebsda", "lasda"):
-        options = {"n_points": args.points, "max_iter": args.iterations}
+        options = {"n_points": args.points}
         if args.budget is not None:
             options["max_nfev"] = args.budget
+        if args.iterations is not None:
+            options["max_iter"] = args.iterations
+        elif args.budget is not None:
+            # A budget of evaluations is the stop; iterations must not cut it.
+            options["max_iter"] = args.budget
     elif args.refine:
         raise UsageError("--refine applies to the spiral methods sda, ebsda, lasda")
     model = identify(
@@ -326,12 +349,14 @@ def _cmd_validate(args) -> int:
         raise UsageError(f"model file {args.model!r} does not exist")
     try:
         model = IdentifiedModel.from_dict(json.loads(path.read_text()))
-    except (json.JSONDecodeError, KeyError, TypeError) as exc:
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        message = " ".join(str(exc).split())
         raise UsageError(
-            f"{args.model!r} is not a spiralid model file ({exc})"
+            f"{args.model!r} is not a valid spiralid model file ({message})"
         ) from None
-    ts = args.ts if args.ts is not None else model.ts
-    data = _load(args.data, args.input, args.output, ts)
+    # The data's own sample time wins; validate() refuses one that differs
+    # from the model's. Only a file without one borrows the model's.
+    data = _load(args.data, args.input, args.output, args.ts, default_ts=model.ts)
     if args.fraction is not None:
         warm, data = data.split(args.fraction)
     else:
@@ -356,9 +381,12 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
         check_output_dir(args.out, args.force)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
-    data = None
+    data = source = None
     if args.data is not None:
         data = _load(args.data, args.input, args.output, args.ts)
+        source = {"kind": "user data", "path": str(Path(args.data).resolve())}
+    elif (args.input, args.output, args.ts) != (None, None, None):
+        raise UsageError("--input, --output and --ts describe --data; give --data too")
     bar = _progress(args, 1, "reproduce")
     try:
         rep = reproduce(
@@ -367,13 +395,12 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
             max_nfev=args.budget,
             n_points=args.points,
             initial=args.initial,
+            source=source,
             workers=args.workers,
             progress=bar,
         )
     finally:
         bar.close()
-    if args.data is not None:
-        rep.source["path"] = str(Path(args.data).resolve())
     command = "spiralid " + shlex.join(argv)
     write_reproduction(rep, args.out, force=args.force, command=command)
     if not args.quiet:
@@ -392,10 +419,10 @@ def build_parser() -> argparse.ArgumentParser:
         description="System identification with spiral dynamic optimisation "
         "(SDA and exponential-based SDA) for flexible structures.",
     )
-    from spiralid import __version__
+    from importlib.metadata import version
 
     parser.add_argument(
-        "--version", action="version", version=f"spiralid {__version__}"
+        "--version", action="version", version=f"spiralid {version('spiralid')}"
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
@@ -413,9 +440,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="torque input: 'paper' is the reproduction's train of bang-bang "
         "pulses (one per second), 'bang-bang' a single pulse pair (default paper)",
     )
-    p.add_argument("--amplitude", type=float, default=None, help="torque (N m)")
     p.add_argument(
-        "--width", type=_positive_float, default=0.04, help="bang-bang pulse width (s)"
+        "--amplitude", type=float, default=None, help="torque (N m); default 0.3"
+    )
+    p.add_argument(
+        "--width",
+        type=_positive_float,
+        default=None,
+        help="bang-bang pulse width (s); default 0.04",
     )
     p.add_argument(
         "--duration", type=_positive_float, default=6.0, help="record length (s)"
@@ -464,7 +496,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--points", type=_positive_int, default=50, help="search points")
     p.add_argument(
-        "--iterations", type=_positive_int, default=500, help="max iterations"
+        "--iterations",
+        type=_positive_int,
+        default=None,
+        help="max iterations (default 500, or no cap below --budget)",
     )
     p.add_argument(
         "--budget", type=_positive_int, default=None, help="max cost evaluations"

@@ -8,7 +8,16 @@ class Terminal(io.StringIO):
         return True
 
 
-def test_draws_on_a_terminal_only_after_the_delay():
+def test_waits_for_the_delay_but_draws_the_end():
+    out = Terminal()
+    bar = ProgressBar(4, "run", stream=out, delay=60.0)
+    bar(1)
+    assert out.getvalue() == ""
+    bar(4)
+    assert "4/4" in out.getvalue()
+
+
+def test_draws_on_a_terminal():
     out = Terminal()
     bar = ProgressBar(4, "run", stream=out, delay=0.0)
     bar(1)

@@ -4,8 +4,8 @@
 seeds with an equal budget of cost evaluations, adds the least-squares and
 output-error baselines, and returns a :class:`Reproduction` holding every
 model and every number. It computes only: figures are drawn by
-:mod:`spiralid.report.figures` and files written by :mod:`spiralid.report.html`
-and the command line.
+:mod:`spiralid.report.figures` and files written by
+:mod:`spiralid.report.output` and the command line.
 """
 
 from __future__ import annotations
@@ -81,6 +81,7 @@ class Run:
 
     def to_dict(self) -> dict:
         res = self.model.result
+        refined = self.model.refine_result
         return {
             "label": self.label,
             "seed": self.seed,
@@ -93,7 +94,10 @@ class Run:
             "nfev": getattr(res, "nfev", None),
             "nit": getattr(res, "nit", None),
             "message": getattr(res, "message", None),
+            "refine_nfev": getattr(refined, "nfev", None),
             "seconds": self.model.timings.get("total"),
+            "history": None if self.history is None else self.history.tolist(),
+            "times": None if self.times is None else self.times.tolist(),
         }
 
 
@@ -160,16 +164,19 @@ class Reproduction:
     def ranksum(self, a: str, b: str) -> dict:
         """Wilcoxon rank-sum test of the estimation costs of `a` against `b`.
 
+        Computed as the equivalent Mann-Whitney U test, exact for the small,
+        tie-free samples of a few seeds (SciPy's ``method="auto"``), where
+        the normal approximation of ``scipy.stats.ranksums`` is poor.
         ``p_two_sided`` tests for any difference; ``p_less`` for `a` lower.
         """
         ca = [r.cost for r in self.runs[a]]
         cb = [r.cost for r in self.runs[b]]
-        two = stats.ranksums(ca, cb)
-        less = stats.ranksums(ca, cb, alternative="less")
+        two = stats.mannwhitneyu(ca, cb, alternative="two-sided")
+        less = stats.mannwhitneyu(ca, cb, alternative="less")
         return {
             "a": a,
             "b": b,
-            "statistic": float(two.statistic),
+            "u_statistic": float(two.statistic),
             "p_two_sided": float(two.pvalue),
             "p_less": float(less.pvalue),
         }
@@ -263,6 +270,7 @@ def reproduce(
     fraction: float = 2 / 3,
     initial: str = "rest",
     configurations: Sequence[Configuration] = CONFIGURATIONS,
+    source: dict | None = None,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Reproduction:
@@ -292,6 +300,9 @@ def reproduce(
         that start in motion (the real arm, a slice of a periodic sweep).
     configurations : sequence of Configuration
         Default :data:`CONFIGURATIONS`.
+    source : dict, optional
+        How `data` was obtained, recorded in the results (e.g. its path);
+        default a description of the simulated rig when `data` is None.
     workers : int, optional
         Processes for the spiral runs; default the CPU count. ``1`` runs in
         this process.
@@ -303,17 +314,26 @@ def reproduce(
     Reproduction
     """
     t0 = time.perf_counter()
-    source = {"kind": "user data"}
     if data is None:
         data, source = default_data(), default_data_source()
+    source = {"kind": "user data"} if source is None else dict(source)
     if not isinstance(data, IOData):
         raise ValueError(f"`data` must be an IOData or None; got {type(data)!r}")
     arx = ARX(8, 8, 0) if arx is None else arx
     seed_list = list(range(seeds)) if isinstance(seeds, int) else list(seeds)
     if not seed_list:
         raise ValueError(f"`seeds` must give at least one seed; got {seeds!r}")
-    if isinstance(max_nfev, bool) or not isinstance(max_nfev, int) or max_nfev < 2:
-        raise ValueError(f"`max_nfev` must be an integer >= 2; got {max_nfev!r}")
+    if isinstance(n_points, bool) or not isinstance(n_points, int) or n_points < 2:
+        raise ValueError(f"`n_points` must be an integer >= 2; got {n_points!r}")
+    # The initial population alone costs n_points evaluations.
+    if (
+        isinstance(max_nfev, bool)
+        or not isinstance(max_nfev, int)
+        or max_nfev < n_points
+    ):
+        raise ValueError(
+            f"`max_nfev` must be an integer >= n_points = {n_points}; got {max_nfev!r}"
+        )
     est, val = data.split(fraction)
     arx.check_length(est, "data")
     gain = PaperCost(arx, est, predictor="simulation", initial=initial).w

@@ -108,12 +108,18 @@ def distributions(rep: Reproduction) -> Figure:
 
 
 def all_figures(rep: Reproduction) -> dict[str, Figure]:
-    """Every figure of the report, keyed by a file-name stem."""
-    return {
-        "fig6a_convergence": convergence(rep),
-        "fig6bc_estimation": estimation_response(rep),
-        "fig7ab_validation": validation_response(rep),
-        "fig7c_spectrum": spectrum(rep),
-        "pole_zero": pole_zero(rep),
-        "distributions": distributions(rep),
-    }
+    """Every figure of the report, keyed by a file-name stem.
+
+    The figures of the SDA vs Eb-SDA pair need both in the experiment.
+    """
+    figures = {}
+    if set(PAPER_PAIR) <= set(rep.runs):
+        figures |= {
+            "fig6a_convergence": convergence(rep),
+            "fig6bc_estimation": estimation_response(rep),
+            "fig7ab_validation": validation_response(rep),
+            "fig7c_spectrum": spectrum(rep),
+            "pole_zero": pole_zero(rep),
+        }
+    figures["distributions"] = distributions(rep)
+    return figures

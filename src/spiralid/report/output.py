@@ -75,6 +75,8 @@ def _versions() -> dict:
 
 def verdict(rep: Reproduction, a: str = "Eb-SDA", b: str = "SDA") -> str:
     """One sentence: did `a` beat `b` on estimation cost over the seeds?"""
+    if a not in rep.runs or b not in rep.runs:
+        return f"No {a} vs {b} comparison: the experiment ran neither or one of them."
     test = rep.ranksum(a, b)
     ma = rep.statistics(a)["cost_median"]
     mb = rep.statistics(b)["cost_median"]
@@ -114,7 +116,9 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
         },
         "structure": {"na": rep.arx.na, "nb": rep.arx.nb, "nk": rep.arx.nk},
         "seeds": rep.seeds,
-        "options": rep.options,
+        "options": {**rep.options, "penalty": _penalty(rep)},
+        "rules": _rules(),
+        "search_bounds": _bounds(rep),
         "configurations": [
             {
                 "label": c.label,
@@ -141,6 +145,33 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
         "baselines": {k: r.to_dict() for k, r in rep.baselines.items()},
         "runs": {k: [r.to_dict() for r in runs] for k, runs in rep.runs.items()},
     }
+
+
+def _penalty(rep: Reproduction) -> float:
+    return float(next(iter(rep.baselines.values())).model.penalty)
+
+
+def _rules() -> dict:
+    """The radius and angle rules' constants (SDA, eq. (7)-(8), linear)."""
+    from dataclasses import asdict
+
+    from spiralid.optim.rules import ConstantSpiral, ExponentialSpiral, LinearSpiral
+
+    return {
+        "sda": asdict(ConstantSpiral()),
+        "ebsda": asdict(ExponentialSpiral()),
+        "lasda": asdict(LinearSpiral()),
+    }
+
+
+def _bounds(rep: Reproduction) -> dict:
+    """The search box of each parametrisation, from the first run using it."""
+    out = {}
+    for c in rep.configurations:
+        bounds = rep.runs[c.label][0].model.bounds
+        if c.parametrization not in out and bounds is not None:
+            out[c.parametrization] = np.asarray(bounds).tolist()
+    return out
 
 
 def _table(header: list[str], rows: list[list], fmt: str = "text") -> str:
@@ -231,7 +262,8 @@ def summary_text(rep: Reproduction) -> str:
             f"{rep.arx} on {rep.data.output_name} ({rep.data.n} samples, ts = "
             f"{rep.data.ts:g} s; estimation {rep.estimation.n}, validation "
             f"{rep.validation.n}); {len(rep.seeds)} seeds, {d['max_nfev']} cost "
-            f"evaluations per run, {d['n_points']} points.",
+            f"evaluations per run (refine adds its own), {d['n_points']} points, "
+            f"simulation from {d['initial']}.",
             "",
             "Table-2 (best run of each method; cost = eq. (2), % of rms(y))",
             _table(_T2_HEAD, _table2_rows(rep)),
@@ -240,7 +272,7 @@ def summary_text(rep: Reproduction) -> str:
             _table(_STAT_HEAD, _stat_rows(rep)),
             "",
             verdict(rep),
-            f"Wall time {rep.elapsed:.1f} s.",
+            f"Experiment wall time {rep.elapsed:.1f} s.",
         ]
     )
 
@@ -287,16 +319,23 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "gain w = "
         f"{d['gain']:.4g} (cost = 100 rms(e)/rms(y)).<br>"
         f"Budget: {d['max_nfev']} cost evaluations per run, {d['n_points']} "
-        f"points, seeds {rep.seeds}. Wall time {rep.elapsed:.1f} s.</p>",
+        f"points, seeds {rep.seeds}; the local polish of '+ refine' adds its own "
+        f"evaluations. Experiment wall time {rep.elapsed:.1f} s.</p>",
         f"<h2>Verdict</h2><p><b>{e(verdict(rep))}</b></p>",
         "<h2>Table-2</h2><p>Best run of each method (lowest estimation cost). "
         "Error ranges are min and max of the free-run error y - y&#770; in "
         "output units.</p>",
         _table(_T2_HEAD, _table2_rows(rep), "html"),
-        "<p>The paper reports best fitness 35.85 (SDA) and 17.83 (Eb-SDA) on its "
-        "own rig and record, with error ranges [-0.1159, 0.1074] / [-0.1355, "
-        "0.1458] and [-0.0614, 0.0638] / [-0.0642, 0.0629]; its gain w is not "
-        "stated, so its fitness scale is unknown.</p>",
+        "<p>The paper's Table-2, on its own rig and record (its gain w is not "
+        "stated, so its fitness scale is unknown):</p>",
+        _table(
+            _T2_HEAD[:4],
+            [
+                [k, f"{v[0]:g}", _range(v[1]), _range(v[2])]
+                for k, v in PAPER_TABLE2.items()
+            ],
+            "html",
+        ),
         "<h2>Statistics over seeds</h2><p>Estimation cost (eq. (2) at the "
         "default gain) of every run; rank-sum tests of Eb-SDA against SDA:</p>",
         _table(_STAT_HEAD, _stat_rows(rep), "html"),
@@ -308,25 +347,41 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
             f"one-sided (lower) p = {t['p_less']:.3g}</li>"
         )
     parts.append("</ul>")
-    captions = {
-        "fig6a_convergence": "Figure 6a. Best cost against iteration and wall "
-        "time: median over seeds with the interquartile band.",
-        "fig6bc_estimation": "Figures 6b-c. Modelling part: measured end-point "
-        "output against the best SDA, Eb-SDA and OE models, and their errors.",
-        "fig7ab_validation": "Figures 7a-b. Validation part (models run over the "
-        "whole record), and errors.",
-        "fig7c_spectrum": "Figure 7c. Power spectral density of the validation "
-        "output: measured peaks labelled, model modes as dotted lines.",
-        "pole_zero": "Pole-zero map of the best SDA and Eb-SDA models.",
-        "distributions": "Every run: estimation cost and validation fit per "
-        "configuration, with LS and OE as dashed lines. The w x 0.1 and w x 10 "
-        "rows show how Eb-SDA moves when the unstated gain of eq. (2) is scaled.",
+    figures = {
+        "fig6a_convergence": (
+            "Figure 6a: convergence",
+            "Best cost against iteration and wall time: median over seeds with "
+            "the interquartile band.",
+        ),
+        "fig6bc_estimation": (
+            "Figures 6b-c: modelling part",
+            "Measured output against the best SDA, Eb-SDA and OE models (free "
+            "run), and their errors.",
+        ),
+        "fig7ab_validation": (
+            "Figures 7a-b: validation part",
+            "The models run over the whole record; the validation third and its "
+            "errors are shown.",
+        ),
+        "fig7c_spectrum": (
+            "Figure 7c: power spectral density",
+            "Validation output: measured peaks labelled, model modes as dotted lines.",
+        ),
+        "pole_zero": ("Pole-zero map", "The best SDA and Eb-SDA models."),
+        "distributions": (
+            "Every run",
+            "Estimation cost and validation fit per configuration, with LS and "
+            "OE as dashed lines. The 'w x 0.1' and 'w x 10' boxes show how "
+            "Eb-SDA moves when the unstated gain of eq. (2) is scaled (their "
+            "costs rescored at the default gain).",
+        ),
     }
     for stem, png in images.items():
+        title, caption = figures.get(stem, (stem, ""))
         b64 = base64.b64encode(png).decode("ascii")
         parts.append(
-            f"<h3>{e(stem)}</h3><img alt='{e(stem)}' src='data:image/png;base64,"
-            f"{b64}'><p class='caption'>{e(captions.get(stem, ''))}</p>"
+            f"<h3>{e(title)}</h3><img alt='{e(title)}' "
+            f"src='data:image/png;base64,{b64}'><p class='caption'>{e(caption)}</p>"
         )
     parts.append("<h2>Transfer functions (form of eq. (9)-(10))</h2><pre>")
     for label in [*rep.runs, *rep.baselines]:
@@ -339,7 +394,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
             [
                 label,
                 "yes" if v.stable else "NO",
-                f"{v.max_pole_radius:.4f}",
+                f"{v.max_pole_radius:.7f}",
                 "yes" if r.controllable else "no",
                 "yes" if r.observable else "no",
                 f"{r.min_pole_zero_distance:.3g}",

@@ -154,6 +154,11 @@ class IdentifiedModel:
                 f"`theta` must have shape ({self.arx.n_params},) for {self.arx}; "
                 f"got {self.theta.shape}"
             )
+        if not np.all(np.isfinite(self.theta)):
+            bad = int(np.flatnonzero(~np.isfinite(self.theta))[0])
+            raise ValueError(
+                f"`theta` must be finite; got {self.theta[bad]!r} at index {bad}"
+            )
 
     # -- model behaviour ---------------------------------------------------------
 
