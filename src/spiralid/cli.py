@@ -59,15 +59,21 @@ def _nonneg_int(text: str) -> int:
 
 
 def _positive_int(text: str) -> int:
-    value = _nonneg_int(text)
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer; got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be >= 1; got {text!r}")
     return value
 
 
 def _fraction(text: str) -> float:
-    value = _positive_float(text)
-    if not value < 1:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number; got {text!r}") from None
+    if not 0 < value < 1:
         raise argparse.ArgumentTypeError(f"must be in (0, 1); got {text!r}")
     return value
 
@@ -116,11 +122,17 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
     from spiralid.sysid import IOData
 
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise UsageError(f"data file {path!r} does not exist")
+    if not file.is_file():
+        raise UsageError(f"data file {path!r} is not a file")
     suffix = file.suffix.lower()
     if suffix == ".csv":
-        header = file.open().readline().strip().split(",")
+        try:
+            with file.open(encoding="utf-8") as fh:
+                header = [c.strip() for c in fh.readline().strip().split(",")]
+        except UnicodeDecodeError:
+            raise UsageError(f"data file {path!r} is not a text CSV file") from None
         written_by_us = "torque_Nm" in header
         if input is None:
             input = "torque_Nm" if written_by_us else "u"
@@ -163,10 +175,11 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
 
 
 def _new_file(path: Path, force: bool) -> Path:
+    """`path`, its folder created, refusing to overwrite without `force`."""
+    if path.is_dir():
+        raise UsageError(f"{str(path)!r} is a directory, not a file")
     if path.exists() and not force:
         raise UsageError(f"{str(path)!r} exists; pass --force to overwrite it")
-    if path.exists() and path.is_dir():
-        raise UsageError(f"{str(path)!r} is a directory")
     path.parent.mkdir(parents=True, exist_ok=True)
     return path
 
@@ -210,6 +223,10 @@ def _cmd_simulate(args) -> int:
         prbs,
     )
 
+    suffix = Path(args.out).suffix.lower()
+    if suffix not in (".csv", ".npz"):
+        raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
+    path = _new_file(Path(args.out), args.force)
     rig = FlexibleManipulator(payload_mass=args.payload)
     fs = args.fs
     paper = Experiment()
@@ -237,7 +254,6 @@ def _cmd_simulate(args) -> int:
         torque = chirp(amp, 1.0, min(100.0, fs / 2), args.duration, fs)
     sensors = Sensors(accel_noise=args.accel_noise, tach_noise=args.tach_noise)
     rec = rig.simulate(torque, fs=fs, rng=args.seed, sensors=sensors)
-    path = _new_file(Path(args.out), args.force)
     columns = {
         "time_s": rec.t,
         "torque_Nm": rec.u,
@@ -245,7 +261,7 @@ def _cmd_simulate(args) -> int:
         "hub_velocity_rad_s": rec.hub_velocity,
         "end_acceleration_m_s2": rec.end_acceleration,
     }
-    if path.suffix.lower() == ".npz":
+    if suffix == ".npz":
         np.savez(
             path,
             ts=np.float64(rec.ts),
@@ -253,7 +269,7 @@ def _cmd_simulate(args) -> int:
             y=rec.end_acceleration,
             **columns,
         )
-    elif path.suffix.lower() == ".csv":
+    else:
         np.savetxt(
             path,
             np.column_stack(list(columns.values())),
@@ -262,8 +278,6 @@ def _cmd_simulate(args) -> int:
             comments="",
             fmt="%.10g",
         )
-    else:
-        raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
     if not args.quiet:
         print(
             f"wrote {path} ({rec.u.size} samples at {fs:g} Hz; rig modes "
