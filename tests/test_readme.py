@@ -22,3 +22,12 @@ def test_readme_api_example_runs(monkeypatch, capsys):
     assert methods == ["ls", "oe", "ebsda", "ebsda"]
     # The data README's reference: least squares validates at about 95 %.
     assert abs(float(lines[0].split()[1]) - 95.0) <= 1.0
+
+
+def test_readme_figures_exist_and_no_placeholder_is_left():
+    text = (ROOT / "README.md").read_text()
+    assert "PLACEHOLDER" not in text
+    images = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", text)
+    assert images
+    for image in images:
+        assert (ROOT / image).stat().st_size > 10_000, image
