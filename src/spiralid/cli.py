@@ -38,44 +38,26 @@ def _column(value: str) -> str | int:
     return int(value) if value.isdigit() else value
 
 
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a number; got {text!r}") from None
-    if not np.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"must be a positive number; got {text!r}")
-    return value
+def _number(kind: type, allowed: str, ok):
+    """An argparse type: `kind` parsed from text, accepted when `ok` holds."""
+
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            what = "an integer" if kind is int else "a number"
+            raise argparse.ArgumentTypeError(f"must be {what}; got {text!r}") from None
+        if not (np.isfinite(value) and ok(value)):
+            raise argparse.ArgumentTypeError(f"must be {allowed}; got {text!r}")
+        return value
+
+    return parse
 
 
-def _nonneg_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer; got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0; got {text!r}")
-    return value
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer; got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1; got {text!r}")
-    return value
-
-
-def _fraction(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a number; got {text!r}") from None
-    if not 0 < value < 1:
-        raise argparse.ArgumentTypeError(f"must be in (0, 1); got {text!r}")
-    return value
+_positive_float = _number(float, "a positive number", lambda v: v > 0)
+_nonneg_int = _number(int, ">= 0", lambda v: v >= 0)
+_positive_int = _number(int, ">= 1", lambda v: v >= 1)
+_fraction = _number(float, "in (0, 1)", lambda v: 0 < v < 1)
 
 
 def _add_initial_option(p: argparse.ArgumentParser) -> None:
