@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spiralid.fms._checks import is_integer, nonneg, positive
+from spiralid._checks import is_integer, nonneg, positive
 
 __all__ = ["assemble", "element_matrices"]
 
@@ -75,9 +75,9 @@ def element_matrices(
     (1.0, 12.0)
     """
     le, ei, rho_a = (
-        positive(k, v) for k, v in (("le", le), ("ei", ei), ("rho_a", rho_a))
+        positive(v, k) for k, v in (("le", le), ("ei", ei), ("rho_a", rho_a))
     )
-    x0 = nonneg("x0", x0)
+    x0 = nonneg(x0, "x0")
     n = _hermite(_XI, le)
     me = rho_a * le * (n * _WXI) @ n.T
     ce = rho_a * le * (n * _WXI) @ (x0 + le * _XI)
@@ -134,10 +134,10 @@ def assemble(
     if not is_integer(n_elements) or n_elements < 1:
         raise ValueError(f"`n_elements` must be an integer >= 1; got {n_elements!r}")
     n = int(n_elements)
-    length = positive("length", length)
-    hub_inertia = positive("hub_inertia", hub_inertia)
-    payload_mass = nonneg("payload_mass", payload_mass)
-    payload_inertia = nonneg("payload_inertia", payload_inertia)
+    length = positive(length, "length")
+    hub_inertia = positive(hub_inertia, "hub_inertia")
+    payload_mass = nonneg(payload_mass, "payload_mass")
+    payload_inertia = nonneg(payload_inertia, "payload_inertia")
     ndof = 2 * n + 1
     # Work on the unconstrained node set (node 0 included), then drop node 0's
     # two coordinates: that is the clamp at the hub.

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid.fms._checks import is_integer, positive
+from spiralid._checks import is_integer, positive
 from spiralid.fms.rig import FlexibleManipulator, Recording
 from spiralid.fms.sensors import Sensors
 from spiralid.fms.signals import bang_bang
@@ -63,7 +63,7 @@ class Experiment:
         # The scalars first, so that a bad one is named before arithmetic on
         # it fails (round(nan) in torque(), say).
         for name in ("width", "period", "duration", "fs"):
-            positive(name, getattr(self, name))
+            positive(getattr(self, name), name)
         if not self.period >= 2 * self.width:
             raise ValueError(
                 f"`period` must be finite and >= 2 * width = {2 * self.width:g}; "

@@ -23,7 +23,7 @@ from functools import cached_property, lru_cache
 import numpy as np
 from scipy.linalg import eigh
 
-from spiralid.fms._checks import generator, is_integer, nonneg, positive, real_array
+from spiralid._checks import generator, is_integer, nonneg, positive, real_array
 from spiralid.fms._zoh import discretise_zoh, simulate_discrete
 from spiralid.fms.beam import assemble
 from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
@@ -165,11 +165,11 @@ class FlexibleManipulator:
             "density",
             "hub_inertia",
         ):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
+            object.__setattr__(self, name, positive(getattr(self, name), name))
         for name in ("payload_mass", "payload_inertia", "hub_friction"):
-            object.__setattr__(self, name, nonneg(name, getattr(self, name)))
+            object.__setattr__(self, name, nonneg(getattr(self, name), name))
         try:
-            z = nonneg("damping_ratio", self.damping_ratio)
+            z = nonneg(self.damping_ratio, "damping_ratio")
         except ValueError:
             z = math.nan
         if not z < 1.0:
@@ -377,8 +377,8 @@ class FlexibleManipulator:
         >>> round(float(rec.hub_angle[-1]) / (0.3 * 0.1**2 / rig.total_inertia), 2)
         1.0
         """
-        fs_v = positive("fs", fs)
-        u = real_array("torque", torque)
+        fs_v = positive(fs, "fs")
+        u = real_array(torque, "torque")
         if u.ndim == 2 and u.shape[1] == 1:
             u = u[:, 0]
         if u.ndim != 1 or u.size == 0:
@@ -399,7 +399,7 @@ class FlexibleManipulator:
         if x0 is None:
             x0v = np.zeros(2 * n)
         else:
-            x0v = real_array("x0", x0)
+            x0v = real_array(x0, "x0")
             if x0v.shape != (2 * n,) or not np.all(np.isfinite(x0v)):
                 raise ValueError(
                     f"`x0` must hold {2 * n} finite numbers (q, q'), shape "

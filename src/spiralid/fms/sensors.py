@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid.fms._checks import is_integer, nonneg, real
+from spiralid._checks import is_integer, nonneg, real
 
 __all__ = ["Sensors", "butterworth_ss", "quantise"]
 
@@ -83,7 +83,7 @@ class Sensors:
                 f"`quadrature` must be a positive integer; got {self.quadrature!r}"
             )
         for name in ("tach_noise", "accel_noise"):
-            object.__setattr__(self, name, nonneg(name, getattr(self, name)))
+            object.__setattr__(self, name, nonneg(getattr(self, name), name))
         order = self.antialias_order
         if not is_integer(order) or not 0 <= order <= 12:
             raise ValueError(
@@ -91,7 +91,7 @@ class Sensors:
                 f"got {self.antialias_order!r}"
             )
         try:
-            c = real("antialias_cutoff", self.antialias_cutoff)
+            c = real(self.antialias_cutoff, "antialias_cutoff")
         except ValueError:
             c = math.nan
         if not 0.0 < c <= 1.0:

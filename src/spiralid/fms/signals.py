@@ -8,14 +8,14 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _signal
 
-from spiralid.fms._checks import is_integer, positive, real
+from spiralid._checks import is_integer, positive, real
 
 __all__ = ["bang_bang", "chirp", "prbs"]
 
 
 def _nsamples(duration: float, fs: float) -> int:
-    duration = positive("duration", duration)
-    fs = positive("fs", fs)
+    duration = positive(duration, "duration")
+    fs = positive(fs, "fs")
     n = round(duration * fs)
     if n < 1:
         raise ValueError(
@@ -51,9 +51,9 @@ def bang_bang(
     >>> bang_bang(1.0, 0.2, 0.1, 0.6, 10.0)
     array([ 0.,  1.,  1., -1., -1.,  0.])
     """
-    amplitude = real("amplitude", amplitude)
-    width = positive("width", width)
-    start = real("start", start)
+    amplitude = real(amplitude, "amplitude")
+    width = positive(width, "width")
+    start = real(start, "start")
     if start < 0.0:
         raise ValueError(f"`start` must be >= 0; got {start!r}")
     n = _nsamples(duration, fs)
@@ -93,7 +93,7 @@ def prbs(
     >>> prbs(2.0, 0.7, 10.0, n_bits=3)
     array([ 2.,  2.,  2., -2.,  2., -2., -2.])
     """
-    amplitude = real("amplitude", amplitude)
+    amplitude = real(amplitude, "amplitude")
     n = _nsamples(duration, fs)
     if not is_integer(n_bits) or not 2 <= n_bits <= 32:
         raise ValueError(f"`n_bits` must be an integer in [2, 32]; got {n_bits!r}")
@@ -124,12 +124,12 @@ def chirp(
     >>> chirp(1.0, 0.0, 1.0, 1.0, 4.0).round(3)
     array([ 1.   ,  0.981,  0.707, -0.195])
     """
-    amplitude = real("amplitude", amplitude)
+    amplitude = real(amplitude, "amplitude")
     n = _nsamples(duration, fs)
     fs = float(fs)
     nyq = 0.5 * fs
     for name, f in (("f0", f0), ("f1", f1)):
-        v = real(name, f)
+        v = real(f, name)
         if not 0.0 <= v <= nyq:
             raise ValueError(f"`{name}` must be in [0, fs/2 = {nyq:g}] Hz; got {f!r}")
     methods = ("linear", "quadratic", "logarithmic", "hyperbolic")

@@ -16,8 +16,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from spiralid._checks import integer, real, real_array
 from spiralid.optim import _kernels
-from spiralid.optim._checks import integer, real, real_array
 
 __all__ = ["planes", "rotate", "rotation_matrix"]
 
@@ -84,7 +84,7 @@ def rotation_matrix(n: int, theta: float) -> np.ndarray:
            [ 1.,  0.]])
     """
     n = integer(n, "n", 1)
-    theta = real(theta, "theta")
+    theta = real(theta, "theta", strict=False)
     c, s = np.cos(theta), np.sin(theta)
     out = np.eye(n)
     # Right-multiplying by R_pq mixes columns p and q only: O(n) per factor.

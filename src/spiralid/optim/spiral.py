@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import Bounds
 
+from spiralid._checks import generator, integer, real_array
 from spiralid.optim import _kernels
-from spiralid.optim._checks import generator, integer, real_array
 from spiralid.optim.rotation import _sweep_order, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid.optim._checks import real_array
+from spiralid._checks import real_array
 
 __all__ = [
     "PROBLEMS",
