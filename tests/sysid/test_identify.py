@@ -56,6 +56,7 @@ def test_ls_recovers_theta(known):
         dict(method="ebsda", refine=True, rng=0),
         dict(method="ebsda", refine=True, rng=0, initial="measured"),
         dict(method="ebsda", refine=True, rng=1, parametrization="reflection"),
+        dict(method="de", refine=True, rng=0, max_nfev=5000),
     ],
 )
 def test_oe_and_refined_ebsda_fit_the_known_system(known, kwargs):
@@ -233,7 +234,11 @@ def test_oe_keeps_the_start_with_the_lower_cost(initial):
         ),
         (
             dict(method="ls", n_points=5),
-            "`optimiser_options` apply to the spiral methods",
+            "`optimiser_options` apply to the search methods",
+        ),
+        (
+            dict(method="de", target=1.0),
+            r"`optimiser_options` of method 'de' must be among .*; got \['target'\]",
         ),
         (dict(predictor="two-step"), "`predictor` must be one of .*; got 'two-step'"),
         (dict(method="oe", initial="zero"), "`initial` must be one of .*; got 'zero'"),
@@ -355,3 +360,15 @@ def test_rig_rest_criterion_validates_better_than_measured():
     # Measured: rest 95.85 %, measured 92.55 %.
     assert fits["rest"] > fits["measured"] + 2.0
     assert fits["rest"] > 95.0
+
+
+def test_differential_evolution_shares_the_spiral_methods_start(known):
+    est, _ = known.split()
+    fit = identify(est, ARX(2, 2, 1), method="de", rng=4, n_points=20, max_nfev=2000)
+    # Same cost, box and stable initial points as the spiral methods: the
+    # history starts at the best of those points and never rises.
+    assert fit.result.nfev <= 2000
+    assert fit.history.size == fit.result.nit + 1
+    assert np.all(np.diff(fit.history) <= 0)
+    assert fit.cost == pytest.approx(fit.history[-1])
+    assert fit.is_stable

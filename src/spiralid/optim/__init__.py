@@ -1,9 +1,11 @@
 """General-purpose spiral dynamic optimisers (SDA, Eb-SDA, linear adaptive SDA).
 
-Knows nothing of system identification. See :func:`minimize`.
+Knows nothing of system identification. See :func:`minimize`;
+:func:`differential_evolution` is the baseline beside them.
 """
 
 from spiralid.optim import testfunctions
+from spiralid.optim.evolution import differential_evolution
 from spiralid.optim.rotation import planes, rotate, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,
@@ -21,6 +23,7 @@ __all__ = [
     "SpiralResult",
     "SpiralRule",
     "SpiralSearch",
+    "differential_evolution",
     "exponential_rule",
     "minimize",
     "planes",

@@ -64,7 +64,7 @@ from typing import Any
 import numpy as np
 from scipy import optimize, signal
 
-from spiralid.optim import minimize
+from spiralid.optim import differential_evolution, minimize
 
 from .arx import ARX, arx_least_squares
 from .cost import INITIAL_CONDITIONS, PaperCost
@@ -80,7 +80,11 @@ __all__ = [
 ]
 
 _SPIRAL = ("sda", "ebsda", "lasda")
-_METHODS = ("ls", "oe", *_SPIRAL)
+# Population searches over the paper's cost: the spiral ones and, as the
+# baseline beside them, SciPy's differential evolution.
+_SEARCH = (*_SPIRAL, "de")
+_DE_OPTIONS = ("n_points", "max_iter", "max_nfev", "x0", "callback")
+_METHODS = ("ls", "oe", *_SEARCH)
 _PARAMETRIZATIONS = ("coefficients", "reflection")
 _KMAX = 1.0 - 1e-6
 
@@ -588,10 +592,13 @@ def identify(
         Estimation record.
     arx : ARX
         Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6).
-    method : {"ebsda", "sda", "lasda", "ls", "oe"}
+    method : {"ebsda", "sda", "lasda", "de", "ls", "oe"}
         Estimator (see the module docstring). ``"ls"`` minimises the
         one-step error and ``"oe"`` the simulation error whatever
         `predictor` says; `predictor` then only selects the reported cost.
+        ``"de"`` is SciPy's differential evolution over the same cost, box
+        and initial points as the spiral methods, a baseline beside them
+        (:func:`spiralid.optim.differential_evolution`).
     predictor : {"simulation", "one-step"}
         The error of the paper's cost (DESIGN.md item 3).
     parametrization : {"coefficients", "reflection"}
@@ -614,7 +621,9 @@ def identify(
         ``"measured"`` for records that start in motion.
     **optimiser_options
         Passed to :func:`spiralid.optim.minimize` (``n_points``, ``max_iter``,
-        ``max_nfev``, ``target``, ``callback``, ``bounds_policy``, ``x0``...).
+        ``max_nfev``, ``target``, ``callback``, ``bounds_policy``, ``x0``...);
+        for ``"de"`` only ``n_points``, ``max_iter``, ``max_nfev``, ``x0`` and
+        ``callback``.
 
     Returns
     -------
@@ -642,10 +651,15 @@ def identify(
             f"`parametrization` must be one of {_PARAMETRIZATIONS}; "
             f"got {parametrization!r}"
         )
-    if method not in _SPIRAL and optimiser_options:
+    if method not in _SEARCH and optimiser_options:
         raise ValueError(
-            f"`optimiser_options` apply to the spiral methods {_SPIRAL}; method "
+            f"`optimiser_options` apply to the search methods {_SEARCH}; method "
             f"{method!r} got {sorted(optimiser_options)}"
+        )
+    if method == "de" and set(optimiser_options) - set(_DE_OPTIONS):
+        raise ValueError(
+            f"`optimiser_options` of method 'de' must be among {_DE_OPTIONS}; got "
+            f"{sorted(set(optimiser_options) - set(_DE_OPTIONS))}"
         )
     cost = PaperCost(
         arx, data, predictor=predictor, gain=gain, penalty=penalty, initial=initial
@@ -730,9 +744,12 @@ def identify(
         if "x0" not in optimiser_options:
             m = int(optimiser_options.get("n_points", 50))
             optimiser_options["x0"] = feasible_initial_points(box, arx, m, gen)
-    res = minimize(
-        fun, box, method=method, rng=gen, vectorized=True, **optimiser_options
-    )
+    if method == "de":
+        res = differential_evolution(fun, box, rng=gen, **optimiser_options)
+    else:
+        res = minimize(
+            fun, box, method=method, rng=gen, vectorized=True, **optimiser_options
+        )
     t_search = time.perf_counter() - t_start
     theta = to_theta(res.x)
     best = cost(theta)
