@@ -237,6 +237,8 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
         "Eb-SDA + refine",
         "Eb-SDA (w x 0.1)",
         "Eb-SDA (w x 10)",
+        "DE",
+        "DE (reflection)",
         "LS",
         "OE",
     ]

@@ -285,7 +285,7 @@ def _cmd_identify(args) -> int:
     arx.check_length(est, "estimation part of DATA")
     out = _out_dir(args.out, args.force)
     options = {}
-    if args.method in ("sda", "ebsda", "lasda"):
+    if args.method in ("sda", "ebsda", "lasda", "de"):
         options = {"n_points": args.points}
         if args.budget is not None:
             options["max_nfev"] = args.budget
@@ -295,7 +295,7 @@ def _cmd_identify(args) -> int:
             # A budget of evaluations is the stop; iterations must not cut it.
             options["max_iter"] = args.budget
     elif args.refine:
-        raise UsageError("--refine applies to the spiral methods sda, ebsda, lasda")
+        raise UsageError("--refine applies to the search methods sda, ebsda, lasda, de")
     model = identify(
         est,
         arx,
@@ -476,7 +476,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (default 0)")
     p.add_argument(
-        "--method", choices=["ebsda", "sda", "lasda", "ls", "oe"], default="ebsda"
+        "--method", choices=["ebsda", "sda", "lasda", "de", "ls", "oe"], default="ebsda"
     )
     p.add_argument(
         "--predictor", choices=["simulation", "one-step"], default="simulation"

@@ -45,8 +45,10 @@ class Configuration:
 
 
 # The paper's comparison first (raw coefficients with the stability penalty),
-# then what we add: the stable-by-construction search, a local polish, and
-# Eb-SDA under a gain w scaled by 0.1 and 10 (the paper does not state w).
+# then what we add: the stable-by-construction search, a local polish,
+# Eb-SDA under a gain w scaled by 0.1 and 10 (the paper does not state w),
+# and SciPy's differential evolution at the same budget as another
+# population metaheuristic beside the spiral ones.
 CONFIGURATIONS: tuple[Configuration, ...] = (
     Configuration("SDA", "sda"),
     Configuration("Eb-SDA", "ebsda"),
@@ -55,6 +57,8 @@ CONFIGURATIONS: tuple[Configuration, ...] = (
     Configuration("Eb-SDA + refine", "ebsda", refine=True),
     Configuration("Eb-SDA (w x 0.1)", "ebsda", gain_scale=0.1),
     Configuration("Eb-SDA (w x 10)", "ebsda", gain_scale=10.0),
+    Configuration("DE", "de"),
+    Configuration("DE (reflection)", "de", "reflection"),
 )
 
 
@@ -283,7 +287,7 @@ def reproduce(
     seeds : int or sequence of int, default 6
         Seeds of the spiral runs (an int ``n`` means ``0..n-1``).
     max_nfev : int, default 20000
-        Budget of cost evaluations of every spiral run, the same for all so
+        Budget of cost evaluations of every search run, the same for all so
         that the algorithms compare at equal cost. ``max_iter`` is set high
         enough never to stop a run first.
     n_points : int, default 50
@@ -325,14 +329,15 @@ def reproduce(
         raise ValueError(f"`seeds` must give at least one seed; got {seeds!r}")
     if isinstance(n_points, bool) or not isinstance(n_points, int) or n_points < 2:
         raise ValueError(f"`n_points` must be an integer >= 2; got {n_points!r}")
-    # The initial population alone costs n_points evaluations.
+    # Every search needs its initial population and one iteration.
     if (
         isinstance(max_nfev, bool)
         or not isinstance(max_nfev, int)
-        or max_nfev < n_points
+        or max_nfev < 2 * n_points
     ):
         raise ValueError(
-            f"`max_nfev` must be an integer >= n_points = {n_points}; got {max_nfev!r}"
+            f"`max_nfev` must be an integer >= 2 * n_points = {2 * n_points}; "
+            f"got {max_nfev!r}"
         )
     est, val = data.split(fraction)
     arx.check_length(est, "data")
