@@ -112,4 +112,7 @@ def test_round_trip_property(k):
     a = step_up(k)
     assert is_stable_polynomial(a)
     assert np.abs(np.roots(np.r_[1.0, a])).max() < 1.0
-    np.testing.assert_allclose(step_down(a), k, rtol=0, atol=1e-9)
+    # Each step-down stage divides by 1 - k_i^2, so rounding grows with the
+    # product of those factors: the tolerance scales with that condition.
+    condition = np.prod(1.0 / (1.0 - k**2))
+    np.testing.assert_allclose(step_down(a), k, rtol=0, atol=1e-13 * condition)
