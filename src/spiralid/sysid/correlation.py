@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg, stats
 
-from .data import check_signal
+from .data import check_pair, check_signal
 
 __all__ = [
     "CorrelationTest",
@@ -159,12 +159,7 @@ def correlation(a, b, max_lag: int) -> np.ndarray:
     >>> np.round(r, 4).tolist()
     [0.25, 1.0, 0.25]
     """
-    a = check_signal(a, "a")
-    b = check_signal(b, "b")
-    if a.shape != b.shape:
-        raise ValueError(
-            f"`a` and `b` must have the same length; got {a.size} and {b.size}"
-        )
+    a, b = check_pair(a, b, "a", "b")
     n = a.size
     max_lag = check_lags(max_lag, n)
     a = a - a.mean()
@@ -296,12 +291,7 @@ def independence_test(
     >>> independence_test(u, np.convolve(u, [0.0, 1.0, 0.5])[:1000]).passed[0.99]
     False
     """
-    u = check_signal(u, "u")
-    e = check_signal(e, "e")
-    if u.shape != e.shape:
-        raise ValueError(
-            f"`u` and `e` must have the same length; got {u.size} and {e.size}"
-        )
+    u, e = check_pair(u, e, "u", "e")
     n = e.size
     lags = check_lags(lags, n)
     levels = _check_levels(levels)

@@ -45,6 +45,18 @@ def check_signal(x, name: str, min_size: int = 1) -> np.ndarray:
     return arr
 
 
+def check_pair(a, b, name_a: str, name_b: str) -> tuple[np.ndarray, np.ndarray]:
+    """Two signals through :func:`check_signal`, refused unless equally long."""
+    a = check_signal(a, name_a)
+    b = check_signal(b, name_b)
+    if a.size != b.size:
+        raise ValueError(
+            f"`{name_a}` and `{name_b}` must have the same length; "
+            f"got {a.size} and {b.size}"
+        )
+    return a, b
+
+
 def _frozen_signal(x, name: str) -> np.ndarray:
     # A private read-only copy: IOData is immutable, and freezing the
     # caller's own array instead would make it read-only behind their back.

@@ -30,7 +30,7 @@ from .correlation import (
     independence_test,
     whiteness_test,
 )
-from .data import check_signal
+from .data import check_pair
 from .spectra import PSD, Modes, Peaks, find_resonances, modes_from_poles, psd
 
 __all__ = [
@@ -43,17 +43,6 @@ __all__ = [
 ]
 
 _RESIDUALS = ("one-step", "simulation")
-
-
-def _pair(y, yhat, name_y="y", name_yhat="yhat") -> tuple[np.ndarray, np.ndarray]:
-    a = check_signal(y, name_y)
-    b = check_signal(yhat, name_yhat)
-    if a.size != b.size:
-        raise ValueError(
-            f"`{name_y}` and `{name_yhat}` must have the same length; "
-            f"got {a.size} and {b.size}"
-        )
-    return a, b
 
 
 def fit_percent(y, yhat) -> float:
@@ -81,7 +70,7 @@ def fit_percent(y, yhat) -> float:
     >>> round(fit_percent([1.0, 2.0, 3.0], [1.0, 2.0, 4.0]), 6)
     29.289322
     """
-    a, b = _pair(y, yhat)
+    a, b = check_pair(y, yhat, "y", "yhat")
     scale = np.linalg.norm(a - a.mean())
     if scale == 0.0:
         raise ValueError(
@@ -99,7 +88,7 @@ def rmse(y, yhat) -> float:
     >>> rmse([0.0, 0.0], [3.0, 4.0])  # sqrt((9 + 16) / 2)
     3.5355339059327378
     """
-    a, b = _pair(y, yhat)
+    a, b = check_pair(y, yhat, "y", "yhat")
     return float(np.sqrt(np.mean((a - b) ** 2)))
 
 
@@ -675,8 +664,8 @@ def validate(
             f"output overflows on this record of N = {n} samples; a free-run "
             "validation of it is meaningless"
         )
-    y, y_sim = _pair(y, y_sim, "data.y", "model.simulate(data.u)")
-    y, y_pred = _pair(y, y_pred, "data.y", "model.predict(data)")
+    y, y_sim = check_pair(y, y_sim, "data.y", "model.simulate(data.u)")
+    y, y_pred = check_pair(y, y_pred, "data.y", "model.predict(data)")
     e_sim, e_pred = y - y_sim, y - y_pred
 
     # Eq. (2)-(3) on the very errors the fit and error range are computed
