@@ -369,6 +369,27 @@ class SpiralSearch:
         self.history.append(self._best_cost())
         return self.x, float(self._f[0])
 
+    def move_centre(self, x, fun: float) -> bool:
+        """Replace the centre by `x` of cost `fun` if that is lower.
+
+        For a point found outside the spiral moves, e.g. a local polish of
+        the centre in a memetic search; the rule's next moves rotate about
+        it. It must lie within the bounds. Returns whether it was taken.
+        """
+        pt = np.asarray(x, dtype=np.float64)
+        if pt.shape != self._lo.shape or not np.all(np.isfinite(pt)):
+            raise ValueError(
+                f"`x` must be a finite vector of shape {self._lo.shape}; got {x!r}"
+            )
+        if np.any((pt < self._lo) | (pt > self._hi)):
+            raise ValueError("`x` must lie within `bounds`")
+        if not (math.isfinite(fun) and fun < self._f[0]):
+            return False
+        self._x[0] = pt
+        self._f[0] = fun
+        self.history[-1] = self._best_cost()
+        return True
+
     def __iter__(self):
         return self
 
