@@ -137,6 +137,17 @@ def test_same_theta_and_cost_as_before_the_refactor(name, kwargs):
     assert run(EST, kwargs) == PINNED[name]
 
 
+BUDGETED = [(n, kw) for n, kw in CASES if "max_nfev" in kw]
+
+
+@pytest.mark.parametrize(("name", "kwargs"), BUDGETED, ids=[n for n, _ in BUDGETED])
+def test_the_budget_rule_gives_the_same_runs(name, kwargs):
+    # reproduce() used to pass max_iter = 10 x max_nfev; the one budget rule
+    # (max_iter = max_nfev when only a budget is given) stops them alike.
+    kwargs = {k: v for k, v in kwargs.items() if k != "max_iter"}
+    assert run(EST, kwargs) == PINNED[name]
+
+
 if __name__ == "__main__":
     est, todo = cases()
     PINS.write_text(json.dumps({name: run(est, kw) for name, kw in todo}, indent=1))
