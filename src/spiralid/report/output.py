@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from spiralid.report.experiment import Reproduction
+from spiralid.sysid.polynomials import format_pole_radius
 
 __all__ = [
     "OUTPUT_FILES",
@@ -126,6 +127,7 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
                 "parametrization": c.parametrization,
                 "gain_scale": c.gain_scale,
                 "refine": c.refine,
+                "safe_start": c.safe_start,
             }
             for c in rep.configurations
         ],
@@ -152,16 +154,12 @@ def _penalty(rep: Reproduction) -> float:
 
 
 def _rules() -> dict:
-    """The radius and angle rules' constants (SDA, eq. (7)-(8), linear)."""
+    """The radius and angle rules' constants (SDA, eq. (7)-(8), linear...)."""
     from dataclasses import asdict
 
-    from spiralid.optim.rules import ConstantSpiral, ExponentialSpiral, LinearSpiral
+    from spiralid.optim import RULES
 
-    return {
-        "sda": asdict(ConstantSpiral()),
-        "ebsda": asdict(ExponentialSpiral()),
-        "lasda": asdict(LinearSpiral()),
-    }
+    return {name: asdict(rule()) for name, rule in RULES.items()}
 
 
 def _bounds(rep: Reproduction) -> dict:
@@ -394,7 +392,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
             [
                 label,
                 "yes" if v.stable else "NO",
-                f"{v.max_pole_radius:.7f}",
+                format_pole_radius(v.max_pole_radius),
                 "yes" if r.controllable else "no",
                 "yes" if r.observable else "no",
                 f"{r.min_pole_zero_distance:.3g}",
@@ -432,7 +430,11 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "coefficients); the paper's runs search raw coefficients with the "
         "penalty, the '(reflection)' rows search reflection coefficients.</li>"
         "<li>2/3 of the record estimates, 1/3 validates; validation fit is "
-        "MATLAB's compare fit of the free run.</li></ul>"
+        "MATLAB's compare fit of the free run.</li>"
+        "<li>Stable means every pole has |z| &lt; 1, decided by the Schur-Cohn "
+        "test on the coefficients (the penalty's test, margin zero), the same "
+        "verdict everywhere; a radius within 1e-4 of the circle is printed as "
+        "its distance from 1.</li></ul>"
         "</body></html>"
     )
     return "".join(parts)

@@ -31,6 +31,7 @@ from .correlation import (
     whiteness_test,
 )
 from .data import check_pair
+from .polynomials import format_pole_radius, is_stable_polynomial, max_pole_radius
 from .spectra import PSD, Modes, Peaks, find_resonances, modes_from_poles, psd
 
 __all__ = [
@@ -280,9 +281,12 @@ class Validation:
     modes : Modes
         Lightly damped modes of the model, from its poles.
     stable : bool
-        All poles strictly inside the unit circle.
+        All poles strictly inside the unit circle: spiralid's one stability
+        verdict (:func:`~spiralid.sysid.polynomials.is_stable_polynomial`,
+        the same as ``model.is_stable`` and the cost's penalty).
     max_pole_radius : float
-        Largest ``|p|``.
+        Largest ``|p|``, on the verdict's side of the unit circle
+        (:func:`~spiralid.sysid.polynomials.max_pole_radius`).
     realization : Realization
         Controllability / observability of the state-space realisation.
     poles, zeros : ndarray of complex
@@ -382,7 +386,10 @@ class Validation:
                 or "none",
             ),
             ("PSD resolution (Hz)", f"{self.psd_measured.resolution:.3g}"),
-            ("stable (max |pole|)", f"{self.stable} ({self.max_pole_radius:.4f})"),
+            (
+                "stable (max |pole|)",
+                f"{self.stable} ({format_pole_radius(self.max_pole_radius)})",
+            ),
             (
                 "controllable / observable",
                 f"{rz.controllable} / {rz.observable} (order {rz.order})",
@@ -643,8 +650,12 @@ def validate(
     penalty = float(getattr(model, "penalty", 1e6))
     poles = np.asarray(_attr(model, "poles"), dtype=complex)
     zeros = np.asarray(_attr(model, "zeros"), dtype=complex)
-    max_radius = float(np.max(np.abs(poles))) if poles.size else 0.0
-    stable = max_radius < 1.0
+    # The one stability verdict (Schur-Cohn on the coefficients, see
+    # spiralid.sysid.polynomials), not |np.roots| < 1, which misjudges
+    # clustered poles near the circle.
+    denominator = np.asarray(model.theta, dtype=float)[: model.arx.na]
+    stable = bool(is_stable_polynomial(denominator))
+    max_radius = float(max_pole_radius(denominator))
 
     if warmup is None:
         y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
@@ -660,7 +671,8 @@ def validate(
         y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[wu.size :]
     if y_sim.size == n and not np.all(np.isfinite(y_sim)):
         raise ValueError(
-            f"`model` is unstable (max |pole| = {max_radius:.6g}) and its free-run "
+            f"`model` is unstable (max |pole| = {format_pole_radius(max_radius)}) "
+            "and its free-run "
             f"output overflows on this record of N = {n} samples; a free-run "
             "validation of it is meaningless"
         )
