@@ -20,13 +20,16 @@ points):
 - ``VP``: Eb-SDA over reflection coefficients, numerator projected out.
 - ``modal+VP`` (SDA and Eb-SDA): modal denominator, numerator projected.
 - ``modal+VP+restart``: the same with restarts after 20 stalled iterations.
-- ``modal+VP+fseed``: half the first population at the frequency
+- ``modal+VP+fseed``: 25 of the 50 first points at the frequency
   response's peaks.
+- ``modal+VP+safe``: the first population holds the stabilised LS,
+  Steiglitz-McBride and zero models.
 - ``modal+VP+memetic``: Levenberg-Marquardt polish of the centre every 5
   iterations (10 evaluations each).
-- ``spiral``: the recommended combination (``identify(method="spiral")``):
-  Eb-SDA, modal, VP, memetic, restarts, safe starts (stabilised LS,
-  Steiglitz-McBride).
+- ``spiral (no gradient)``: restarts and safe starts, no polish.
+- ``spiral``: the recommended method, ``identify(method="spiral")`` at its
+  default budget of 10,000 evaluations: Eb-SDA, modal, VP, memetic,
+  restarts, safe starts.
 - ``DE``: SciPy's differential evolution over the paper's cost.
 - ``CMA-ES``: pycma (``cma``, the ``bench`` extra) over the paper's cost in
   raw coefficients, started at the stabilised least-squares estimate with
@@ -44,7 +47,8 @@ from rest over the whole record, scored on the last third), median wall
 time per identification, and the machine load.
 
 Run: ``python benchmarks/identification.py [--seeds 20] [--budget 20000]
-[--records rig,arm] [--methods spiral,OE] [--workers 2] [--json out.json]``.
+[--records rig,arm] [--methods spiral,OE] [--workers 2] [--jsonl runs.jsonl]``;
+``--summarise runs.jsonl`` prints the tables of a finished or partial run.
 BLAS is pinned to one thread: on a shared machine OpenBLAS threads
 oversubscribe and small dense kernels get tens of times slower.
 """
@@ -66,7 +70,7 @@ import numpy as np
 from spiralid.optim import minimize
 from spiralid.sysid import ARX, IOData, PaperCost, identify
 from spiralid.sysid.identify import default_bounds
-from spiralid.sysid.memetic import modal_spiral, projected_spiral
+from spiralid.sysid.memetic import projected_spiral
 from spiralid.sysid.modal import ModalParametrization
 from spiralid.sysid.polynomials import fold_reflection, step_up
 from spiralid.sysid.validate import fit_percent
@@ -171,40 +175,33 @@ def _modal(est):
     return ModalParametrization(8, est.ts)
 
 
-def _fseed(est, seed, budget):
-    return modal_spiral(
-        est,
-        ARX_8,
-        polish_every=None,
-        restart_after=None,
-        safe_starts=False,
-        seeds=25,
-        rng=seed,
-        max_nfev=budget,
-    ).x
+def _identify(method, parametrization=None, budget_cap=None, **kw):
+    def run(est, seed, budget):
+        if budget_cap is not None:
+            budget = min(budget, budget_cap)
+        return identify(
+            est,
+            ARX_8,
+            method=method,
+            parametrization=parametrization,
+            rng=seed,
+            max_nfev=budget,
+            **kw,
+        ).theta
 
-
-def _spiral(est, seed, budget):
-    return modal_spiral(est, ARX_8, rng=seed, max_nfev=budget).x
-
-
-def _spiral_free(est, seed, budget):
-    """Best without any gradient step: no polish, no Steiglitz-McBride."""
-    return modal_spiral(
-        est, ARX_8, polish_every=None, steiglitz=False, rng=seed, max_nfev=budget
-    ).x
+    return run
 
 
 def _cma_coefficients(est, seed, budget):
     import cma
 
-    from spiralid.sysid.memetic import safe_denominators
+    from spiralid.sysid.parametrizations import Coefficients
 
     cost = PaperCost(ARX_8, est)
     box = default_bounds(est, ARX_8)
     half = 0.5 * (box[:, 1] - box[:, 0])
     ls = identify(est, ARX_8, method="ls").theta
-    x0 = np.r_[safe_denominators(est, ARX_8, steiglitz=False)[0], ls[8:]]
+    x0 = Coefficients(est, ARX_8).from_theta(ls)  # stabilised LS
     es = cma.CMAEvolutionStrategy(
         x0,
         0.1,
@@ -253,13 +250,32 @@ METHODS = {
     "Eb-SDA": (_paper("ebsda"), False, False),
     "modal": (_modal_only, False, False),
     "VP": (_projected(lambda est: _Reflection(8)), False, False),
-    "modal+VP (SDA)": (_projected(_modal, "sda"), False, False),
-    "modal+VP": (_projected(_modal), False, False),
+    "modal+VP (SDA)": (_identify("sda", "modal"), False, False),
+    "modal+VP": (_identify("ebsda", "modal"), False, False),
     "modal+VP+restart": (_projected(_modal, restart_after=20), False, False),
-    "modal+VP+fseed": (_fseed, False, False),
-    "modal+VP+memetic": (_projected(_modal, polish_every=5), True, False),
-    "spiral (no gradient)": (_spiral_free, False, False),
-    "spiral": (_spiral, True, False),
+    "modal+VP+fseed": (
+        _identify(
+            "spiral",
+            polish_every=None,
+            restart_after=None,
+            safe_start=False,
+            frequency_seeds=25,
+        ),
+        False,
+        False,
+    ),
+    "modal+VP+safe": (
+        _identify("spiral", polish_every=None, restart_after=None),
+        False,
+        False,
+    ),
+    "modal+VP+memetic": (
+        _identify("spiral", restart_after=None, safe_start=False),
+        True,
+        False,
+    ),
+    "spiral (no gradient)": (_identify("spiral", polish_every=None), False, False),
+    "spiral": (_identify("spiral", budget_cap=10_000), True, False),
     "DE": (_paper("de"), False, False),
     "CMA-ES": (_cma_coefficients, False, False),
     "CMA-ES (modal+VP)": (_cma_modal, False, False),
@@ -320,24 +336,50 @@ def main(argv=None):
     ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--arm", default=None, help="path of daisy_robot_arm.csv")
-    ap.add_argument("--json", default=None, help="write every run here")
+    ap.add_argument(
+        "--jsonl", default=None, help="append every run here as it finishes"
+    )
+    ap.add_argument(
+        "--summarise",
+        default=None,
+        metavar="JSONL",
+        help="print the tables of a (possibly partial) --jsonl file and exit",
+    )
     args = ap.parse_args(argv)
     records = args.records.split(",")
     methods = args.methods.split(",")
     for m in methods:
         if m not in METHODS:
             ap.error(f"--methods: unknown {m!r}; choose from {list(METHODS)}")
+    if args.summarise:
+        lines = Path(args.summarise).read_text().splitlines()
+        rows = [json.loads(line) for line in lines if line.strip()]
+        print(summarise(rows, records, methods))
+        print(f"\n{len(rows)} identifications in {args.summarise}")
+        return
+    # Seed-major order: a run stopped early still has every method and
+    # record, with fewer seeds.
     tasks = []
-    for record in records:
-        for method in methods:
-            n = 1 if METHODS[method][2] else args.seeds
-            tasks += [(record, method, s, args.budget, args.arm) for s in range(n)]
-    # Warm the compiled kernels once before timing anything.
+    for seed in range(args.seeds):
+        for record in records:
+            for method in methods:
+                if METHODS[method][2] and seed > 0:
+                    continue
+                tasks.append((record, method, seed, args.budget, args.arm))
+    # Warm the compiled kernels (and Numba's cache) once before timing.
     run_one(("rig", "spiral", 0, 2000, args.arm))
     t0 = time.perf_counter()
     load0 = os.getloadavg()
+    sink = open(args.jsonl, "a") if args.jsonl else None
+    rows = []
     with ProcessPoolExecutor(args.workers) as pool:
-        rows = list(pool.map(run_one, tasks, chunksize=1))
+        for row in pool.map(run_one, tasks, chunksize=1):
+            rows.append(row)
+            if sink is not None:
+                sink.write(json.dumps(row) + "\n")
+                sink.flush()
+    if sink is not None:
+        sink.close()
     wall = time.perf_counter() - t0
     print(summarise(rows, records, methods))
     print(
@@ -345,8 +387,6 @@ def main(argv=None):
         f"{args.workers} workers: {wall:.0f} s wall; load average at start "
         f"{load0[0]:.2f}, at end {os.getloadavg()[0]:.2f}"
     )
-    if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=1))
 
 
 if __name__ == "__main__":

@@ -98,7 +98,9 @@ def test_identify_then_validate(rig_csv, tmp_path):
     model = IdentifiedModel.from_dict(
         json.loads((tmp_path / "m" / "model.json").read_text())
     )
-    assert model.method == "ebsda" and model.theta.shape == (16,)
+    # The default method is the recommended one, over the modes.
+    assert model.method == "spiral" and model.parametrization == "modal"
+    assert model.theta.shape == (16,) and model.is_stable
     saved_model = json.loads((tmp_path / "m" / "model.json").read_text())
     # --budget, not the default 500 iterations, stops the search.
     assert 350 < saved_model["result"]["nfev"] <= 400
@@ -239,6 +241,7 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
         "Eb-SDA (w x 10)",
         "DE",
         "DE (reflection)",
+        "spiral (recommended)",
         "LS",
         "OE",
     ]

@@ -487,7 +487,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--parametrization",
         choices=list(PARAMETRIZATIONS),
-        default="coefficients",
+        default=None,
+        help="what a search moves (default: the method's; modal for spiral)",
     )
     _add_initial_option(p)
     p.add_argument(

@@ -123,8 +123,16 @@ def _stabilised_ls(data, arx):
     return np.r_[step_up(k_b[: arx.na]), k_b[arx.na :]]
 
 
-@pytest.mark.parametrize("parametrization", list(PARAMETRIZATIONS))
-@pytest.mark.parametrize("method", SEARCHES)
+@pytest.mark.parametrize(
+    "method, parametrization",
+    [
+        (m, p)
+        for m in SEARCHES
+        for p in PARAMETRIZATIONS
+        # The recommended method searches the modes only.
+        if m != "spiral" or p == "modal"
+    ],
+)
 def test_no_safe_search_is_worse_than_the_zero_model_or_least_squares(
     record, method, parametrization
 ):
@@ -136,9 +144,16 @@ def test_no_safe_search_is_worse_than_the_zero_model_or_least_squares(
         fit = identify(record, ARX4, rng=seed, max_nfev=100, safe_start=True, **kw)
         assert fit.cost <= floor
         assert fit.result.safe_start
+    if method == "spiral":
+        # Its polish reaches below least squares without the safe start too,
+        # so the check below cannot fail for it.
+        return
     # The test can fail: without the safe start short searches end above
     # least squares on this record.
-    plain = [identify(record, ARX4, rng=s, max_nfev=100, **kw).cost for s in range(3)]
+    plain = [
+        identify(record, ARX4, rng=s, max_nfev=100, safe_start=False, **kw).cost
+        for s in range(3)
+    ]
     assert max(plain) > floor
 
 

@@ -243,7 +243,7 @@ def test_oe_keeps_the_start_with_the_lower_cost(initial):
         (dict(predictor="two-step"), "`predictor` must be one of .*; got 'two-step'"),
         (dict(method="oe", initial="zero"), "`initial` must be one of .*; got 'zero'"),
         (
-            dict(bounds=np.zeros((3, 2))),
+            dict(method="ebsda", bounds=np.zeros((3, 2))),
             r"`bounds` must have shape \(4, 2\); got shape \(3, 2\)",
         ),
     ],

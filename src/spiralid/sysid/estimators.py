@@ -73,6 +73,7 @@ methods. :data:`DEFAULT_METHOD` is the default of ``identify`` and of
 
 from __future__ import annotations
 
+import copy
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -194,6 +195,8 @@ class Method:
         Default of ``identify(safe_start=None)`` (see the module docstring).
     summary : str
         One line for help texts.
+    parametrization : str
+        Default of ``identify(parametrization=None)``.
     """
 
     estimate: Callable[..., EstimatorResult]
@@ -201,6 +204,7 @@ class Method:
     options: tuple[str, ...] | None = None
     safe_start: bool = False
     summary: str = ""
+    parametrization: str = "coefficients"
 
 
 def search_options(options: dict) -> dict:
@@ -395,6 +399,118 @@ def _estimate_de(problem: Problem, **options) -> EstimatorResult:
     return _search(problem, run, options, per_iteration=lambda m: m)
 
 
+def _estimate_recommended(
+    problem: Problem,
+    *,
+    rule: str = "ebsda",
+    n_points: int = 50,
+    max_nfev: int | None = None,
+    polish_every: int | None = 5,
+    polish_nfev: int = 10,
+    restart_after: int | None = 20,
+    frequency_seeds: int = 0,
+    x0=None,
+    max_iter: int | None = None,
+    callback=None,
+) -> EstimatorResult:
+    """``"spiral"``: the recommended spiral identification.
+
+    A spiral search (`rule`, default Eb-SDA) over the modal coordinates of
+    the denominator with the numerator projected out
+    (:class:`~spiralid.sysid.parametrizations.Modal`), its centre polished
+    every `polish_every` iterations by `polish_nfev` evaluations of
+    Levenberg-Marquardt on the projected problem, a fresh population after
+    `restart_after` iterations without progress
+    (:func:`~spiralid.sysid.memetic.projected_spiral`), `frequency_seeds`
+    initial points at the frequency response's peaks, and with the safe
+    start the stabilised least-squares, Steiglitz-McBride and zero models in
+    the first population (the result is never worse than their projected
+    models). Default budget ``max_nfev = 10_000`` evaluations, polish
+    included (measured in ``benchmarks/identification.py``).
+    """
+    from .memetic import frequency_seeds as peak_seeds
+    from .memetic import projected_spiral
+    from .parametrizations import Modal, stabilise
+    from .polynomials import step_up
+
+    t0 = time.perf_counter()
+    par = problem.parametrization
+    if not isinstance(par, Modal):
+        raise ValueError(
+            "`parametrization` must be 'modal' for method 'spiral' (it searches "
+            f"the modes with the numerator projected out); got {par.name!r}"
+        )
+    cost = par.projected(problem.cost)
+    box = par.default_bounds() if problem.bounds is None else problem.bounds
+    modes = copy.copy(par.modes)
+    modes.bounds = box
+    budget = 10_000 if max_nfev is None else int(max_nfev)
+    rows = []
+    safe = None
+    if problem.safe_start:
+        theta_ls = par.theta_ls
+        models = (
+            theta_ls,
+            steiglitz_mcbride(problem.data, problem.arx, theta_ls),
+            np.zeros(problem.arx.n_params),
+        )
+        rows = [par.from_theta(th) for th in models]
+        na = problem.arx.na
+        safe = np.array(
+            [step_up(stabilise(theta_ls, problem.arx)[:na]), models[1][:na]]
+        )
+    if frequency_seeds:
+        rows += list(peak_seeds(problem.data, modes, int(frequency_seeds), problem.rng))
+    if x0 is not None:
+        rows += list(np.atleast_2d(np.asarray(x0, dtype=float)))
+    start = np.clip(np.array(rows[:n_points]), box[:, 0], box[:, 1]) if rows else None
+    raw = projected_spiral(
+        cost,
+        modes,
+        rule,
+        n_points=n_points,
+        max_nfev=budget,
+        polish_every=polish_every,
+        polish_nfev=polish_nfev,
+        restart_after=restart_after,
+        x0=start,
+        max_iter=max_iter,
+        callback=callback,
+        rng=problem.rng,
+    )
+    theta, kept = raw.x, "search"
+    if safe is not None:
+        # The exact projected models of the safe starts (the modal map of a
+        # start can only approximate poles it cannot represent).
+        f_safe, b_safe = cost.evaluate(safe)
+        i = int(np.argmin(f_safe))
+        if f_safe[i] < raw.fun:
+            theta = np.r_[safe[i], b_safe[i]]
+            kept = ("ls", "steiglitz-mcbride")[i]
+    result = EstimatorResult(
+        x=theta,
+        fun=float(problem.cost(theta)),
+        status=int(raw.status),
+        success=True,
+        message=str(raw.message),
+        nfev=int(raw.nfev),
+        nit=int(raw.nit),
+        history=raw.history,
+        elapsed=time.perf_counter() - t0,
+        x_search=raw.z,
+        bounds=box,
+        safe_start=problem.safe_start,
+        start=kept,
+        n_polish=raw.n_polish,
+        n_restarts=raw.n_restarts,
+        refine=None,
+        raw=raw,
+    )
+    if problem.refine:
+        _refine(problem, result)
+    return result
+
+
 # One entry per method; its key is the name users pass.
 METHODS: dict[str, Method] = {
     **{
@@ -409,8 +525,29 @@ METHODS: dict[str, Method] = {
         options=("n_points", "max_iter", "max_nfev", "x0", "callback"),
         summary="SciPy's differential evolution (baseline)",
     ),
+    "spiral": Method(
+        _estimate_recommended,
+        options=(
+            "rule",
+            "n_points",
+            "max_nfev",
+            "polish_every",
+            "polish_nfev",
+            "restart_after",
+            "frequency_seeds",
+            "x0",
+            "max_iter",
+            "callback",
+        ),
+        safe_start=True,
+        parametrization="modal",
+        summary=(
+            "recommended: Eb-SDA over the modes, numerator projected out, "
+            "memetic polish, restarts, safe starts"
+        ),
+    ),
     "ls": Method(_estimate_ls, search=False, summary="least squares"),
     "oe": Method(_estimate_oe, search=False, summary="output error"),
 }
 
-DEFAULT_METHOD = "ebsda"
+DEFAULT_METHOD = "spiral"

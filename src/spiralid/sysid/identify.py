@@ -94,7 +94,7 @@ def identify(
     arx: ARX,
     method: str = DEFAULT_METHOD,
     predictor: str = "simulation",
-    parametrization: str = "coefficients",
+    parametrization: str | None = None,
     rng=None,
     refine: bool = False,
     gain: str | float = "auto",
@@ -112,21 +112,27 @@ def identify(
         Estimation record.
     arx : ARX
         Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6).
-    method : str, default "ebsda"
-        A key of :data:`spiralid.sysid.estimators.METHODS`: ``"ebsda"``,
-        ``"sda"``, ``"lasda"`` (spiral searches), ``"de"`` (SciPy's
-        differential evolution over the same cost, box and initial points,
-        a baseline), ``"ls"`` or ``"oe"`` (see
+    method : str, default "spiral"
+        A key of :data:`spiralid.sysid.estimators.METHODS`: ``"spiral"``
+        (the recommended spiral identification: Eb-SDA over the modes with
+        the numerator projected out, a memetic Levenberg-Marquardt polish,
+        restarts and safe starts; it reaches the output-error optimum, see
+        the README), ``"ebsda"``, ``"sda"``, ``"lasda"`` (the paper's spiral
+        searches), ``"de"`` (SciPy's differential evolution over the same
+        cost, box and initial points, a baseline), ``"ls"`` or ``"oe"`` (see
         :mod:`spiralid.sysid.estimators`). ``"ls"`` minimises the one-step
         error and ``"oe"`` the simulation error whatever `predictor` says;
         `predictor` then only selects the reported cost.
     predictor : {"simulation", "one-step"}
         The error of the paper's cost (DESIGN.md item 3).
-    parametrization : str, default "coefficients"
+    parametrization : str, optional
         What a search moves, a key of
         :data:`spiralid.sysid.parametrizations.PARAMETRIZATIONS`:
-        ``"coefficients"`` (the paper's, DESIGN.md item 12) or
-        ``"reflection"`` (stable by construction, item 13).
+        ``"coefficients"`` (the paper's, DESIGN.md item 12),
+        ``"reflection"`` (stable by construction, item 13) or ``"modal"``
+        (the denominator's modes, numerator projected out; simulation error
+        from rest only). Default: the method's (``"modal"`` for
+        ``"spiral"``, which needs it; ``"coefficients"`` otherwise).
     rng : int, numpy.random.Generator or None
         Randomness of a search (initial points and the search).
     refine : bool
@@ -180,6 +186,8 @@ def identify(
         raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
+    if parametrization is None:
+        parametrization = METHODS[method].parametrization
     par = make_parametrization(parametrization, data, arx)
     _check_options(method, optimiser_options)
     if safe_start is not None and not isinstance(safe_start, bool | np.bool_):

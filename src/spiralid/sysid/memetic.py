@@ -36,7 +36,7 @@ from .data import IOData
 from .spectra import PSD, default_nperseg, find_resonances
 from .varpro import ProjectedCost, gauss_newton_polish
 
-__all__ = ["frequency_seeds", "modal_spiral", "projected_spiral", "safe_denominators"]
+__all__ = ["frequency_seeds", "projected_spiral"]
 
 
 def frequency_seeds(data: IOData, parametrization, m: int, rng=None) -> np.ndarray:
@@ -95,6 +95,8 @@ def projected_spiral(
     x0=None,
     restart_after: int | None = None,
     restart_points=None,
+    max_iter: int | None = None,
+    callback=None,
     rng=None,
 ) -> optimize.OptimizeResult:
     """Spiral search over denominator coordinates, numerator projected out.
@@ -126,6 +128,12 @@ def projected_spiral(
         ``None``: no restarts.
     restart_points : array_like, shape (k, na), optional
         Initial points of every restarted population.
+    max_iter : int, optional
+        Cap on the iterations (all populations together).
+    callback : callable, optional
+        ``callback(intermediate)`` after every iteration with an
+        ``OptimizeResult`` holding ``x`` (coordinates) and ``fun`` (best so
+        far); returning True stops the search.
     rng : int, Generator or None
 
     Returns
@@ -134,7 +142,8 @@ def projected_spiral(
         ``x`` the ARX theta ``[a, b]``, ``fun`` its cost (eq. (2)-(3)),
         ``z`` the searched coordinates, ``nfev``, ``nit``, ``n_polish``
         (polishes that moved the centre), ``history`` (best cost after each
-        iteration), ``status`` (1: budget used), ``message``, ``success``,
+        iteration), ``status`` (1: budget used, 2: `max_iter`, 0: the
+        callback), ``message``, ``success``,
         ``elapsed``.
     """
     t_start = time.perf_counter()
@@ -172,7 +181,11 @@ def projected_spiral(
         used += res.nfev
         n_polish += bool(search.move_centre(res.x, res.fun))
 
+    status, message = 1, "Maximum number of function evaluations reached."
     while spent() + per_step <= max_nfev:
+        if max_iter is not None and nit >= max_iter:
+            status, message = 2, "Maximum number of iterations reached."
+            break
         before = search.fun
         search.step()
         nit += 1
@@ -185,6 +198,11 @@ def projected_spiral(
         if search.fun < best_f:
             best_z, best_f = search.x, search.fun
         history.append(best_f)
+        if callback is not None and callback(
+            optimize.OptimizeResult(x=best_z.copy(), fun=best_f)
+        ):
+            status, message = 0, "The callback requested a stop."
+            break
         if restart_after and stalled >= restart_after:
             if spent() + n_points + per_step > max_nfev:
                 break
@@ -208,114 +226,8 @@ def projected_spiral(
         n_polish=n_polish,
         n_restarts=n_restarts,
         history=np.asarray(history, dtype=float),
-        status=1,
+        status=status,
         success=True,
-        message="Maximum number of function evaluations reached.",
+        message=message,
         elapsed=time.perf_counter() - t_start,
     )
-
-
-def safe_denominators(data: IOData, arx, steiglitz: bool = True) -> np.ndarray:
-    """Denominators every projected search should hold from the start.
-
-    The least-squares estimate with its unstable poles reflected into the
-    unit circle and, with `steiglitz`, the Steiglitz-McBride estimate
-    started from it (the classical output-error start). With the numerator
-    projected out, the search's cost at either is at most the paper's cost
-    of the full estimate, and any stable denominator costs at most the zero
-    model (``b = 0`` is always available).
-
-    Returns
-    -------
-    ndarray, shape (k, na)
-    """
-    from .arx import arx_least_squares
-    from .identify import _stabilise, steiglitz_mcbride
-    from .polynomials import step_up
-
-    theta_ls = arx_least_squares(data, arx)
-    rows = [step_up(_stabilise(theta_ls, arx)[: arx.na])]
-    if steiglitz:
-        rows.append(steiglitz_mcbride(data, arx, theta_ls)[: arx.na])
-    return np.array(rows)
-
-
-def modal_spiral(
-    data: IOData,
-    arx,
-    method="ebsda",
-    *,
-    n_points: int = 50,
-    max_nfev: int = 20_000,
-    polish_every: int | None = 5,
-    polish_nfev: int = 10,
-    restart_after: int | None = 20,
-    safe_starts: bool = True,
-    steiglitz: bool = True,
-    seeds: int = 0,
-    gain="auto",
-    penalty: float = 1e6,
-    rng=None,
-) -> optimize.OptimizeResult:
-    """Spiral identification over modal coordinates with the numerator
-    projected out: the building block of ``identify(method="spiral")``.
-
-    Parameters
-    ----------
-    data : IOData
-    arx : ARX
-    method : str or SpiralRule
-        The spiral rule.
-    n_points, max_nfev, polish_every, polish_nfev, restart_after
-        As in :func:`projected_spiral`.
-    safe_starts : bool
-        Put :func:`safe_denominators` in the first population (mapped to
-        modal coordinates) and return whichever is best of the search and
-        their exact projected models, so the result is never worse than the
-        stabilised least-squares estimate or the zero model.
-    steiglitz : bool
-        Include the Steiglitz-McBride start among the safe starts.
-    seeds : int
-        Points of the first population placed at the frequency response's
-        peaks (:func:`frequency_seeds`).
-    gain, penalty
-        As in :class:`~spiralid.sysid.PaperCost`.
-    rng : int, Generator or None
-
-    Returns
-    -------
-    OptimizeResult
-        As :func:`projected_spiral`, plus ``start`` ("search" or the index
-        of the safe start that won).
-    """
-    from .modal import ModalParametrization
-
-    gen = np.random.default_rng(rng)
-    cost = ProjectedCost(arx, data, gain=gain, penalty=penalty)
-    par = ModalParametrization(arx.na, data.ts)
-    rows = []
-    safe = safe_denominators(data, arx, steiglitz) if safe_starts else None
-    if safe is not None:
-        rows += [par.from_denominator(a) for a in safe]
-    if seeds:
-        rows += list(frequency_seeds(data, par, seeds, gen))
-    x0 = np.array(rows[:n_points]) if rows else None
-    res = projected_spiral(
-        cost,
-        par,
-        method,
-        n_points=n_points,
-        max_nfev=max_nfev,
-        polish_every=polish_every,
-        polish_nfev=polish_nfev,
-        x0=x0,
-        restart_after=restart_after,
-        rng=gen,
-    )
-    res.start = "search"
-    if safe is not None:
-        f_safe, b_safe = cost.evaluate(safe)
-        i = int(np.argmin(f_safe))
-        if f_safe[i] < res.fun:
-            res.x, res.fun, res.start = np.r_[safe[i], b_safe[i]], float(f_safe[i]), i
-    return res

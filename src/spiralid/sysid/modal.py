@@ -146,8 +146,15 @@ class ModalParametrization:
         return np.atleast_2d(arr), arr.ndim == 1
 
     def sections(self, x) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(c1, c2, p)``: section coefficients, shapes (m, S), (m, S), (m, R)."""
+        """``(c1, c2, p)``: section coefficients, shapes (m, S), (m, S), (m, R).
+
+        Coordinates outside :attr:`bounds` are clipped into it first, so
+        every ``x`` maps to a stable polynomial.
+        """
         xx, _ = self._batch(x)
+        # The map is defined on the box: a search that steps outside it
+        # gets the boundary's (still stable) polynomial.
+        xx = np.clip(xx, self.bounds[:, 0], self.bounds[:, 1])
         s = self.n_sections
         wt = 2.0 * np.pi * xx[:, :s] * self.ts  # wn ts
         zeta = 10.0 ** xx[:, s : 2 * s]
@@ -233,7 +240,8 @@ class ModalParametrization:
             )
         z = np.roots(np.r_[1.0, a])
         mag = np.abs(z)
-        z = np.where(mag >= 1.0, 1.0 / np.conj(z), z)
+        outside = mag >= 1.0
+        z[outside] = 1.0 / np.conj(z[outside])
         tol = 1e-9
         upper = z[z.imag > tol]
         real = np.sort(z[np.abs(z.imag) <= tol].real)

@@ -11,6 +11,16 @@ model, see the safe start in :mod:`spiralid.sysid.estimators`).
     candidates pay the penalty of eq. (3). The initial denominators are
     drawn uniformly in reflection coefficients and mapped by the step-up
     recursion, so every initial point is stable ("feasible").
+``"modal"`` (numerator projected out)
+    ``x`` = the denominator's modes, ``[f_1..f_S, log10 zeta_1..log10
+    zeta_S, p_1..p_R]`` (:class:`~spiralid.sysid.modal.ModalParametrization`:
+    second-order sections in natural frequency (Hz) and log damping ratio,
+    stable by construction), and no numerator: for every candidate
+    denominator the numerator is the least-squares solution of the
+    simulation error from rest (:class:`~spiralid.sysid.varpro.ProjectedCost`),
+    so a search moves ``na`` coordinates, not ``na + nb``. Only for the
+    simulation error from rest (the cost's ``predictor="simulation"``,
+    ``initial="rest"``).
 ``"reflection"`` (DESIGN.md item 13)
     ``x = [k_1..k_na, b]``; each ``k`` is folded into ``(-1, 1)``
     (:func:`~spiralid.sysid.polynomials.fold_reflection`, clipped to
@@ -53,6 +63,7 @@ __all__ = [
     "KMAX",
     "PARAMETRIZATIONS",
     "Coefficients",
+    "Modal",
     "Parametrization",
     "Reflection",
     "default_bounds",
@@ -196,10 +207,72 @@ class Reflection(Parametrization):
         return stabilise(np.asarray(theta, dtype=float), self.arx)
 
 
+class Modal(Parametrization):
+    """Modal denominator, numerator projected out (see the module docstring)."""
+
+    name = "modal"
+
+    def __init__(self, data: IOData, arx: ARX):
+        super().__init__(data, arx)
+        from .modal import ModalParametrization
+
+        if arx.na == 0:
+            raise ValueError(
+                f"`parametrization` 'modal' needs a denominator; got {arx} (na = 0)"
+            )
+        self.modes = ModalParametrization(arx.na, data.ts)
+        self._projected = None
+
+    @property
+    def n_search(self) -> int:
+        return self.arx.na
+
+    def projected(self, cost=None):
+        """The :class:`~spiralid.sysid.varpro.ProjectedCost` of this record,
+        with `cost`'s gain and penalty (default: the paper's defaults)."""
+        from .varpro import ProjectedCost
+
+        if cost is None:
+            if self._projected is None:
+                self._projected = ProjectedCost(self.arx, self.data)
+            return self._projected
+        return ProjectedCost(
+            self.arx,
+            self.data,
+            gain=cost.w,
+            penalty=cost.penalty,
+            predictor=cost.predictor,
+            initial=cost.initial,
+        )
+
+    def default_bounds(self) -> np.ndarray:
+        return self.modes.bounds.copy()
+
+    def to_theta(self, x) -> np.ndarray:
+        xx = np.asarray(x, dtype=float)
+        a = self.modes.to_denominator(np.atleast_2d(xx))
+        theta = np.concatenate([a, self.projected().numerator(a)], axis=1)
+        return theta[0] if xx.ndim == 1 else theta
+
+    def from_theta(self, theta) -> np.ndarray:
+        th = np.asarray(theta, dtype=float)
+        return self.modes.from_denominator(th[: self.arx.na])
+
+    def objective(self, cost):
+        projected = self.projected(cost)
+        modes = self.modes
+
+        def fun(x):
+            return projected(modes.to_denominator(x))
+
+        return fun
+
+
 # One entry per parametrisation; its key is the name users pass.
 PARAMETRIZATIONS: dict[str, type[Parametrization]] = {
     Coefficients.name: Coefficients,
     Reflection.name: Reflection,
+    Modal.name: Modal,
 }
 
 
