@@ -18,8 +18,10 @@ def test_readme_api_example_runs(monkeypatch, capsys):
     monkeypatch.setenv("MPLBACKEND", "Agg")
     exec(compile(blocks[0], "README.md", "exec"), {})
     lines = capsys.readouterr().out.splitlines()
-    methods = [line.split()[0] for line in lines[:4]]
-    assert methods == ["ls", "oe", "ebsda", "ebsda"]
+    methods = [line.split()[0] for line in lines[:5]]
+    assert methods == ["ls", "oe", "ebsda", "ebsda", "spiral"]
+    # The recommended method validates within a point of output error.
+    assert abs(float(lines[4].split()[1]) - float(lines[1].split()[1])) <= 1.0
     # The data README's reference: least squares validates at about 95 %.
     assert abs(float(lines[0].split()[1]) - 95.0) <= 1.0
 
