@@ -102,12 +102,29 @@ def projected_sse(u, y, a, nk, b, sse):  # pragma: no cover - compiled
             for r in range(m):
                 lagged[d, r] += vs[r] * vd[r]
                 cross[d, r] += vs[r] * ys
+    _solve_gram(v, lagged, cross, length, b, False)
+    # One step of iterative refinement: b += G^-1 V'e with the residual e
+    # computed directly. The normal equations lose digits to the squared
+    # conditioning; this recovers them (the seminormal-equations fix).
+    corr = np.zeros((nb, m))
+    _accumulate_residual(v, y, b, nk, sse, corr, True)
+    _solve_gram(v, lagged, corr, length, b, True)
+    for r in range(m):
+        sse[r] = 0.0
+    _accumulate_residual(v, y, b, nk, sse, corr, False)
+
+
+@numba.njit(cache=True)
+def _solve_gram(v, lagged, rhs, length, b, add):  # pragma: no cover - compiled
+    """For each candidate r solve ``G_r x = rhs[:, r]`` into ``b[:, r]``
+    (``+=`` with `add`), ``G_r = V_r' V_r`` from the lagged products:
+    ``G[i, j] (i <= j) = sum_{s < length - j} v(s) v(s + j - i)``, the full
+    lagged product less its last ``i`` terms."""
+    nb, m = b.shape
     g = np.empty((nb, nb))
     c = np.empty(nb)
     x = np.empty(nb)
     for r in range(m):
-        # G[i, j] (i <= j) = sum_{s < length - j} v(s) v(s + j - i): the full
-        # lagged product less its last i terms.
         for j in range(nb):
             for i in range(j + 1):
                 dd = j - i
@@ -116,31 +133,13 @@ def projected_sse(u, y, a, nk, b, sse):  # pragma: no cover - compiled
                     acc -= v[s, r] * v[s + dd, r]
                 g[i, j] = acc
                 g[j, i] = acc
-            c[j] = cross[j, r]
+            c[j] = rhs[j, r]
         _solve_equilibrated(g, c, x)
         for j in range(nb):
-            b[j, r] = x[j]
-    # One step of iterative refinement: b += G^-1 V'e with the residual e
-    # computed directly. The normal equations lose digits to the squared
-    # conditioning; this recovers them (the seminormal-equations fix).
-    corr = np.zeros((nb, m))
-    _accumulate_residual(v, y, b, nk, sse, corr, True)
-    for r in range(m):
-        for j in range(nb):
-            for i in range(j + 1):
-                dd = j - i
-                val = lagged[dd, r]
-                for s in range(length - j, length - dd):
-                    val -= v[s, r] * v[s + dd, r]
-                g[i, j] = val
-                g[j, i] = val
-            c[j] = corr[j, r]
-        _solve_equilibrated(g, c, x)
-        for j in range(nb):
-            b[j, r] += x[j]
-    for r in range(m):
-        sse[r] = 0.0
-    _accumulate_residual(v, y, b, nk, sse, corr, False)
+            if add:
+                b[j, r] += x[j]
+            else:
+                b[j, r] = x[j]
 
 
 @numba.njit(cache=True)

@@ -35,6 +35,9 @@ from itertools import combinations
 
 import numpy as np
 
+from .arx import _order
+from .data import _check_ts
+
 __all__ = ["ModalParametrization"]
 
 # log10(zeta) box: from a mode ringing for ~150 periods (zeta = 1e-3) to an
@@ -44,14 +47,6 @@ _LOG_ZETA = (-3.0, 1.0)
 # degenerates (a double pole at z = 1 or z = -rho).
 _EDGE = 1e-3
 _PMAX = 1.0 - 1e-6
-
-
-def _check_int(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer):
-        raise ValueError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
-    if value < minimum:
-        raise ValueError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
-    return int(value)
 
 
 class ModalParametrization:
@@ -97,16 +92,9 @@ class ModalParametrization:
     def __init__(
         self, na: int, ts: float, real_poles: int | None = None, log_damping=_LOG_ZETA
     ) -> None:
-        na = _check_int(na, "na", 1)
-        try:
-            ts = float(ts)
-        except (TypeError, ValueError):
-            raise ValueError(f"`ts` must be a positive number; got {ts!r}") from None
-        if not (np.isfinite(ts) and ts > 0):
-            raise ValueError(f"`ts` must be a positive number; got {ts!r}")
-        n_real = (
-            na % 2 if real_poles is None else _check_int(real_poles, "real_poles", 0)
-        )
+        na = _order(na, "na", 1)
+        ts = _check_ts(ts)
+        n_real = na % 2 if real_poles is None else _order(real_poles, "real_poles", 0)
         if n_real > na or (na - n_real) % 2:
             raise ValueError(
                 f"`real_poles` must be at most na={na} with the parity of na; "
@@ -325,7 +313,7 @@ class ModalParametrization:
 
     def initial_points(self, m: int, rng=None) -> np.ndarray:
         """``m`` points uniform in :attr:`bounds` (each a stable denominator)."""
-        m = _check_int(m, "m", 1)
+        m = _order(m, "m", 1)
         gen = np.random.default_rng(rng)
         return gen.uniform(self.bounds[:, 0], self.bounds[:, 1], size=(m, self.na))
 
