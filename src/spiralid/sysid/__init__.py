@@ -36,11 +36,22 @@ from .validate import realization_tests as realization_tests
 from .validate import validate as validate
 
 
+# The modal search's building blocks, loaded on first use (identify loads
+# them itself when a method needs them).
+_LAZY = {
+    "ModalParametrization": ".modal",
+    "ProjectedCost": ".varpro",
+    "projected_spiral": ".memetic",
+}
+
+
 def __getattr__(name: str):
+    import importlib
+
     # `plots` needs matplotlib, which is slow to import and not needed to
     # identify or validate a model: load it on first use only.
     if name == "plots":
-        import importlib
-
         return importlib.import_module(".plots", __name__)
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name], __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
