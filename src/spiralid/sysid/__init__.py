@@ -35,7 +35,6 @@ from .validate import fit_percent as fit_percent
 from .validate import realization_tests as realization_tests
 from .validate import validate as validate
 
-
 # The modal search's building blocks, loaded on first use (identify loads
 # them itself when a method needs them).
 _LAZY = {
