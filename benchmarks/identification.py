@@ -351,6 +351,13 @@ def main(argv=None):
     for m in methods:
         if m not in METHODS:
             ap.error(f"--methods: unknown {m!r}; choose from {list(METHODS)}")
+    try:
+        import cma  # noqa: F401
+    except ImportError:
+        dropped = [m for m in methods if m.startswith("CMA-ES")]
+        if dropped and not args.summarise:
+            print(f"pycma is not installed (pip install cma): leaving out {dropped}")
+            methods = [m for m in methods if m not in dropped]
     if args.summarise:
         lines = Path(args.summarise).read_text().splitlines()
         rows = [json.loads(line) for line in lines if line.strip()]
