@@ -27,8 +27,10 @@ bang-bang record it is 567 while the largest LS numerator coefficient is 43.
 Adding a parametrisation
 ------------------------
 Subclass :class:`Parametrization` in this module, set ``name``, implement
-:meth:`~Parametrization.default_bounds`, :meth:`~Parametrization.to_theta`
-and :meth:`~Parametrization.from_theta` (override
+:meth:`~Parametrization.denominator_bounds` (or all of
+:meth:`~Parametrization.default_bounds` when the search does not hold the
+numerator), :meth:`~Parametrization.to_theta` and
+:meth:`~Parametrization.from_theta` (override
 :meth:`~Parametrization.initial_points` for stable initial points and
 :meth:`~Parametrization.objective` when the cost of a population can be
 computed faster than ``cost(to_theta(x))``), and add one entry to
@@ -113,7 +115,14 @@ class Parametrization:
         return s
 
     def default_bounds(self) -> np.ndarray:
-        """The default search box, shape ``(n_search, 2)``."""
+        """The default search box, shape ``(n_search, 2)``: the denominator's
+        box above ``|b_j| <= s`` (:meth:`numerator_scale`)."""
+        s = self.numerator_scale()
+        numerator = np.tile([-s, s], (self.arx.nb, 1))
+        return np.concatenate([self.denominator_bounds(), numerator])
+
+    def denominator_bounds(self) -> np.ndarray:
+        """The denominator's part of the default box, shape ``(na, 2)``."""
         raise NotImplementedError
 
     def initial_points(self, box: np.ndarray, m: int, rng) -> np.ndarray | None:
@@ -145,15 +154,10 @@ class Coefficients(Parametrization):
 
     name = "coefficients"
 
-    def default_bounds(self) -> np.ndarray:
+    def denominator_bounds(self) -> np.ndarray:
         na = self.arx.na
-        box = np.empty((self.arx.n_params, 2))
-        for i in range(na):
-            half = float(comb(na, i + 1))
-            box[i] = (-half, half)
-        s = self.numerator_scale()
-        box[na:] = (-s, s)
-        return box
+        half = np.array([float(comb(na, i + 1)) for i in range(na)])
+        return np.column_stack([-half, half]).reshape(na, 2)
 
     def initial_points(self, box: np.ndarray, m: int, rng) -> np.ndarray:
         return feasible_initial_points(box, self.arx, m, rng)
@@ -176,13 +180,8 @@ class Reflection(Parametrization):
 
     name = "reflection"
 
-    def default_bounds(self) -> np.ndarray:
-        na = self.arx.na
-        box = np.empty((self.arx.n_params, 2))
-        box[:na] = (-1.0, 1.0)
-        s = self.numerator_scale()
-        box[na:] = (-s, s)
-        return box
+    def denominator_bounds(self) -> np.ndarray:
+        return np.tile([-1.0, 1.0], (self.arx.na, 1))
 
     def to_theta(self, x) -> np.ndarray:
         xx = np.asarray(x, dtype=float)
