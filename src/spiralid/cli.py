@@ -408,7 +408,10 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``spiralid`` command."""
     from spiralid.sysid.estimators import DEFAULT_METHOD, METHODS
-    from spiralid.sysid.parametrizations import PARAMETRIZATIONS
+    from spiralid.sysid.parametrizations import (
+        DEFAULT_PARAMETRIZATION,
+        PARAMETRIZATIONS,
+    )
 
     parser = _Parser(
         prog="spiralid",
@@ -487,7 +490,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--parametrization",
         choices=list(PARAMETRIZATIONS),
-        default="coefficients",
+        default=DEFAULT_PARAMETRIZATION,
     )
     _add_initial_option(p)
     p.add_argument(

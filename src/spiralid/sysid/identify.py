@@ -44,6 +44,7 @@ from .estimators import DEFAULT_METHOD, METHODS, Problem
 from .model import IdentifiedModel
 from .outputerror import steiglitz_mcbride
 from .parametrizations import (
+    DEFAULT_PARAMETRIZATION,
     default_bounds,
     feasible_initial_points,
     make_parametrization,
@@ -94,7 +95,7 @@ def identify(
     arx: ARX,
     method: str = DEFAULT_METHOD,
     predictor: str = "simulation",
-    parametrization: str = "coefficients",
+    parametrization: str = DEFAULT_PARAMETRIZATION,
     rng=None,
     refine: bool = False,
     gain: str | float = "auto",
@@ -121,12 +122,13 @@ def identify(
         error and ``"oe"`` the simulation error whatever `predictor` says;
         `predictor` then only selects the reported cost.
     predictor : {"simulation", "one-step"}
-        The error of the paper's cost (DESIGN.md item 3).
+        The error of the paper's cost, eq. (2): the free-run simulation
+        error or the one-step prediction error.
     parametrization : str, default "coefficients"
         What a search moves, a key of
         :data:`spiralid.sysid.parametrizations.PARAMETRIZATIONS`:
-        ``"coefficients"`` (the paper's, DESIGN.md item 12) or
-        ``"reflection"`` (stable by construction, item 13).
+        ``"coefficients"`` (the paper's) or ``"reflection"`` (stable by
+        construction).
     rng : int, numpy.random.Generator or None
         Randomness of a search (initial points and the search).
     refine : bool

@@ -6,12 +6,12 @@ every result hold. Each one knows its default search box, its stable initial
 points, its map to theta and back (the back map seeds a search with a known
 model, see the safe start in :mod:`spiralid.sysid.estimators`).
 
-``"coefficients"`` (paper-faithful, DESIGN.md item 12)
+``"coefficients"`` (paper-faithful; the default)
     ``x = theta``: the optimiser moves the raw coefficients and unstable
     candidates pay the penalty of eq. (3). The initial denominators are
     drawn uniformly in reflection coefficients and mapped by the step-up
     recursion, so every initial point is stable ("feasible").
-``"reflection"`` (DESIGN.md item 13)
+``"reflection"`` (beyond the paper)
     ``x = [k_1..k_na, b]``; each ``k`` is folded into ``(-1, 1)``
     (:func:`~spiralid.sysid.polynomials.fold_reflection`, clipped to
     ``KMAX = 1 - 1e-6``) and mapped by step-up, so every candidate is stable
@@ -52,6 +52,7 @@ from .data import IOData
 from .polynomials import fold_reflection, step_down, step_up
 
 __all__ = [
+    "DEFAULT_PARAMETRIZATION",
     "KMAX",
     "PARAMETRIZATIONS",
     "Coefficients",
@@ -62,6 +63,8 @@ __all__ = [
     "make_parametrization",
     "stabilise",
 ]
+
+DEFAULT_PARAMETRIZATION = "coefficients"
 
 # Largest |k| of a stable-by-construction denominator: reflection search,
 # output error and the stabilised least-squares start.
@@ -212,7 +215,7 @@ def make_parametrization(name, data: IOData, arx: ARX) -> Parametrization:
 
 
 def default_bounds(
-    data: IOData, arx: ARX, parametrization: str = "coefficients"
+    data: IOData, arx: ARX, parametrization: str = DEFAULT_PARAMETRIZATION
 ) -> np.ndarray:
     """The default search box, shape (p, 2) (see the module docstring).
 
@@ -230,7 +233,7 @@ def default_bounds(
 
 
 def feasible_initial_points(box: np.ndarray, arx: ARX, m: int, rng=None) -> np.ndarray:
-    """``m`` initial points "in the feasible region" (DESIGN.md item 12).
+    """``m`` initial points "in the feasible region", as the paper asks.
 
     Denominators: reflection coefficients uniform in (-1, 1) mapped by
     step-up, so every point is stable (a uniform draw in the coefficient box
