@@ -410,9 +410,9 @@ METHODS: dict[str, Method] = {
     **{
         name: Method(
             partial(_estimate_spiral, rule=name),
-            summary=f"spiral search with the {rule.__name__} rule",
+            summary=f"spiral search with the rule {name!r} of spiralid.optim.RULES",
         )
-        for name, rule in RULES.items()
+        for name in RULES
     },
     "de": Method(
         _estimate_de,
