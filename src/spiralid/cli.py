@@ -408,7 +408,9 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``spiralid`` command."""
     from spiralid.sysid.estimators import DEFAULT_METHOD, METHODS
-    from spiralid.sysid.parametrizations import PARAMETRIZATIONS
+    from spiralid.sysid.parametrizations import (
+        PARAMETRIZATIONS,
+    )
 
     parser = _Parser(
         prog="spiralid",

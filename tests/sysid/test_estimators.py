@@ -2,6 +2,7 @@
 result type, one budget rule, the safe start and capped polishes."""
 
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -187,3 +188,30 @@ def test_polish_says_when_it_stopped_at_its_evaluation_cap(record, monkeypatch):
 def test_bad_safe_start_is_rejected(record):
     with pytest.raises(ValueError, match="`safe_start` must be True, False or None"):
         identify(record, ARX4, method="sda", safe_start="yes")
+
+
+ARM = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
+
+
+@pytest.mark.skipif(
+    not (ARM / "daisy_robot_arm.csv").is_file(), reason="real arm data not available"
+)
+@pytest.mark.parametrize("parametrization", list(PARAMETRIZATIONS))
+@pytest.mark.parametrize("method", ["sda", "ebsda"])
+def test_safe_searches_on_the_real_arm(method, parametrization):
+    # The record where the paper's searches can end far above the zero model.
+    data = IOData.from_csv(ARM / "daisy_robot_arm.csv", input="u", output="y",
+                           ts=0.01).split()[0]  # fmt: skip
+    arx = ARX(8, 8, 0)
+    cost = PaperCost(arx, data, initial="measured")
+    floor = min(cost(np.zeros(arx.n_params)), cost(_stabilised_ls(data, arx)))
+    if parametrization == "modal":
+        # Its projection is of the simulation from rest only: said, not guessed.
+        with pytest.raises(ValueError, match="`initial` must be 'rest'"):
+            identify(data, arx, method=method, parametrization="modal",
+                     initial="measured", rng=0, max_nfev=2000)  # fmt: skip
+        return
+    fit = identify(data, arx, method=method, parametrization=parametrization,
+                   initial="measured", safe_start=True, rng=0,
+                   max_nfev=2000)  # fmt: skip
+    assert fit.cost <= floor

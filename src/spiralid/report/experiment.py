@@ -21,6 +21,7 @@ from scipy import stats
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
 from spiralid.sysid.estimators import search_options
+from spiralid.sysid.parametrizations import DEFAULT_PARAMETRIZATION
 from spiralid.sysid.validate import Validation, fit_percent, validate
 
 __all__ = [
@@ -44,7 +45,7 @@ class Configuration:
 
     label: str
     method: str
-    parametrization: str = "coefficients"
+    parametrization: str = DEFAULT_PARAMETRIZATION
     gain_scale: float = 1.0
     refine: bool = False
     safe_start: bool | None = None

@@ -88,7 +88,7 @@ from .arx import ARX, arx_least_squares
 from .cost import PaperCost
 from .data import IOData
 from .outputerror import local_polish, steiglitz_mcbride
-from .parametrizations import Parametrization
+from .parametrizations import DEFAULT_PARAMETRIZATION, Parametrization
 
 __all__ = [
     "DEFAULT_METHOD",
@@ -99,6 +99,9 @@ __all__ = [
     "Problem",
     "search_options",
 ]
+
+# The iteration cap of minimize() and differential_evolution() when none is given.
+_DEFAULT_MAX_ITER = 500
 
 STATUS = {
     0: "Finished: exact, converged, or stopped by the target or the callback.",
@@ -204,7 +207,7 @@ class Method:
     options: tuple[str, ...] | None = None
     safe_start: bool = False
     summary: str = ""
-    parametrization: str = "coefficients"
+    parametrization: str = DEFAULT_PARAMETRIZATION
 
 
 def search_options(options: dict) -> dict:
@@ -314,6 +317,30 @@ def _safe_start_points(problem: Problem, box: np.ndarray) -> np.ndarray:
     return np.clip(points, box[:, 0], box[:, 1])
 
 
+def _first_population(
+    problem: Problem, box: np.ndarray, m: int, x0
+) -> np.ndarray | None:
+    """The given or drawn initial points, after the safe start's two."""
+    seeds = _safe_start_points(problem, box) if problem.safe_start else None
+    if x0 is not None:
+        x0 = np.atleast_2d(np.asarray(x0, dtype=float))
+        return x0 if seeds is None else np.concatenate([seeds, x0])
+    n_seeds = 0 if seeds is None else seeds.shape[0]
+    drawn = problem.parametrization.initial_points(box, m - n_seeds, problem.rng)
+    parts = [p for p in (seeds, drawn) if p is not None]
+    return np.concatenate(parts) if parts else None
+
+
+def _stop_status(nit: int, nfev: int, options: dict, per_iteration: int) -> int:
+    """The :data:`STATUS` key of a search that ran `nit` iterations."""
+    if nit >= options.get("max_iter", _DEFAULT_MAX_ITER):
+        return 2
+    budget = options.get("max_nfev")
+    if budget is not None and nfev + per_iteration > budget:
+        return 1
+    return 0
+
+
 def _search(
     problem: Problem,
     optimiser: Callable,
@@ -331,35 +358,18 @@ def _search(
     box = par.default_bounds() if problem.bounds is None else problem.bounds
     options = search_options(options)
     m = int(options.get("n_points", 50))
-    seeds = _safe_start_points(problem, box) if problem.safe_start else None
-    x0 = options.pop("x0", None)
-    if x0 is None:
-        n_seeds = 0 if seeds is None else seeds.shape[0]
-        drawn = par.initial_points(box, m - n_seeds, problem.rng)
-        parts = [p for p in (seeds, drawn) if p is not None]
-        x0 = np.concatenate(parts) if parts else None
-    elif seeds is not None:
-        x0 = np.concatenate([seeds, np.atleast_2d(np.asarray(x0, dtype=float))])
+    x0 = _first_population(problem, box, m, options.pop("x0", None))
     raw = optimiser(par.objective(problem.cost), box, x0=x0, **options)
     theta = par.to_theta(raw.x)
-    nit, nfev = int(raw.nit), int(raw.nfev)
-    if nit >= options.get("max_iter", 500):
-        status = 2
-    elif options.get("max_nfev") is not None and (
-        nfev + per_iteration(m) > options["max_nfev"]
-    ):
-        status = 1
-    else:
-        status = 0
     history = getattr(raw, "history", None)
     result = EstimatorResult(
         x=theta,
         fun=float(problem.cost(theta)),
-        status=status,
+        status=_stop_status(raw.nit, raw.nfev, options, per_iteration(m)),
         success=bool(raw.success),
         message=str(raw.message),
-        nfev=nfev,
-        nit=nit,
+        nfev=int(raw.nfev),
+        nit=int(raw.nit),
         history=None if history is None else np.asarray(history, dtype=float),
         elapsed=time.perf_counter() - t0,
         x_search=np.asarray(raw.x, dtype=float),
@@ -516,9 +526,9 @@ METHODS: dict[str, Method] = {
     **{
         name: Method(
             partial(_estimate_spiral, rule=name),
-            summary=f"spiral search with the {rule.__name__} rule",
+            summary=f"spiral search with the rule {name!r} of spiralid.optim.RULES",
         )
-        for name, rule in RULES.items()
+        for name in RULES
     },
     "de": Method(
         _estimate_de,

@@ -124,15 +124,16 @@ def identify(
         error and ``"oe"`` the simulation error whatever `predictor` says;
         `predictor` then only selects the reported cost.
     predictor : {"simulation", "one-step"}
-        The error of the paper's cost (DESIGN.md item 3).
+        The error of the paper's cost, eq. (2): the free-run simulation
+        error or the one-step prediction error.
     parametrization : str, optional
         What a search moves, a key of
         :data:`spiralid.sysid.parametrizations.PARAMETRIZATIONS`:
-        ``"coefficients"`` (the paper's, DESIGN.md item 12),
-        ``"reflection"`` (stable by construction, item 13) or ``"modal"``
-        (the denominator's modes, numerator projected out; simulation error
-        from rest only). Default: the method's (``"modal"`` for
-        ``"spiral"``, which needs it; ``"coefficients"`` otherwise).
+        ``"coefficients"`` (the paper's), ``"reflection"`` (stable by
+        construction) or ``"modal"`` (the denominator's modes, numerator
+        projected out; simulation error from rest only). Default: the
+        method's (``"modal"`` for ``"spiral"``, which needs it;
+        ``"coefficients"`` otherwise).
     rng : int, numpy.random.Generator or None
         Randomness of a search (initial points and the search).
     refine : bool

@@ -6,7 +6,7 @@ every result hold. Each one knows its default search box, its stable initial
 points, its map to theta and back (the back map seeds a search with a known
 model, see the safe start in :mod:`spiralid.sysid.estimators`).
 
-``"coefficients"`` (paper-faithful, DESIGN.md item 12)
+``"coefficients"`` (paper-faithful; the default)
     ``x = theta``: the optimiser moves the raw coefficients and unstable
     candidates pay the penalty of eq. (3). The initial denominators are
     drawn uniformly in reflection coefficients and mapped by the step-up
@@ -21,7 +21,7 @@ model, see the safe start in :mod:`spiralid.sysid.estimators`).
     so a search moves ``na`` coordinates, not ``na + nb``. Only for the
     simulation error from rest (the cost's ``predictor="simulation"``,
     ``initial="rest"``).
-``"reflection"`` (DESIGN.md item 13)
+``"reflection"`` (beyond the paper)
     ``x = [k_1..k_na, b]``; each ``k`` is folded into ``(-1, 1)``
     (:func:`~spiralid.sysid.polynomials.fold_reflection`, clipped to
     ``KMAX = 1 - 1e-6``) and mapped by step-up, so every candidate is stable
@@ -37,8 +37,10 @@ bang-bang record it is 567 while the largest LS numerator coefficient is 43.
 Adding a parametrisation
 ------------------------
 Subclass :class:`Parametrization` in this module, set ``name``, implement
-:meth:`~Parametrization.default_bounds`, :meth:`~Parametrization.to_theta`
-and :meth:`~Parametrization.from_theta` (override
+:meth:`~Parametrization.denominator_bounds` (or all of
+:meth:`~Parametrization.default_bounds` when the search does not hold the
+numerator), :meth:`~Parametrization.to_theta` and
+:meth:`~Parametrization.from_theta` (override
 :meth:`~Parametrization.initial_points` for stable initial points and
 :meth:`~Parametrization.objective` when the cost of a population can be
 computed faster than ``cost(to_theta(x))``), and add one entry to
@@ -60,6 +62,7 @@ from .data import IOData
 from .polynomials import fold_reflection, step_down, step_up
 
 __all__ = [
+    "DEFAULT_PARAMETRIZATION",
     "KMAX",
     "PARAMETRIZATIONS",
     "Coefficients",
@@ -71,6 +74,8 @@ __all__ = [
     "make_parametrization",
     "stabilise",
 ]
+
+DEFAULT_PARAMETRIZATION = "coefficients"
 
 # Largest |k| of a stable-by-construction denominator: reflection search,
 # output error and the stabilised least-squares start.
@@ -124,7 +129,14 @@ class Parametrization:
         return s
 
     def default_bounds(self) -> np.ndarray:
-        """The default search box, shape ``(n_search, 2)``."""
+        """The default search box, shape ``(n_search, 2)``: the denominator's
+        box above ``|b_j| <= s`` (:meth:`numerator_scale`)."""
+        s = self.numerator_scale()
+        numerator = np.tile([-s, s], (self.arx.nb, 1))
+        return np.concatenate([self.denominator_bounds(), numerator])
+
+    def denominator_bounds(self) -> np.ndarray:
+        """The denominator's part of the default box, shape ``(na, 2)``."""
         raise NotImplementedError
 
     def initial_points(self, box: np.ndarray, m: int, rng) -> np.ndarray | None:
@@ -156,15 +168,10 @@ class Coefficients(Parametrization):
 
     name = "coefficients"
 
-    def default_bounds(self) -> np.ndarray:
+    def denominator_bounds(self) -> np.ndarray:
         na = self.arx.na
-        box = np.empty((self.arx.n_params, 2))
-        for i in range(na):
-            half = float(comb(na, i + 1))
-            box[i] = (-half, half)
-        s = self.numerator_scale()
-        box[na:] = (-s, s)
-        return box
+        half = np.array([float(comb(na, i + 1)) for i in range(na)])
+        return np.column_stack([-half, half]).reshape(na, 2)
 
     def initial_points(self, box: np.ndarray, m: int, rng) -> np.ndarray:
         return feasible_initial_points(box, self.arx, m, rng)
@@ -187,13 +194,8 @@ class Reflection(Parametrization):
 
     name = "reflection"
 
-    def default_bounds(self) -> np.ndarray:
-        na = self.arx.na
-        box = np.empty((self.arx.n_params, 2))
-        box[:na] = (-1.0, 1.0)
-        s = self.numerator_scale()
-        box[na:] = (-s, s)
-        return box
+    def denominator_bounds(self) -> np.ndarray:
+        return np.tile([-1.0, 1.0], (self.arx.na, 1))
 
     def to_theta(self, x) -> np.ndarray:
         xx = np.asarray(x, dtype=float)
@@ -286,7 +288,7 @@ def make_parametrization(name, data: IOData, arx: ARX) -> Parametrization:
 
 
 def default_bounds(
-    data: IOData, arx: ARX, parametrization: str = "coefficients"
+    data: IOData, arx: ARX, parametrization: str = DEFAULT_PARAMETRIZATION
 ) -> np.ndarray:
     """The default search box, shape (p, 2) (see the module docstring).
 
@@ -304,7 +306,7 @@ def default_bounds(
 
 
 def feasible_initial_points(box: np.ndarray, arx: ARX, m: int, rng=None) -> np.ndarray:
-    """``m`` initial points "in the feasible region" (DESIGN.md item 12).
+    """``m`` initial points "in the feasible region", as the paper asks.
 
     Denominators: reflection coefficients uniform in (-1, 1) mapped by
     step-up, so every point is stable (a uniform draw in the coefficient box
