@@ -409,6 +409,37 @@ def _estimate_de(problem: Problem, **options) -> EstimatorResult:
     return _search(problem, run, options, per_iteration=lambda m: m)
 
 
+def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
+    """First points of the modal search and the safe denominators.
+
+    With the safe start: the stabilised least-squares, Steiglitz-McBride
+    and zero models (modal coordinates, clipped to the box), and the exact
+    denominators of the first two for the final check (the modal map can
+    only approximate poles it cannot represent). Then `n_peaks` points at
+    the frequency response's peaks, then the caller's `x0`.
+    """
+    from .memetic import frequency_seeds
+    from .parametrizations import stabilise
+    from .polynomials import step_up
+
+    par, arx = problem.parametrization, problem.arx
+    rows, safe = [], None
+    if problem.safe_start:
+        theta_ls = par.theta_ls
+        theta_sm = steiglitz_mcbride(problem.data, arx, theta_ls)
+        rows = [par.from_theta(th) for th in (theta_ls, theta_sm, 0 * theta_ls)]
+        a_ls = step_up(stabilise(theta_ls, arx)[: arx.na])
+        safe = np.array([a_ls, theta_sm[: arx.na]])
+    if n_peaks:
+        rows += list(frequency_seeds(problem.data, modes, int(n_peaks), problem.rng))
+    if x0 is not None:
+        rows += list(np.atleast_2d(np.asarray(x0, dtype=float)))
+    if not rows:
+        return None, safe
+    box = modes.bounds
+    return np.clip(np.array(rows[:n_points]), box[:, 0], box[:, 1]), safe
+
+
 def _estimate_recommended(
     problem: Problem,
     *,
@@ -438,10 +469,8 @@ def _estimate_recommended(
     models). Default budget ``max_nfev = 10_000`` evaluations, polish
     included (measured in ``benchmarks/identification.py``).
     """
-    from .memetic import frequency_seeds as peak_seeds
     from .memetic import projected_spiral
-    from .parametrizations import Modal, stabilise
-    from .polynomials import step_up
+    from .parametrizations import Modal
 
     t0 = time.perf_counter()
     par = problem.parametrization
@@ -455,25 +484,7 @@ def _estimate_recommended(
     modes = copy.copy(par.modes)
     modes.bounds = box
     budget = 10_000 if max_nfev is None else int(max_nfev)
-    rows = []
-    safe = None
-    if problem.safe_start:
-        theta_ls = par.theta_ls
-        models = (
-            theta_ls,
-            steiglitz_mcbride(problem.data, problem.arx, theta_ls),
-            np.zeros(problem.arx.n_params),
-        )
-        rows = [par.from_theta(th) for th in models]
-        na = problem.arx.na
-        safe = np.array(
-            [step_up(stabilise(theta_ls, problem.arx)[:na]), models[1][:na]]
-        )
-    if frequency_seeds:
-        rows += list(peak_seeds(problem.data, modes, int(frequency_seeds), problem.rng))
-    if x0 is not None:
-        rows += list(np.atleast_2d(np.asarray(x0, dtype=float)))
-    start = np.clip(np.array(rows[:n_points]), box[:, 0], box[:, 1]) if rows else None
+    start, safe = _modal_starts(problem, modes, n_points, frequency_seeds, x0)
     raw = projected_spiral(
         cost,
         modes,
@@ -490,8 +501,6 @@ def _estimate_recommended(
     )
     theta, kept = raw.x, "search"
     if safe is not None:
-        # The exact projected models of the safe starts (the modal map of a
-        # start can only approximate poles it cannot represent).
         f_safe, b_safe = cost.evaluate(safe)
         i = int(np.argmin(f_safe))
         if f_safe[i] < raw.fun:
