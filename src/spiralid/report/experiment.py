@@ -10,10 +10,12 @@ model and every number. It computes only: figures are drawn by
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -279,6 +281,28 @@ def _run_one(job) -> tuple[str, int, IdentifiedModel, np.ndarray]:
     return config.label, seed, model, times
 
 
+@contextmanager
+def _single_threaded_blas():
+    """One BLAS thread in the worker processes started inside the block.
+
+    The workers already run one identification per core; a threaded BLAS
+    inside each oversubscribes the cores and its small least-squares solves
+    (safe starts, output-error polish) become 10-50x slower. The workers are
+    spawned, so they load BLAS afresh and read these variables; a user's own
+    setting is kept.
+    """
+    names = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+    saved = {name: os.environ.get(name) for name in names}
+    for name in names:
+        os.environ.setdefault(name, "1")
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+
+
 def reproduce(
     data: IOData | None = None,
     *,
@@ -404,7 +428,12 @@ def reproduce(
             results[label, seed] = as_run(label, seed, model, times)
             tick()
     else:
-        with ProcessPoolExecutor(max_workers=n_workers) as pool:
+        with (
+            _single_threaded_blas(),
+            ProcessPoolExecutor(
+                max_workers=n_workers, mp_context=multiprocessing.get_context("spawn")
+            ) as pool,
+        ):
             for label, seed, model, times in pool.map(_run_one, jobs):
                 results[label, seed] = as_run(label, seed, model, times)
                 tick()
