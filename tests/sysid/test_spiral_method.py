@@ -69,3 +69,18 @@ def test_modal_parametrization_maps_to_the_projected_model(two_modes):
 def test_unsupported_settings_are_refused_clearly(two_modes, kwargs, match):
     with pytest.raises(ValueError, match=match):
         identify(two_modes, ARX4, **kwargs)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(max_nfev=10), "`max_nfev` must be an integer >= 50"),
+        (dict(polish_every=0), "`polish_every`"),
+        (dict(restart_after=2.5), "`restart_after`"),
+        (dict(frequency_seeds=-1), "`frequency_seeds`"),
+        (dict(n_points=1), "`n_points`"),
+    ],
+)
+def test_bad_search_options_are_named(two_modes, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        identify(two_modes, ARX4, **kwargs)

@@ -82,6 +82,7 @@ from functools import partial
 import numpy as np
 from scipy import optimize
 
+from spiralid._checks import integer
 from spiralid.optim import RULES, differential_evolution, minimize
 
 from .arx import ARX, arx_least_squares
@@ -483,7 +484,9 @@ def _estimate_recommended(
     box = par.default_bounds() if problem.bounds is None else problem.bounds
     modes = copy.copy(par.modes)
     modes.bounds = box
-    budget = 10_000 if max_nfev is None else int(max_nfev)
+    budget = 10_000 if max_nfev is None else max_nfev
+    if frequency_seeds:
+        frequency_seeds = integer(frequency_seeds, "frequency_seeds", 0)
     start, safe = _modal_starts(problem, modes, n_points, frequency_seeds, x0)
     raw = projected_spiral(
         cost,

@@ -30,6 +30,7 @@ import time
 import numpy as np
 from scipy import optimize, signal
 
+from spiralid._checks import integer
 from spiralid.optim import SpiralSearch
 
 from .data import IOData
@@ -63,6 +64,7 @@ def frequency_seeds(data: IOData, parametrization, m: int, rng=None) -> np.ndarr
     -------
     ndarray, shape (m, na), inside ``parametrization.bounds``
     """
+    m = integer(m, "m", 1)
     gen = np.random.default_rng(rng)
     fs = 1.0 / data.ts
     nperseg = default_nperseg(data.n)
@@ -147,6 +149,15 @@ def projected_spiral(
         ``elapsed``.
     """
     t_start = time.perf_counter()
+    n_points = integer(n_points, "n_points", 2)
+    max_nfev = integer(max_nfev, "max_nfev", n_points)
+    polish_nfev = integer(polish_nfev, "polish_nfev", 2)
+    if polish_every is not None:
+        polish_every = integer(polish_every, "polish_every", 1)
+    if restart_after is not None:
+        restart_after = integer(restart_after, "restart_after", 1)
+    if max_iter is not None:
+        max_iter = integer(max_iter, "max_iter", 1)
     gen = np.random.default_rng(rng)
 
     def fun(z):
