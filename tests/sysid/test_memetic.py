@@ -41,6 +41,7 @@ def test_same_seed_same_result_and_budget_respected():
     assert np.array_equal(one.x, two.x) and one.fun == two.fun
     assert one.nfev <= 1500
     assert np.all(np.diff(one.history) <= 0)
+    assert one.history.size == one.nit + 1
 
 
 def test_an_initial_point_bounds_the_result():

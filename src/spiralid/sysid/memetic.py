@@ -200,9 +200,8 @@ def projected_spiral(
         before = search.fun
         search.step()
         nit += 1
-        if polish_every and search.nit % polish_every == 0:
-            if spent() + polish_nfev > max_nfev:
-                break
+        due = polish_every and search.nit % polish_every == 0
+        if due and spent() + polish_nfev <= max_nfev:
             polish()
         improved = search.fun < before * (1.0 - 1e-9)
         stalled = 0 if improved else stalled + 1
@@ -221,7 +220,7 @@ def projected_spiral(
             search = new_search(restart_points)
             n_restarts += 1
             stalled = 0
-    if polish_every and spent() + polish_nfev <= max_nfev:
+    if polish_every and status != 0 and spent() + polish_nfev <= max_nfev:
         polish()
     if search.fun < best_f:
         best_z, best_f = search.x, search.fun
