@@ -39,7 +39,7 @@ from spiralid.optim.rules import (
     StepRateRule,
 )
 
-__all__ = ["SpiralResult", "SpiralSearch", "minimize"]
+__all__ = ["METHODS", "SpiralResult", "SpiralSearch", "minimize"]
 
 # Every stop message comes from here, so `message` is always one of these
 # (plus the notes below).
@@ -71,6 +71,8 @@ _METHODS = {
 # Rules whose output is right by construction (exact types: a subclass may
 # override __call__).
 _BUILTIN = (ConstantSpiral, ExponentialSpiral, LinearSpiral)
+METHODS = tuple(_METHODS)
+"""Names of the spiral rules, for ``method``."""
 _POLICIES = ("none", "clip", "reflect")
 
 
