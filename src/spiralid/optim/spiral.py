@@ -405,6 +405,7 @@ class SpiralSearch:
         """Perform one iteration; return the best point and cost."""
         x = self._x
         k = x.shape[0] - 1
+        centre_cost = _finite_or_inf(self._f[0])
         if self._fixed is not None:
             self._step_rate(x)
         else:
@@ -418,7 +419,7 @@ class SpiralSearch:
         self.history.append(self._best_cost())
         # Step 4 of the convergence setting: k* is the iteration at which
         # the centre last moved (it only moves to a strictly better cost).
-        if float(self._f[0]) < self._centre_cost:
+        if float(self._f[0]) < centre_cost:
             self.last_move = self.nit
         return self.x, self.fun
 
@@ -434,7 +435,6 @@ class SpiralSearch:
                 raise ValueError(
                     f"`method` step_rate must return a number in (0, 1]; got {r!r}"
                 )
-        self._centre_cost = _finite_or_inf(self._f[0])
         w = x[1:] - x[0]
         x[1:] = w @ self._fixed.T
         x[1:] *= r
@@ -444,7 +444,6 @@ class SpiralSearch:
 
     def _step_angles(self, x: np.ndarray, k: int) -> None:
         """x_i <- x* + r_i R(theta_i) (x_i - x*) with the rule's r_i, theta_i."""
-        self._centre_cost = _finite_or_inf(self._f[0])
         out = self.rule(self._deviations(), self._rng)
         # The built-in rules give finite values of the right shape by
         # construction; checking them would cost about a tenth of the
