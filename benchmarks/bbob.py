@@ -37,15 +37,23 @@ from pathlib import Path
 
 import numpy as np
 
-from spiralid.optim import METHODS, Restarts, minimize
+from spiralid.optim import RULES, Restarts, minimize
 
 TARGETS = 10.0 ** (2.0 - 0.2 * np.arange(51))  # COCO's 51 standard targets
 DIMS = (2, 5, 10, 20)
 FUNCTIONS = tuple(range(1, 25))
 INSTANCES = tuple(range(1, 16))
+# BBOB's five function groups.
+GROUPS = {
+    "separable": range(1, 6),
+    "moderate": range(6, 10),
+    "ill-conditioned": range(10, 15),
+    "multimodal": range(15, 20),
+    "weakly structured": range(20, 25),
+}
 RESTART = "+restarts"
 REFERENCES = ("cma", "random")
-ALL_METHODS = (*METHODS, *(m + RESTART for m in METHODS), *REFERENCES)
+ALL_METHODS = (*RULES, *(m + RESTART for m in RULES), *REFERENCES)
 # Every bbob function has its optimum in [-4, 4]^D; the search box is [-5, 5]^D.
 SIGMA0 = 2.0
 
@@ -228,9 +236,16 @@ def _blocks(dat: Path) -> list[float]:
     return deltas
 
 
-def fraction_reached(deltas: dict, dim: int) -> tuple[float, int]:
-    """Fraction of (function, instance, target) triples reached in ``dim``."""
-    values = np.array([v for (d, _, _), v in deltas.items() if d == dim])
+def fraction_reached(deltas: dict, dim: int, functions=None) -> tuple[float, int]:
+    """Fraction of (function, instance, target) triples reached in ``dim``
+    (over ``functions`` only, if given)."""
+    values = np.array(
+        [
+            v
+            for (d, f, _), v in deltas.items()
+            if d == dim and (functions is None or f in functions)
+        ]
+    )
     if values.size == 0:
         return math.nan, 0
     hit = values[:, None] <= TARGETS[None, :]
@@ -266,6 +281,9 @@ def _parse(argv):
         action="store_true",
         help="only tabulate the complete tasks already in OUTPUT",
     )
+    parser.add_argument(
+        "--markdown", action="store_true", help="also print the README's tables"
+    )
     return parser.parse_args(argv)
 
 
@@ -292,6 +310,8 @@ def main(argv=None) -> dict:
     total = time.perf_counter() - start
     summary = _summarise(args, out)
     _print(args, summary, total)
+    if args.markdown:
+        _markdown(args, summary)
     (out / "summary.json").write_text(json.dumps(summary, indent=1))
     if args.cocopp:
         _postprocess(out, args.methods)
@@ -313,11 +333,16 @@ def _summarise(args, out) -> dict:
             timing = json.loads((folder / "timing.json").read_text())
             wall, inside = timing["wall_s"], timing["objective_s"]
             evals = timing["evaluations"]
-            fraction, problems = fraction_reached(final_deltas(folder), dim)
+            deltas = final_deltas(folder)
+            fraction, problems = fraction_reached(deltas, dim)
             summary[f"{method} D={dim}"] = {
                 "method": method,
                 "dim": dim,
                 "fraction": fraction,
+                "groups": {
+                    group: fraction_reached(deltas, dim, functions)[0]
+                    for group, functions in GROUPS.items()
+                },
                 "problems": problems,
                 "wall_s": wall,
                 "evaluations": evals,
@@ -353,6 +378,42 @@ def _print(args, summary, total) -> None:
             f"{row['problems']:>10}{row['wall_s']:>9.1f}{row['evaluations']:>11}"
             f"{row['objective_us_per_eval']:>9.2f}{row['overhead_us_per_eval']:>11.2f}"
         )
+
+
+def _markdown(args, summary) -> None:
+    """Fractions, then the optimiser's time per evaluation, method by D."""
+    dims = [
+        d for d in sorted(args.dims) if any(r["dim"] == d for r in summary.values())
+    ]
+    for key, what, fmt in (
+        ("fraction", "fraction of (function, instance, target) triples", ".3f"),
+        ("overhead_us_per_eval", "optimiser's time per evaluation, us", ".1f"),
+    ):
+        print(f"\n{what}\n")
+        print("| method | " + " | ".join(f"D = {d}" for d in dims) + " |")
+        print("|---|" + "---|" * len(dims))
+        for method in args.methods:
+            cells = []
+            for d in dims:
+                row = summary.get(f"{method} D={d}")
+                cells.append("" if row is None else format(row[key], fmt))
+            print(f"| {method} | " + " | ".join(cells) + " |")
+    largest = dims[-1]
+    print(f"\nfraction by function group, D = {largest}\n")
+    print("| method | " + " | ".join(GROUPS) + " |")
+    print("|---|" + "---|" * len(GROUPS))
+    for method in args.methods:
+        row = summary.get(f"{method} D={largest}")
+        if row is not None:
+            cells = [format(row["groups"][g], ".3f") for g in GROUPS]
+            print(f"| {method} | " + " | ".join(cells) + " |")
+    walls = {
+        d: sum(r["wall_s"] for r in summary.values() if r["dim"] == d) for d in dims
+    }
+    print(
+        "\nwall time per dimension, all methods, s: "
+        + ", ".join(f"D = {d}: {w:.0f}" for d, w in walls.items())
+    )
 
 
 def _postprocess(out: Path, methods) -> None:

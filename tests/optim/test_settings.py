@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from spiralid.optim import (
+    RULES,
     ConvergentSpiral,
     ExponentialSpiral,
     PeriodicSpiral,
@@ -22,7 +23,6 @@ from spiralid.optim import (
     minimize,
     rank_condition,
 )
-from spiralid.optim.spiral import _METHODS
 from spiralid.optim.testfunctions import PROBLEMS, rastrigin, rosenbrock
 
 
@@ -278,7 +278,7 @@ def test_restarts_collapse_criteria():
     assert Restarts().next_size(7) == 14 and Restarts(growth=1.5).next_size(7) == 11
 
 
-@pytest.mark.parametrize("method", list(_METHODS))
+@pytest.mark.parametrize("method", list(RULES))
 def test_restarts_grow_the_population_within_the_budget(method):
     p = PROBLEMS["rastrigin"]
     sizes = []

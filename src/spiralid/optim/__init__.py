@@ -21,10 +21,10 @@ from spiralid.optim.rules import (
     exponential_rule,
     rank_condition,
 )
-from spiralid.optim.spiral import METHODS, SpiralResult, SpiralSearch, minimize
+from spiralid.optim.spiral import RULES, SpiralResult, SpiralSearch, minimize
 
 __all__ = [
-    "METHODS",
+    "RULES",
     "ConstantSpiral",
     "ConvergentSpiral",
     "ExponentialSpiral",

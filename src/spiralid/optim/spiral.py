@@ -39,7 +39,7 @@ from spiralid.optim.rules import (
     StepRateRule,
 )
 
-__all__ = ["METHODS", "SpiralResult", "SpiralSearch", "minimize"]
+__all__ = ["RULES", "SpiralResult", "SpiralSearch", "minimize"]
 
 # Every stop message comes from here, so `message` is always one of these
 # (plus the notes below).
@@ -59,7 +59,6 @@ _NOTES = {
     "target_missed": "The target cost was not reached.",
 }
 
-# The one table of rule names: identify, the CLI and the benchmarks read it.
 _METHODS = {
     "sda": ConstantSpiral,
     "ebsda": ExponentialSpiral,
@@ -71,8 +70,9 @@ _METHODS = {
 # Rules whose output is right by construction (exact types: a subclass may
 # override __call__).
 _BUILTIN = (ConstantSpiral, ExponentialSpiral, LinearSpiral)
-METHODS = tuple(_METHODS)
-"""Names of the spiral rules, for ``method``."""
+# The one list of rule names: minimize() accepts them, and
+# spiralid.sysid.identify() offers each as an identification method.
+RULES = _METHODS
 _POLICIES = ("none", "clip", "reflect")
 
 
@@ -175,8 +175,8 @@ def _parse_method(method) -> SpiralRule | StepRateRule:
         return _METHODS[method.lower()]()
     names = ", ".join(repr(name) for name in _METHODS)
     raise ValueError(
-        f"`method` must be one of {names}, a SpiralRule or a StepRateRule "
-        f"instance; got {method!r}"
+        f"`method` must be {names}, a SpiralRule or a StepRateRule instance; "
+        f"got {method!r}"
     )
 
 
