@@ -71,12 +71,6 @@ class _Timed:
         self.seconds += time.perf_counter() - start
         return out
 
-    def one(self, x):
-        start = time.perf_counter()
-        value = self.problem(x)
-        self.seconds += time.perf_counter() - start
-        return value
-
 
 def _spiral(problem, objective, budget, rng, method, n_points):
     name, restarts = method.removesuffix(RESTART), method.endswith(RESTART)
@@ -96,7 +90,11 @@ def _spiral(problem, objective, budget, rng, method, n_points):
 
 
 def _cma(problem, objective, budget, rng, method, n_points):
-    """IPOP-CMA-ES (pycma): restarts doubling the population, same budget."""
+    """IPOP-CMA-ES (pycma): restarts doubling the population, same budget.
+
+    pycma checks ``maxfevals`` after a whole generation, so its last one may
+    pass the budget by less than one population.
+    """
     import cma
 
     popsize = None  # pycma's default 4 + 3 ln D first
