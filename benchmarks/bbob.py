@@ -92,13 +92,15 @@ def _spiral(problem, objective, budget, rng, method, n_points):
 def _cma(problem, objective, budget, rng, method, n_points):
     """IPOP-CMA-ES (pycma): restarts doubling the population, same budget.
 
-    pycma checks ``maxfevals`` after a whole generation, so its last one may
-    pass the budget by less than one population.
+    Like the spiral searches, it stops before a generation that would pass
+    the budget (pycma's own ``maxfevals`` is checked after a generation).
     """
     import cma
 
     popsize = None  # pycma's default 4 + 3 ln D first
-    while problem.evaluations < budget and not problem.final_target_hit:
+    while (
+        not problem.final_target_hit and problem.evaluations + (popsize or 1) <= budget
+    ):
         x0 = rng.uniform(-4.0, 4.0, problem.dimension)
         options = {
             "maxfevals": budget - problem.evaluations,
@@ -108,7 +110,11 @@ def _cma(problem, objective, budget, rng, method, n_points):
         if popsize is not None:
             options["popsize"] = popsize
         es = cma.CMAEvolutionStrategy(x0, SIGMA0, options)
-        while not es.stop() and not problem.final_target_hit:
+        while (
+            not es.stop()
+            and not problem.final_target_hit
+            and problem.evaluations + es.popsize <= budget
+        ):
             X = es.ask()
             es.tell(X, objective(np.array(X)).tolist())
         popsize = 2 * es.popsize
