@@ -1,4 +1,5 @@
-"""General-purpose spiral dynamic optimisers (SDA, Eb-SDA, linear adaptive SDA).
+"""General-purpose spiral dynamic optimisers (SDA, Eb-SDA, linear adaptive SDA,
+Tamura & Yasuda's periodic and convergent settings), with optional restarts.
 
 Knows nothing of system identification. See :func:`minimize`;
 :func:`differential_evolution` is the baseline beside them.
@@ -6,28 +7,40 @@ Knows nothing of system identification. See :func:`minimize`;
 
 from spiralid.optim import testfunctions
 from spiralid.optim.evolution import differential_evolution
+from spiralid.optim.restarts import Restarts
 from spiralid.optim.rotation import planes, rotate, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,
+    ConvergentSpiral,
     ExponentialSpiral,
     LinearSpiral,
+    PeriodicSpiral,
     SpiralRule,
+    StepRateRule,
+    descent_rotation,
     exponential_rule,
+    rank_condition,
 )
 from spiralid.optim.spiral import RULES, SpiralResult, SpiralSearch, minimize
 
 __all__ = [
     "RULES",
     "ConstantSpiral",
+    "ConvergentSpiral",
     "ExponentialSpiral",
     "LinearSpiral",
+    "PeriodicSpiral",
+    "Restarts",
     "SpiralResult",
     "SpiralRule",
     "SpiralSearch",
+    "StepRateRule",
+    "descent_rotation",
     "differential_evolution",
     "exponential_rule",
     "minimize",
     "planes",
+    "rank_condition",
     "rotate",
     "rotation_matrix",
     "testfunctions",

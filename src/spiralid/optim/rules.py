@@ -10,6 +10,16 @@ step 2). A non-finite cost gives ``d_i = inf``.
   and (8).
 - :class:`LinearSpiral`: a linear adaptive rule, the alternative the paper
   contrasts Eb-SDA with (our reading; see the class).
+
+A :class:`StepRateRule` is the other kind of setting: one fixed rotation
+matrix for every point and a step rate ``r(k)`` that depends on the
+iteration, as in Tamura & Yasuda's later settings with convergence
+conditions (IEEE Trans. SMC: Systems, 2020):
+
+- :class:`PeriodicSpiral`: the periodic-descent-direction setting,
+  ``r = delta^(1 / k_max)``.
+- :class:`ConvergentSpiral`: the convergence setting, ``r(k) = 1`` for
+  ``2n`` iterations after each centre update, ``h < 1`` otherwise.
 """
 
 import math
@@ -18,15 +28,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid._checks import positive, real, real_array
+from spiralid._checks import integer, positive, real, real_array
 from spiralid.optim import _kernels
 
 __all__ = [
     "ConstantSpiral",
+    "ConvergentSpiral",
     "ExponentialSpiral",
     "LinearSpiral",
+    "PeriodicSpiral",
     "SpiralRule",
+    "StepRateRule",
+    "descent_rotation",
     "exponential_rule",
+    "rank_condition",
 ]
 
 # Beyond z = 60 the value moves by under expit(-60) (upper - lower), about
@@ -89,6 +104,16 @@ def _deviations(d) -> np.ndarray:
     if d.ndim != 1:
         raise _bad_deviations(d)
     return d
+
+
+def _relative(d: np.ndarray) -> np.ndarray:
+    """``d`` over its largest finite entry (unchanged if that is 0 or none).
+
+    NaN and negative entries pass through for the caller's check.
+    """
+    finite = d[np.isfinite(d)]
+    spread = float(finite.max()) if finite.size else 0.0
+    return d / spread if spread > 0.0 else d
 
 
 @dataclass(frozen=True)
@@ -192,6 +217,13 @@ class ExponentialSpiral(SpiralRule):
     eq. (8), garbled in print, read in the same form with ``th_l=0.1,
     th_u=2`` (radians), ``c1=10, c2=1``.
 
+    ``scale_free=True`` (not the paper's; off by default) divides each
+    deviation by the population's current cost spread, the largest finite
+    ``d_i`` (worst finite cost minus the centre's), before eq. (4), so that
+    multiplying the cost by any positive constant leaves the radii, the
+    angles and hence the whole search unchanged. The paper's rule depends
+    on the cost's scale through ``c2 d``.
+
     Examples
     --------
     >>> import numpy as np
@@ -208,10 +240,16 @@ class ExponentialSpiral(SpiralRule):
     th_u: float = 2.0
     th_c1: float = 10.0
     th_c2: float = 1.0
+    scale_free: bool = False
 
     def __post_init__(self):
         r_l, r_u = _check_interval(self.r_l, self.r_u, "r_l", "r_u", radius=True)
         th_l, th_u = _check_interval(self.th_l, self.th_u, "th_l", "th_u", radius=False)
+        if not isinstance(self.scale_free, bool | np.bool_):
+            raise ValueError(
+                f"`scale_free` must be True or False; got {self.scale_free!r}"
+            )
+        object.__setattr__(self, "scale_free", bool(self.scale_free))
         values = {"r_l": r_l, "r_u": r_u, "th_l": th_l, "th_u": th_u}
         for name in ("r_c1", "r_c2", "th_c1", "th_c2"):
             values[name] = positive(getattr(self, name), name, strict=False)
@@ -243,6 +281,8 @@ class ExponentialSpiral(SpiralRule):
 
     def __call__(self, d, rng):
         d = _deviations(d)
+        if self.scale_free:
+            d = _relative(d)
         (r, theta), zeros, invalid = _kernels.exponential(d, *self._consts)
         if invalid:
             raise _bad_deviations(d)
@@ -317,3 +357,185 @@ class LinearSpiral(SpiralRule):
         r = self.r_l + (self.r_u - self.r_l) * g
         theta = self.th_l + (self.th_u - self.th_l) * g
         return r, theta
+
+
+class StepRateRule(ABC):
+    """A spiral setting with one fixed rotation and a step rate per iteration.
+
+    Every point moves as ``x_i(k+1) = x*(k) + r(k) R (x_i(k) - x*(k))`` with
+    the same matrix ``R`` (:meth:`rotation`) and step rate ``r(k)``
+    (:meth:`step_rate`), the form of Tamura & Yasuda's settings with
+    convergence conditions (IEEE Trans. SMC: Systems, 2020). Subclass it to
+    pass a custom setting as the ``method`` of :func:`spiralid.optim.minimize`.
+    """
+
+    def rotation(self, n: int) -> np.ndarray:
+        """The rotation matrix ``R`` in dimension ``n``; default
+        :func:`descent_rotation`."""
+        return descent_rotation(n)
+
+    @abstractmethod
+    def step_rate(self, k: int, k_star: int, n: int, k_max: int) -> float:
+        """Step rate ``r(k)`` in (0, 1].
+
+        Parameters
+        ----------
+        k : int
+            Current iteration, ``0 <= k < k_max``.
+        k_star : int
+            Last iteration at which the centre moved (0 at the start).
+        n : int
+            Dimension.
+        k_max : int
+            The search's iteration budget.
+        """
+
+
+def descent_rotation(n: int) -> np.ndarray:
+    """Tamura & Yasuda's rotation for the periodic-descent-direction setting.
+
+    ``R = [[0^T, -1], [I_(n-1), 0]]``: coordinate ``j`` moves to ``j + 1``
+    and the last returns, negated, to the first. It is orthogonal with
+    ``R^n = -I`` and ``R^(2n) = I``, so a spiral vector ``R^k d`` runs
+    through ``d, R d, ..., R^(n-1) d`` and their negatives: with the rank
+    condition of :func:`rank_condition`, these ``2n`` directions span the
+    space positively and one of them descends in every ``2n`` iterations.
+
+    Parameters
+    ----------
+    n : int
+        Dimension, ``n >= 1`` (``n = 1`` gives ``[[-1.0]]``).
+
+    Examples
+    --------
+    >>> descent_rotation(3).astype(int).tolist()
+    [[0, 0, -1], [1, 0, 0], [0, 1, 0]]
+    """
+    n = integer(n, "n", 1)
+    out = np.zeros((n, n))
+    out[0, n - 1] = -1.0
+    out[np.arange(1, n), np.arange(n - 1)] = 1.0
+    return out
+
+
+def rank_condition(points, rotation=None) -> bool:
+    """The initial-point condition of Tamura & Yasuda's settings.
+
+    ``min_i max_j rank[d_ji, R d_ji, ..., R^(2n-1) d_ji] = n`` with
+    ``d_ji = x_j(0) - x_i(0)``: whichever point becomes the centre, some
+    other point's spiral vectors span the space. Uniformly drawn points
+    satisfy it with probability one.
+
+    Parameters
+    ----------
+    points : array_like, shape (m, n)
+        Initial points, ``m >= 2``.
+    rotation : array_like, shape (n, n), optional
+        ``R``; default :func:`descent_rotation`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rank_condition(np.random.default_rng(0).uniform(size=(5, 3)))
+    True
+    >>> rank_condition([[0.0, 0.0, 0.0], [1.0, -1.0, 1.0]])  # eigenvector of R
+    False
+    """
+    x = real_array(points, "points")
+    if x.ndim != 2 or x.shape[0] < 2:
+        raise ValueError(f"`points` must have shape (m, n), m >= 2; got {x.shape}")
+    m, n = x.shape
+    R = descent_rotation(n) if rotation is None else real_array(rotation, "rotation")
+    if R.shape != (n, n):
+        raise ValueError(f"`rotation` must have shape ({n}, {n}); got {R.shape}")
+    for i in range(m):
+        d = x - x[i]
+        # Columns R^k d_j for k < 2n, all j at once: shape (m, n, 2n).
+        krylov = np.empty((m, n, 2 * n))
+        for k in range(2 * n):
+            krylov[:, :, k] = d
+            d = d @ R.T
+        ranks = np.linalg.matrix_rank(np.delete(krylov, i, axis=0))
+        if ranks.max() < n:
+            return False
+    return True
+
+
+def _delta(value, name: str) -> float:
+    value = real(value, name, strict=False)
+    if not 0.0 < value < 1.0:
+        raise ValueError(f"`{name}` must be in (0, 1); got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class PeriodicSpiral(StepRateRule):
+    """Periodic-descent-direction setting (Tamura & Yasuda 2020).
+
+    ``R`` is :func:`descent_rotation` and the step rate is constant,
+    ``r = delta^(1 / k_max)``, so that the spiral has shrunk by exactly
+    ``delta`` when the iteration budget ``k_max`` runs out.
+
+    Parameters
+    ----------
+    delta : float
+        Final contraction in (0, 1); default 1e-3, the value the setting
+        suggests.
+
+    Examples
+    --------
+    >>> rule = PeriodicSpiral(delta=1e-3)
+    >>> round(rule.step_rate(0, 0, 2, 100) ** 100, 12)
+    0.001
+    """
+
+    delta: float = 1e-3
+
+    def __post_init__(self):
+        object.__setattr__(self, "delta", _delta(self.delta, "delta"))
+
+    def step_rate(self, k, k_star, n, k_max):
+        return self.delta ** (1.0 / k_max)
+
+
+@dataclass(frozen=True)
+class ConvergentSpiral(StepRateRule):
+    """Convergence setting (Tamura & Yasuda 2020).
+
+    ``R`` is :func:`descent_rotation`; the step rate is ``r(k) = 1`` while
+    ``k <= k* + 2n - 1``, ``k*`` being the last iteration that moved the
+    centre, and ``h < 1`` after that. With ``r = 1`` each point's offset
+    from an unchanged centre runs through its ``2n`` periodic directions
+    ``R^k d``; only when none of them improved does the spiral contract by
+    ``h``. This is a direct search with a positive spanning set, so for a
+    continuously differentiable cost with bounded level sets the centre
+    approaches a stationary point as the iterations go on.
+
+    Parameters
+    ----------
+    h : float or None
+        Contraction in (0, 1) after ``2n`` iterations without a centre
+        update. ``None`` (default) uses ``delta^(1 / k_max)`` as the setting
+        suggests.
+    delta : float
+        As in :class:`PeriodicSpiral`, for the default ``h``.
+
+    Examples
+    --------
+    >>> rule = ConvergentSpiral(h=0.5)
+    >>> [rule.step_rate(k, 0, 2, 100) for k in (0, 3, 4)]
+    [1.0, 1.0, 0.5]
+    """
+
+    h: float | None = None
+    delta: float = 1e-3
+
+    def __post_init__(self):
+        if self.h is not None:
+            object.__setattr__(self, "h", _delta(self.h, "h"))
+        object.__setattr__(self, "delta", _delta(self.delta, "delta"))
+
+    def step_rate(self, k, k_star, n, k_max):
+        if k <= k_star + 2 * n - 1:
+            return 1.0
+        return self.delta ** (1.0 / k_max) if self.h is None else self.h

@@ -27,12 +27,16 @@ from scipy.optimize import Bounds
 
 from spiralid._checks import generator, integer, real_array
 from spiralid.optim import _kernels
+from spiralid.optim.restarts import MIN_ITER, Restarts, parse_restarts
 from spiralid.optim.rotation import _sweep_order, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,
+    ConvergentSpiral,
     ExponentialSpiral,
     LinearSpiral,
+    PeriodicSpiral,
     SpiralRule,
+    StepRateRule,
 )
 
 __all__ = ["RULES", "SpiralResult", "SpiralSearch", "minimize"]
@@ -55,7 +59,17 @@ _NOTES = {
     "target_missed": "The target cost was not reached.",
 }
 
-_METHODS = {"sda": ConstantSpiral, "ebsda": ExponentialSpiral, "lasda": LinearSpiral}
+_METHODS = {
+    "sda": ConstantSpiral,
+    "ebsda": ExponentialSpiral,
+    "lasda": LinearSpiral,
+    "ebsda-scaled": lambda: ExponentialSpiral(scale_free=True),
+    "periodic": PeriodicSpiral,
+    "convergent": ConvergentSpiral,
+}
+# Rules whose output is right by construction (exact types: a subclass may
+# override __call__).
+_BUILTIN = (ConstantSpiral, ExponentialSpiral, LinearSpiral)
 # The one list of rule names: minimize() accepts them, and
 # spiralid.sysid.identify() offers each as an identification method.
 RULES = _METHODS
@@ -74,24 +88,29 @@ class SpiralResult:
         Its cost as returned by the objective (non-finite only if no finite
         cost was ever found).
     nit : int
-        Iterations performed.
+        Iterations performed (over all runs, with restarts).
     nfev : int
         Objective evaluations, one per point: ``n_points`` for the initial
         population, then ``n_points - 1`` per iteration (the centre does not
-        move and is not re-evaluated), i.e. ``n_points + nit (n_points - 1)``.
+        move and is not re-evaluated), i.e. ``n_points + nit (n_points - 1)``
+        without restarts; each restart adds its new population.
     success : bool
         True if the search ended on its iteration or evaluation budget or
         on ``target``, with a finite cost (and ``target`` reached if given).
     message : str
         Why the search stopped.
-    history : ndarray, shape (nit + 1,)
-        Best cost after each iteration; index 0 is the initial population.
-        Non-finite costs are recorded as ``inf``, so it never increases.
+    history : ndarray, shape (nit + restarts + 1,)
+        Best cost so far after each iteration and each restart's initial
+        population; index 0 is the initial population. Non-finite costs
+        are recorded as ``inf``, so it never increases.
     elapsed : float
         Wall-clock seconds, objective evaluations included.
     mean_radius, mean_angle : ndarray, shape (nit,)
         Mean radius and angle (radians) over the moving points at each
-        iteration, for plots of the rule's behaviour.
+        iteration, for plots of the rule's behaviour. A
+        :class:`~spiralid.optim.StepRateRule` has no angle: NaN.
+    restarts : int
+        Number of restarts (0 unless ``restarts`` was set).
     """
 
     x: np.ndarray
@@ -104,6 +123,7 @@ class SpiralResult:
     elapsed: float
     mean_radius: np.ndarray
     mean_angle: np.ndarray
+    restarts: int = 0
 
 
 def _parse_bounds(bounds) -> tuple[np.ndarray, np.ndarray]:
@@ -148,14 +168,15 @@ def _parse_bounds(bounds) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
-def _parse_method(method) -> SpiralRule:
-    if isinstance(method, SpiralRule):
+def _parse_method(method) -> SpiralRule | StepRateRule:
+    if isinstance(method, SpiralRule | StepRateRule):
         return method
     if isinstance(method, str) and method.lower() in _METHODS:
         return _METHODS[method.lower()]()
     names = ", ".join(repr(name) for name in _METHODS)
     raise ValueError(
-        f"`method` must be {names} or a SpiralRule instance; got {method!r}"
+        f"`method` must be {names}, a SpiralRule or a StepRateRule instance; "
+        f"got {method!r}"
     )
 
 
@@ -205,6 +226,10 @@ class SpiralSearch:
     ----------
     fun, bounds, method, n_points, rng, vectorized, x0, bounds_policy
         As in :func:`minimize`.
+    max_iter : int, optional
+        Iteration budget ``k_max`` that a
+        :class:`~spiralid.optim.StepRateRule` schedules its step rate over
+        (required for those rules; the search itself does not stop there).
 
     Examples
     --------
@@ -227,14 +252,14 @@ class SpiralSearch:
         vectorized: bool = False,
         x0=None,
         bounds_policy: str = "none",
+        max_iter: int | None = None,
     ):
         if not callable(fun):
             raise ValueError(f"`fun` must be callable; got {fun!r}")
         self._fun = fun
         self._lo, self._hi = _parse_bounds(bounds)
         self.rule = _parse_method(method)
-        # Exact types: a subclass may override __call__.
-        self._builtin_rule = type(self.rule) in _METHODS.values()
+        self._builtin_rule = type(self.rule) in _BUILTIN
         m = integer(n_points, "n_points", 2)
         if not isinstance(bounds_policy, str) or bounds_policy not in _POLICIES:
             raise ValueError(
@@ -247,21 +272,59 @@ class SpiralSearch:
         n = self._lo.size
         seeds = self._parse_x0(x0, m, n)
         self._rng = generator(rng)
+        self._planes = _sweep_order(n)
+        self._matrix = (None, None)
+        self._fixed = None
+        if isinstance(self.rule, StepRateRule):
+            if max_iter is None:
+                raise ValueError(
+                    "`max_iter` (the iteration budget k_max) is required for a "
+                    f"step-rate rule such as {type(self.rule).__name__}"
+                )
+            self._fixed = _fixed_rotation(self.rule, n)
+        self._k_max = None if max_iter is None else integer(max_iter, "max_iter", 1)
+        self.nfev = 0
+        self.nit = 0
+        self.restarts = 0
+        # The best of earlier runs (restarts), as (x, f); row 0 is this run's.
+        self._archive = (None, math.inf)
+        self._populate(seeds, m)
+        self.initial_nonfinite = not math.isfinite(self._f[0])
+        self.history = [self._best_cost()]
+        self.mean_radius: list[float] = []
+        self.mean_angle: list[float] = []
+
+    def _populate(self, seeds: np.ndarray, m: int) -> None:
+        """Draw and evaluate a new run's population; ``seeds`` come first."""
+        n = self._lo.size
         x = np.empty((m, n))
         k = seeds.shape[0]
         x[:k] = seeds
         x[k:] = self._rng.uniform(self._lo, self._hi, size=(m - k, n))
         self._x = x
         self._f = self._evaluate(x)
-        self.nfev = m
-        self.nit = 0
-        self._planes = _sweep_order(n)
-        self._matrix = (None, None)
+        self.nfev += m
         self._promote()
-        self.initial_nonfinite = not math.isfinite(self._f[0])
-        self.history = [self._best_cost()]
-        self.mean_radius: list[float] = []
-        self.mean_angle: list[float] = []
+        # Iterations are counted from the run's start for step-rate rules.
+        self._run_start = self.nit
+        self.last_move = self.nit
+
+    def restart(self, n_points: int, max_iter: int | None = None) -> None:
+        """Replace the population by ``n_points`` fresh uniform points.
+
+        The best point so far is kept aside (it stays :attr:`x`), so the
+        new run explores from scratch as IPOP-CMA-ES does. ``max_iter`` is
+        the new run's iteration budget for step-rate rules.
+        """
+        m = integer(n_points, "n_points", 2)
+        if max_iter is not None:
+            self._k_max = integer(max_iter, "max_iter", 1)
+        f0 = float(self._f[0])
+        if math.isfinite(f0) and f0 < self._archive[1]:
+            self._archive = (self._x[0].copy(), f0)
+        self._populate(np.empty((0, self._lo.size)), m)
+        self.restarts += 1
+        self.history.append(self._best_cost())
 
     def _parse_x0(self, x0, m: int, n: int) -> np.ndarray:
         if x0 is None:
@@ -311,7 +374,7 @@ class SpiralSearch:
 
     def _best_cost(self) -> float:
         f0 = float(self._f[0])
-        return f0 if math.isfinite(f0) else math.inf
+        return min(f0 if math.isfinite(f0) else math.inf, self._archive[1])
 
     def _deviations(self) -> np.ndarray:
         """``|f(x_i) - min J|`` of the moving points; ``inf`` if non-finite."""
@@ -342,6 +405,45 @@ class SpiralSearch:
         """Perform one iteration; return the best point and cost."""
         x = self._x
         k = x.shape[0] - 1
+        centre_cost = _finite_or_inf(self._f[0])
+        if self._fixed is not None:
+            self._step_rate(x)
+        else:
+            self._step_angles(x, k)
+        if self.bounds_policy != "none":
+            self._apply_bounds(x[1:])
+        self._f[1:] = self._evaluate(x[1:])
+        self.nfev += k
+        self.nit += 1
+        self._promote()
+        self.history.append(self._best_cost())
+        # Step 4 of the convergence setting: k* is the iteration at which
+        # the centre last moved (it only moves to a strictly better cost).
+        if float(self._f[0]) < centre_cost:
+            self.last_move = self.nit
+        return self.x, self.fun
+
+    def _step_rate(self, x: np.ndarray) -> None:
+        """x_i <- x* + r(k) R (x_i - x*) with the rule's fixed R."""
+        k = self.nit - self._run_start
+        r = self.rule.step_rate(
+            k, self.last_move - self._run_start, self._lo.size, self._k_max
+        )
+        if not self._builtin_rule:
+            r = float(r)
+            if not 0.0 < r <= 1.0:
+                raise ValueError(
+                    f"`method` step_rate must return a number in (0, 1]; got {r!r}"
+                )
+        w = x[1:] - x[0]
+        x[1:] = w @ self._fixed.T
+        x[1:] *= r
+        x[1:] += x[0]
+        self.mean_radius.append(float(r))
+        self.mean_angle.append(math.nan)
+
+    def _step_angles(self, x: np.ndarray, k: int) -> None:
+        """x_i <- x* + r_i R(theta_i) (x_i - x*) with the rule's r_i, theta_i."""
         out = self.rule(self._deviations(), self._rng)
         # The built-in rules give finite values of the right shape by
         # construction; checking them would cost about a tenth of the
@@ -363,14 +465,6 @@ class SpiralSearch:
             _kernels.spiral_step(x, r, theta, self._planes)
             self.mean_radius.append(float(r.sum()) / k)
             self.mean_angle.append(float(theta.sum()) / k)
-        if self.bounds_policy != "none":
-            self._apply_bounds(x[1:])
-        self._f[1:] = self._evaluate(x[1:])
-        self.nfev += k
-        self.nit += 1
-        self._promote()
-        self.history.append(self._best_cost())
-        return self.x, float(self._f[0])
 
     def move_centre(self, x, fun: float) -> bool:
         """Replace the centre by `x` of cost `fun` if that is lower.
@@ -401,13 +495,27 @@ class SpiralSearch:
 
     @property
     def x(self) -> np.ndarray:
-        """The centre: best point so far."""
+        """The best point so far: the centre, or an earlier run's best."""
+        if self._archive[1] < _finite_or_inf(self._f[0]):
+            return self._archive[0].copy()
         return self._x[0].copy()
 
     @property
     def fun(self) -> float:
-        """The centre's cost."""
-        return float(self._f[0])
+        """The cost of :attr:`x`."""
+        return min(float(self._f[0]), self._archive[1])
+
+    @property
+    def n_points(self) -> int:
+        """Size of the current run's population."""
+        return self._x.shape[0]
+
+    def collapsed(self, restarts: Restarts) -> bool:
+        """Whether the current run has collapsed by ``restarts``' criteria."""
+        width = float(np.max(self._hi - self._lo))
+        return restarts.collapsed(
+            self._x[1:] - self._x[0], width, self.nit - self.last_move
+        )
 
     @property
     def population(self) -> np.ndarray:
@@ -451,7 +559,23 @@ class SpiralSearch:
             elapsed=elapsed,
             mean_radius=np.array(self.mean_radius),
             mean_angle=np.array(self.mean_angle),
+            restarts=self.restarts,
         )
+
+
+def _finite_or_inf(value) -> float:
+    value = float(value)
+    return value if math.isfinite(value) else math.inf
+
+
+def _fixed_rotation(rule: StepRateRule, n: int) -> np.ndarray:
+    """The rule's rotation matrix, checked once for shape and finiteness."""
+    R = np.array(rule.rotation(n), dtype=np.float64)
+    if R.shape != (n, n) or not np.all(np.isfinite(R)):
+        raise ValueError(
+            f"`method` rotation must be a finite ({n}, {n}) matrix; got {R!r:.80}"
+        )
+    return R
 
 
 def minimize(
@@ -468,6 +592,7 @@ def minimize(
     x0=None,
     callback: Callable | None = None,
     bounds_policy: str = "none",
+    restarts: bool | Restarts = False,
 ) -> SpiralResult:
     """Minimise ``fun`` with a spiral dynamic algorithm (SDA, Eb-SDA, LASDA).
 
@@ -479,12 +604,18 @@ def minimize(
         Non-finite costs are allowed: they rank worst.
     bounds : sequence of (low, high), (n, 2) array or scipy.optimize.Bounds
         Box for the uniform initial points (finite, ``low < high``).
-    method : {"ebsda", "sda", "lasda"} or SpiralRule
+    method : str, SpiralRule or StepRateRule
         ``"ebsda"``: exponential radius and angle, eq. (4), (7), (8)
         (:class:`~spiralid.optim.ExponentialSpiral`); ``"sda"``: constant
         ``r = 0.95, theta = pi/4`` (:class:`~spiralid.optim.ConstantSpiral`);
         ``"lasda"``: linear adaptive (:class:`~spiralid.optim.LinearSpiral`);
-        or any rule object.
+        ``"ebsda-scaled"``: Eb-SDA with ``scale_free=True``;
+        ``"periodic"`` and ``"convergent"``: Tamura & Yasuda's
+        periodic-descent-direction and convergence settings
+        (:class:`~spiralid.optim.PeriodicSpiral`,
+        :class:`~spiralid.optim.ConvergentSpiral`), whose step rate is
+        scheduled over the iteration budget (``max_iter``, or fewer if
+        ``max_nfev`` allows fewer); or any rule object.
     n_points : int
         Number of search points ``m >= 2``.
     max_iter : int
@@ -510,6 +641,13 @@ def minimize(
     bounds_policy : {"none", "clip", "reflect"}
         What to do with points that leave the box. The paper has no bound
         handling, so ``"none"`` (the default) lets them go.
+    restarts : bool or Restarts
+        IPOP-style restarts (:class:`~spiralid.optim.Restarts`): when a run
+        has collapsed, start again from fresh uniform points with a larger
+        population, within the same ``max_iter`` and ``max_nfev``; the best
+        point of all runs is returned. Off by default (the paper's
+        configurations). A restart happens only if its population can still
+        make 10 iterations within the budget.
 
     Returns
     -------
@@ -542,6 +680,16 @@ def minimize(
             raise ValueError(f"`target` must be a real number or None; got {target!r}")
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
+    restarts = parse_restarts(restarts)
+
+    def iterations_left(m: int, nit: int, nfev: int) -> int:
+        # What the budget allows a population of m after nit iterations and
+        # nfev evaluations: a step-rate rule's schedule spans it.
+        left = max_iter - nit
+        if max_nfev is not None:
+            left = min(left, (max_nfev - nfev) // (m - 1))
+        return left
+
     search = SpiralSearch(
         fun,
         bounds,
@@ -551,6 +699,7 @@ def minimize(
         vectorized=vectorized,
         x0=x0,
         bounds_policy=bounds_policy,
+        max_iter=max(iterations_left(m, 0, m), 1),
     )
     status = None
     if target is not None and search.history[-1] <= target:
@@ -559,9 +708,18 @@ def minimize(
         if search.nit >= max_iter:
             status = "max_iter"
             break
+        m = search.n_points
         if max_nfev is not None and search.nfev + (m - 1) > max_nfev:
             status = "max_nfev"
             break
+        if restarts is not None and search.collapsed(restarts):
+            grown = restarts.next_size(m)
+            left = iterations_left(grown, search.nit, search.nfev + grown)
+            if left >= MIN_ITER:
+                search.restart(grown, max_iter=left)
+                if target is not None and search.history[-1] <= target:
+                    status = "target"
+                continue
         search.step()
         # The callback sees every iteration, the last one included, so that
         # callers can time-stamp each entry of `history`.
