@@ -1,18 +1,15 @@
 """The `spiralid` console script, run as a user would (subprocess)."""
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from clitools import run
 
 from spiralid import IdentifiedModel, IOData
 from spiralid.fms import FlexibleManipulator, paper_experiment
 
-SCRIPT = Path(sys.executable).parent / "spiralid"
 ARM = (
     Path(__file__).resolve().parents[1]
     / ".."
@@ -20,13 +17,6 @@ ARM = (
     / "data"
     / "daisy_robot_arm.csv"
 )
-
-
-def run(*args, cwd):
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    return subprocess.run(
-        [str(SCRIPT), *map(str, args)], cwd=cwd, env=env, capture_output=True, text=True
-    )
 
 
 @pytest.fixture(scope="module")
@@ -248,9 +238,9 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
         assert all(len(r["history"]) == r["nit"] + 1 for r in runs)
     # The gain-scaled arms search at w x 10 but are scored at the default w.
     w = results["options"]["gain"]
-    for run in results["runs"]["Eb-SDA (w x 10)"]:
-        assert run["gain"] == pytest.approx(10 * w)
-        assert run["search_cost"] == pytest.approx(10 * run["cost_estimation"])
+    for arm in results["runs"]["Eb-SDA (w x 10)"]:
+        assert arm["gain"] == pytest.approx(10 * w)
+        assert arm["search_cost"] == pytest.approx(10 * arm["cost_estimation"])
     assert results["rules"]["ebsda"]["r_c1"] == 100.0
     assert results["rules"]["sda"]["radius"] == 0.95
     stats = results["statistics"]["SDA"]

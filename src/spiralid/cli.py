@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import shlex
+import signal
 import sys
 from pathlib import Path
 
@@ -156,34 +157,16 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
     raise UsageError(f"data file {path!r} must end in .csv, .npz or .mat")
 
 
-def _new_file(path: Path, force: bool) -> Path:
-    """`path`, its folder created, refusing to overwrite without `force`."""
-    if path.is_dir():
-        raise UsageError(f"{str(path)!r} is a directory, not a file")
-    if path.exists() and not force:
-        raise UsageError(f"{str(path)!r} exists; pass --force to overwrite it")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return path
+def _open_folder(path: str, force: bool):
+    """The output folder, locked and proved writable before any computation."""
+    from spiralid.report.atomic import OutputFolder
+
+    return OutputFolder(path, force).open()
 
 
-def _out_dir(path: str, force: bool) -> Path:
-    from spiralid.report.output import check_output_dir
-
-    try:
-        out = check_output_dir(path, force)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
-    out.mkdir(parents=True, exist_ok=True)
-    return out
-
-
-def _save_figures(figures: dict, out: Path, prefix: str = "") -> list[Path]:
-    paths = []
+def _save_figures(figures: dict, folder: Path, prefix: str = "") -> None:
     for name, fig in figures.items():
-        path = out / f"{prefix}{name}.png"
-        fig.savefig(path, dpi=110)
-        paths.append(path)
-    return paths
+        fig.savefig(folder / f"{prefix}{name}.png", dpi=110)
 
 
 def _progress(args, total: int, label: str):
@@ -196,6 +179,25 @@ def _progress(args, total: int, label: str):
 
 
 def _cmd_simulate(args) -> int:
+    suffix = Path(args.out).suffix.lower()
+    if suffix not in (".csv", ".npz"):
+        raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
+    from spiralid.report.atomic import OutputFile
+
+    with OutputFile(args.out, args.force) as target:
+        rec, rig = _simulate_record(args)
+        _write_record(rec, target.path, suffix)
+        target.commit()
+    if not args.quiet:
+        print(
+            f"wrote {args.out} ({rec.u.size} samples at {args.fs:g} Hz; rig modes "
+            + ", ".join(f"{f:.2f}" for f in rig.modes(3))
+            + " Hz)"
+        )
+    return 0
+
+
+def _simulate_record(args):
     from spiralid.fms import (
         Experiment,
         FlexibleManipulator,
@@ -205,10 +207,6 @@ def _cmd_simulate(args) -> int:
         prbs,
     )
 
-    suffix = Path(args.out).suffix.lower()
-    if suffix not in (".csv", ".npz"):
-        raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
-    path = _new_file(Path(args.out), args.force)
     rig = FlexibleManipulator(payload_mass=args.payload)
     fs = args.fs
     paper = Experiment()
@@ -236,6 +234,10 @@ def _cmd_simulate(args) -> int:
         torque = chirp(amp, 1.0, min(100.0, fs / 2), args.duration, fs)
     sensors = Sensors(accel_noise=args.accel_noise, tach_noise=args.tach_noise)
     rec = rig.simulate(torque, fs=fs, rng=args.seed, sensors=sensors)
+    return rec, rig
+
+
+def _write_record(rec, path: Path, suffix: str) -> None:
     columns = {
         "time_s": rec.t,
         "torque_Nm": rec.u,
@@ -260,13 +262,6 @@ def _cmd_simulate(args) -> int:
             comments="",
             fmt="%.10g",
         )
-    if not args.quiet:
-        print(
-            f"wrote {path} ({rec.u.size} samples at {fs:g} Hz; rig modes "
-            + ", ".join(f"{f:.2f}" for f in rig.modes(3))
-            + " Hz)"
-        )
-    return 0
 
 
 def _structure(args):
@@ -283,7 +278,6 @@ def _cmd_identify(args) -> int:
     arx = _structure(args)
     est, val = data.split(args.fraction)
     arx.check_length(est, "estimation part of DATA")
-    out = _out_dir(args.out, args.force)
     options = {}
     if args.method in ("sda", "ebsda", "lasda", "de"):
         options = {"n_points": args.points}
@@ -296,45 +290,55 @@ def _cmd_identify(args) -> int:
             options["max_iter"] = args.budget
     elif args.refine:
         raise UsageError("--refine applies to the search methods sda, ebsda, lasda, de")
-    model = identify(
-        est,
-        arx,
-        method=args.method,
-        predictor=args.predictor,
-        initial=args.initial,
-        parametrization=args.parametrization,
-        refine=args.refine,
-        rng=args.seed,
-        **options,
-    )
-    v_est = validate(model, est, label=f"{args.method} (estimation)")
-    v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
-    model_path = out / "model.json"
-    model_path.write_text(json.dumps(model.to_dict(), indent=2))
-    (out / "validation.json").write_text(
-        json.dumps(
-            {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
+    with _open_folder(args.out, args.force) as folder:
+        model = identify(
+            est,
+            arx,
+            method=args.method,
+            predictor=args.predictor,
+            initial=args.initial,
+            parametrization=args.parametrization,
+            refine=args.refine,
+            rng=args.seed,
+            **options,
         )
-    )
-    summary = "\n\n".join(
-        [
-            f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}",
-            f"estimation cost (eq. 2): {model.cost:.6g}",
-            v_est.summary(),
-            v_val.summary(),
-        ]
-    )
-    (out / "summary.txt").write_text(summary + "\n")
-    _save_figures(v_val.plot(), out, "validation_")
-    _save_figures(v_est.plot(), out, "estimation_")
-    if model.history is not None:
-        plot_convergence({args.method: model.history}).savefig(
-            out / "convergence.png", dpi=110
+        v_est = validate(model, est, label=f"{args.method} (estimation)")
+        v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
+        staged = folder.path
+        (staged / "model.json").write_text(json.dumps(model.to_dict(), indent=2))
+        (staged / "validation.json").write_text(
+            json.dumps(
+                {"estimation": v_est.to_dict(), "validation": v_val.to_dict()},
+                indent=2,
+            )
         )
+        summary = "\n\n".join(
+            [
+                f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}",
+                f"estimation cost (eq. 2): {model.cost:.6g}",
+                v_est.summary(),
+                v_val.summary(),
+            ]
+        )
+        (staged / "summary.txt").write_text(summary + "\n")
+        _save_figures(v_val.plot(), staged, "validation_")
+        _save_figures(v_est.plot(), staged, "estimation_")
+        if model.history is not None:
+            plot_convergence({args.method: model.history}).savefig(
+                staged / "convergence.png", dpi=110
+            )
+        written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)
-        print(f"\nwrote {model_path} and figures in {out}")
+        print(f"\nwrote {_listing(written, args.out)}")
     return 0
+
+
+def _listing(paths: list[Path], out: str) -> str:
+    """'a, b and c in OUT' for the files a command wrote."""
+    names = [p.name for p in paths]
+    head = ", ".join(names[:-1])
+    return f"{head + ' and ' if head else ''}{names[-1]} in {out}"
 
 
 def _cmd_validate(args) -> int:
@@ -357,48 +361,49 @@ def _cmd_validate(args) -> int:
         warm, data = data.split(args.fraction)
     else:
         warm = None
-    v = validate(model, data, warmup=warm, label=model.method)
-    text = v.summary()
-    if args.out is not None:
-        out = _out_dir(args.out, args.force)
-        (out / "validation.json").write_text(json.dumps(v.to_dict(), indent=2))
-        (out / "summary.txt").write_text(text + "\n")
-        _save_figures(v.plot(), out)
+    if args.out is None:
+        v = validate(model, data, warmup=warm, label=model.method)
+        if not args.quiet:
+            print(v.summary())
+        return 0
+    with _open_folder(args.out, args.force) as folder:
+        v = validate(model, data, warmup=warm, label=model.method)
+        (folder.path / "validation.json").write_text(json.dumps(v.to_dict(), indent=2))
+        (folder.path / "summary.txt").write_text(v.summary() + "\n")
+        _save_figures(v.plot(), folder.path)
+        written = folder.commit(last="validation.json")
     if not args.quiet:
-        print(text)
+        print(v.summary())
+        print(f"\nwrote {_listing(written, args.out)}")
     return 0
 
 
 def _cmd_reproduce(args, argv: list[str]) -> int:
     from spiralid.report import reproduce, summary_text, write_reproduction
-    from spiralid.report.output import check_output_dir
 
-    try:
-        check_output_dir(args.out, args.force)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
     data = source = None
     if args.data is not None:
         data = _load(args.data, args.input, args.output, args.ts)
         source = {"kind": "user data", "path": str(Path(args.data).resolve())}
     elif (args.input, args.output, args.ts) != (None, None, None):
         raise UsageError("--input, --output and --ts describe --data; give --data too")
-    bar = _progress(args, 1, "reproduce")
-    try:
-        rep = reproduce(
-            data,
-            seeds=range(args.first_seed, args.first_seed + args.seeds),
-            max_nfev=args.budget,
-            n_points=args.points,
-            initial=args.initial,
-            source=source,
-            workers=args.workers,
-            progress=bar,
-        )
-    finally:
-        bar.close()
-    command = "spiralid " + shlex.join(argv)
-    write_reproduction(rep, args.out, force=args.force, command=command)
+    with _open_folder(args.out, args.force) as folder:
+        bar = _progress(args, 1, "reproduce")
+        try:
+            rep = reproduce(
+                data,
+                seeds=range(args.first_seed, args.first_seed + args.seeds),
+                max_nfev=args.budget,
+                n_points=args.points,
+                initial=args.initial,
+                source=source,
+                workers=args.workers,
+                progress=bar,
+            )
+        finally:
+            bar.close()
+        command = "spiralid " + shlex.join(argv)
+        write_reproduction(rep, folder, command=command)
     if not args.quiet:
         print(summary_text(rep))
         print(f"\nwrote figures, results.json and report.html in {args.out}")
@@ -552,12 +557,32 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that partial output is cleaned up."""
+
+
+def _on_sigterm(signum, frame):
+    raise _Terminated
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the ``spiralid`` command; return its exit status."""
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     command = argv[0] if argv and not argv[0].startswith("-") else None
     prefix = f"spiralid {command}" if command else "spiralid"
+    try:
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    except ValueError:  # not the main thread: leave SIGTERM alone
+        previous = None
+    try:
+        return _run(parser, argv, prefix)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _run(parser, argv: list[str], prefix: str) -> int:
     try:
         args = parser.parse_args(argv)
         if args.command is None:
@@ -574,6 +599,9 @@ def main(argv: list[str] | None = None) -> int:
         message = " ".join(str(exc).split())
         print(f"{prefix}: error: {message}", file=sys.stderr)
         return 2
+    except _Terminated:
+        print(f"{prefix}: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print(f"{prefix}: interrupted", file=sys.stderr)
         return 130

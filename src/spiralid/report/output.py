@@ -1,8 +1,9 @@
 """Write a reproduction to disk: PNG figures, ``results.json``, ``report.html``.
 
-The output directory must be new or empty unless ``force`` is given; with
+The output folder must be new or empty unless ``force`` is given; with
 ``force`` the files this module writes are replaced and nothing else in the
-directory is touched.
+folder is touched. The files are written atomically
+(:class:`~spiralid.report.atomic.OutputFolder`): all of them or none.
 """
 
 from __future__ import annotations
@@ -16,11 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
+from spiralid.report.atomic import OutputFolder
 from spiralid.report.experiment import Reproduction
 
 __all__ = [
     "OUTPUT_FILES",
-    "check_output_dir",
     "results_dict",
     "summary_text",
     "verdict",
@@ -34,25 +35,6 @@ PAPER_TABLE2 = {
     "SDA": (35.85, (-0.1159, 0.1074), (-0.1355, 0.1458)),
     "Eb-SDA": (17.83, (-0.0614, 0.0638), (-0.0642, 0.0629)),
 }
-
-
-def check_output_dir(path: str | Path, force: bool) -> Path:
-    """Return `path` as a Path, refusing a non-empty directory without `force`.
-
-    Raises
-    ------
-    ValueError
-        `path` is a file, or a non-empty directory and `force` is false.
-    """
-    out = Path(path)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"`out` must be a directory; {str(out)!r} is a file")
-    if out.is_dir() and any(out.iterdir()) and not force:
-        raise ValueError(
-            f"`out` directory {str(out)!r} is not empty; choose another or pass "
-            "--force to overwrite the files this command writes there"
-        )
-    return out
 
 
 def _versions() -> dict:
@@ -446,30 +428,46 @@ def ranksums(rep: Reproduction) -> list[dict]:
 
 def write_reproduction(
     rep: Reproduction,
-    out: str | Path,
+    out: str | Path | OutputFolder,
     *,
     force: bool = False,
     command: str | None = None,
 ) -> list[Path]:
     """Write figures (PNG), ``results.json`` and ``report.html`` into `out`.
 
-    Returns the paths written. Refuses a non-empty directory unless `force`.
+    Parameters
+    ----------
+    rep : Reproduction
+    out : path-like or OutputFolder
+        The target folder, or an open :class:`OutputFolder` (the command
+        line opens it before computing, so a locked or unwritable target is
+        refused before the experiment runs).
+    force : bool
+        Write into a non-empty folder (ignored for an open OutputFolder).
+    command : str, optional
+        The command line recorded in the report.
+
+    Returns
+    -------
+    list of Path
+        The files written, at their final place.
     """
+    if isinstance(out, OutputFolder):
+        return _write_files(rep, out, command)
+    with OutputFolder(out, force) as folder:
+        return _write_files(rep, folder, command)
+
+
+def _write_files(rep: Reproduction, folder: OutputFolder, command) -> list[Path]:
     from spiralid.report.figures import all_figures
 
-    out = check_output_dir(out, force)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
     images = {}
     for stem, fig in all_figures(rep).items():
         images[stem] = _png(fig)
-        path = out / f"{stem}.png"
-        path.write_bytes(images[stem])
-        written.append(path)
-    path = out / "results.json"
-    path.write_text(json.dumps(results_dict(rep, command), indent=2, allow_nan=True))
-    written.append(path)
-    path = out / "report.html"
-    path.write_text(_html(rep, images, command), encoding="utf-8")
-    written.append(path)
-    return written
+        (folder.path / f"{stem}.png").write_bytes(images[stem])
+    results = json.dumps(results_dict(rep, command), indent=2, allow_nan=True)
+    (folder.path / "results.json").write_text(results)
+    (folder.path / "report.html").write_text(
+        _html(rep, images, command), encoding="utf-8"
+    )
+    return folder.commit(last="report.html")
