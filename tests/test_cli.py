@@ -1,6 +1,7 @@
 """The `spiralid` console script, run as a user would (subprocess)."""
 
 import json
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -10,13 +11,8 @@ from clitools import run
 from spiralid import IdentifiedModel, IOData
 from spiralid.fms import FlexibleManipulator, paper_experiment
 
-ARM = (
-    Path(__file__).resolve().parents[1]
-    / ".."
-    / "shared"
-    / "data"
-    / "daisy_robot_arm.csv"
-)
+# The shipped copy of the DaISy robot arm record (spiralid/datasets/).
+ARM = Path(str(resources.files("spiralid.datasets") / "daisy_robot_arm.csv"))
 
 
 @pytest.fixture(scope="module")
@@ -172,12 +168,11 @@ def test_reproduce_force_keeps_the_users_files(tmp_path):
     assert json.loads((out / "results.json").read_text())["seeds"] == [0]
 
 
-@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
 def test_identify_least_squares_on_the_real_arm(tmp_path):
-    proc = run(
-        "identify", ARM, "--ts", "0.01", "--method", "ls", "--out", "arm", cwd=tmp_path
-    )
+    # The shipped record by name: its own ts = 0.01 s.
+    proc = run("identify", "robot_arm", "--method", "ls", "--out", "arm", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
+    assert "robot_arm" in (tmp_path / "arm" / "summary.txt").read_text()
     val = json.loads((tmp_path / "arm" / "validation.json").read_text())["validation"]
     # The data's README: least-squares ARX(8, 8, 0) validates at about 95 %.
     assert abs(val["fit_percent"] - 95.0) <= 1.0
@@ -250,7 +245,6 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
     assert results["versions"]["spiralid"]
 
 
-@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
 def test_reproduce_on_the_real_arm(tmp_path):
     # The arm's record is a slice of a periodic sweep: it starts in motion.
     results = _reproduce_ok(
@@ -283,8 +277,6 @@ def test_reproduce_on_the_real_arm(tmp_path):
     ],
 )
 def test_bad_arguments_exit_2_with_one_line(tmp_path, args, message):
-    if "ARM" in args and not ARM.is_file():
-        pytest.skip("shared real data not present")
     (tmp_path / "keep.txt").write_text("user data")
     (tmp_path / "garbage.json").write_text('{"theta": ["a"], "na": 1}')
     args = [str(ARM) if a == "ARM" else a for a in args]

@@ -35,4 +35,8 @@ from .sysid import arx_least_squares as arx_least_squares
 from .sysid import identify as identify
 from .sysid import validate as validate
 
+# isort: split
+# --- example data ---
+from . import datasets as datasets
+
 # --- report ---

@@ -102,11 +102,21 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
     The sample time is `ts` if given, else the file's own (a ``time_s`` CSV
     column, a ``ts`` variable), else `default_ts`.
     """
+    from spiralid import datasets
     from spiralid.sysid import IOData
 
     file = Path(path)
+    if not file.exists() and path in datasets.NAMES:
+        if (input, output) != (None, None):
+            raise UsageError(
+                f"--input and --output do not apply to the shipped data set {path!r}"
+            )
+        return datasets.load(path, ts)
     if not file.exists():
-        raise UsageError(f"data file {path!r} does not exist")
+        raise UsageError(
+            f"data file {path!r} does not exist (shipped data sets: "
+            f"{', '.join(datasets.NAMES)})"
+        )
     if not file.is_file():
         raise UsageError(f"data file {path!r} is not a file")
     suffix = file.suffix.lower()
@@ -379,12 +389,17 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_reproduce(args, argv: list[str]) -> int:
+    from spiralid import datasets
     from spiralid.report import reproduce, summary_text, write_reproduction
 
     data = source = None
     if args.data is not None:
         data = _load(args.data, args.input, args.output, args.ts)
-        source = {"kind": "user data", "path": str(Path(args.data).resolve())}
+        source = (
+            {"kind": "shipped data set", "name": args.data}
+            if not Path(args.data).exists() and args.data in datasets.NAMES
+            else {"kind": "user data", "path": str(Path(args.data).resolve())}
+        )
     elif (args.input, args.output, args.ts) != (None, None, None):
         raise UsageError("--input, --output and --ts describe --data; give --data too")
     with _open_folder(args.out, args.force) as folder:
@@ -473,7 +488,9 @@ def build_parser() -> argparse.ArgumentParser:
         "validate it on the rest; write model.json, validation.json, "
         "summary.txt and figures into --out.",
     )
-    p.add_argument("data", help="CSV, NPZ or MAT file")
+    p.add_argument(
+        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+    )
     _add_data_options(p)
     p.add_argument("--na", type=_nonneg_int, default=8, help="poles (default 8)")
     p.add_argument(
@@ -548,7 +565,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--points", type=_positive_int, default=50, help="search points")
     p.add_argument("--workers", type=_positive_int, default=None, help="processes")
-    p.add_argument("--data", default=None, help="your own CSV/NPZ/MAT record")
+    p.add_argument(
+        "--data",
+        default=None,
+        help="your own CSV/NPZ/MAT record, or 'robot_arm' (the shipped DaISy arm)",
+    )
     _add_data_options(p)
     _add_initial_option(p)
     p.add_argument("--out", default="spiralid-reproduce", help="output directory")

@@ -1,20 +1,17 @@
 """IOData: construction, split, detrend, loaders and bad input."""
 
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.io import savemat
 
+from spiralid import datasets
 from spiralid.sysid import IOData
 
-ARM = (
-    Path(__file__).resolve().parents[2]
-    / ".."
-    / "shared"
-    / "data"
-    / "daisy_robot_arm.csv"
-)
+# The shipped copy of the DaISy robot arm record (spiralid/datasets/).
+ARM = Path(str(resources.files("spiralid.datasets") / "daisy_robot_arm.csv"))
 
 
 def test_accepts_lists_and_column_vectors():
@@ -67,11 +64,14 @@ def test_npz_and_mat(tmp_path):
     np.testing.assert_array_equal(m.y, y)
 
 
-@pytest.mark.skipif(not ARM.exists(), reason="real arm data not available")
 def test_real_arm_loads():
     d = IOData.from_csv(ARM, input="u", output="y", ts=0.01)
     assert d.n == 1024
     np.testing.assert_allclose(d.u[:2], [0.22183165, 0.039027807])
+    shipped = datasets.robot_arm()
+    np.testing.assert_array_equal(shipped.u, d.u)
+    np.testing.assert_array_equal(shipped.y, d.y)
+    assert shipped.ts == 0.01 and datasets.robot_arm(ts=0.1).ts == 0.1
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])

@@ -1,12 +1,12 @@
 """identify(): a known ARX(2, 2, 1), the real flexible arm, serialisation, bad input."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy import signal
 
+from spiralid.datasets import robot_arm
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, step_up
 from spiralid.sysid.identify import (
     default_bounds,
@@ -14,13 +14,6 @@ from spiralid.sysid.identify import (
     steiglitz_mcbride,
 )
 
-ARM = (
-    Path(__file__).resolve().parents[2]
-    / ".."
-    / "shared"
-    / "data"
-    / "daisy_robot_arm.csv"
-)
 TRUE = np.array([-1.5, 0.7, 1.0, 0.5])
 
 
@@ -142,9 +135,7 @@ def test_to_dlti_and_dict_round_trip(known):
 
 @pytest.fixture(scope="module")
 def arm():
-    if not ARM.exists():
-        pytest.skip("real arm data not available")
-    return IOData.from_csv(ARM, input="u", output="y", ts=0.01)
+    return robot_arm()
 
 
 @pytest.fixture(scope="module")
