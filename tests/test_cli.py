@@ -271,7 +271,7 @@ def test_reproduce_on_the_real_arm(tmp_path):
         (["validate", "nothing.json", "ARM"], "does not exist"),
         (["validate", "garbage.json", "ARM"], "not a valid spiralid model"),
         (["reproduce", "--ts", "0.01"], "give --data"),
-        (["reproduce", "--budget", "10"], "max_nfev"),
+        (["reproduce", "--budget", "10"], "--budget"),
         (["simulate", "--fs", "0"], "--fs"),
         (["frobnicate"], "invalid choice"),
     ],

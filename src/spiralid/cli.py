@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import shlex
 import signal
 import sys
+import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +34,22 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+class _HelpFormatter(argparse.HelpFormatter):
+    """--help shows the default of every option that has one."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if (
+            "%(default)" in text
+            or not action.option_strings
+            or action.default is None
+            or action.default is False
+            or action.default is argparse.SUPPRESS
+        ):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
 # -- helpers ------------------------------------------------------------------
 
 
@@ -46,7 +65,13 @@ def _number(kind: type, allowed: str, ok):
         try:
             value = kind(text)
         except ValueError:
-            what = "an integer" if kind is int else "a number"
+            what = (
+                "an integer"
+                if kind is int
+                else "a number such as 0.5 or 2/3"
+                if kind is _ratio
+                else "a number"
+            )
             raise argparse.ArgumentTypeError(f"must be {what}; got {text!r}") from None
         if not (np.isfinite(value) and ok(value)):
             raise argparse.ArgumentTypeError(f"must be {allowed}; got {text!r}")
@@ -58,7 +83,20 @@ def _number(kind: type, allowed: str, ok):
 _positive_float = _number(float, "a positive number", lambda v: v > 0)
 _nonneg_int = _number(int, ">= 0", lambda v: v >= 0)
 _positive_int = _number(int, ">= 1", lambda v: v >= 1)
-_fraction = _number(float, "in (0, 1)", lambda v: 0 < v < 1)
+
+
+def _ratio(text: str) -> float:
+    """A number, or a quotient such as ``2/3`` (the README's split)."""
+    top, slash, bottom = text.partition("/")
+    if not slash:
+        return float(text)
+    try:
+        return float(top) / float(bottom)
+    except ZeroDivisionError:
+        raise ValueError(text) from None
+
+
+_fraction = _number(_ratio, "in (0, 1), e.g. 0.5 or 2/3", lambda v: 0 < v < 1)
 
 
 def _add_initial_option(p: argparse.ArgumentParser) -> None:
@@ -67,7 +105,7 @@ def _add_initial_option(p: argparse.ArgumentParser) -> None:
         choices=["rest", "measured"],
         default="rest",
         help="initial condition of the simulation error: 'rest' (the paper's free "
-        "run; records that start at rest, default) or 'measured' (start from the "
+        "run; records that start at rest) or 'measured' (start from the "
         "first measured samples; records that start in motion)",
     )
 
@@ -94,6 +132,45 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
         help="sample time in seconds (CSV: required unless a time_s column is "
         "present; NPZ/MAT: default the file's 'ts')",
     )
+    p.add_argument(
+        "--input-unit",
+        default=None,
+        help="unit of the input for figures and tables, e.g. 'N m' (default: "
+        "from a CSV header such as 'torque [N m]')",
+    )
+    p.add_argument(
+        "--output-unit",
+        default=None,
+        help="unit of the output, e.g. 'm/s^2' (default: from the CSV header)",
+    )
+
+
+def _add_detrend_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--detrend",
+        action="store_true",
+        help="remove the means of input and output (those of the estimation "
+        "part, or of the part before --fraction, from the whole record) first",
+    )
+
+
+def _load_data(args, default_ts: float | None = None):
+    """The record the options describe, with the units they give."""
+    data = _load(args.data, args.input, args.output, args.ts, default_ts)
+    units = {
+        k: v
+        for k, v in (("input_unit", args.input_unit), ("output_unit", args.output_unit))
+        if v is not None
+    }
+    return replace(data, **units) if units else data
+
+
+def _detrended(data, fraction: float | None):
+    """`data` less the means of its part before `fraction` (all of it if None):
+    the validation part is shifted by the offsets the model was estimated
+    with, as new data would be."""
+    reference = data if fraction is None else data.split(fraction)[0]
+    return data.detrend(like=reference)
 
 
 def _load(path: str, input, output, ts, default_ts: float | None = None):
@@ -122,7 +199,7 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
     suffix = file.suffix.lower()
     if suffix == ".csv":
         try:
-            with file.open(encoding="utf-8") as fh:
+            with file.open(encoding="utf-8-sig") as fh:
                 header = [c.strip() for c in fh.readline().strip().split(",")]
         except UnicodeDecodeError:
             raise UsageError(f"data file {path!r} is not a text CSV file") from None
@@ -131,22 +208,26 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
             input = "torque_Nm" if written_by_us else "u"
         if output is None:
             output = "end_acceleration_m_s2" if written_by_us else "y"
-        if ts is None and "time_s" not in header:
-            ts = default_ts
-        if ts is None:
-            if "time_s" not in header:
-                raise UsageError(
-                    f"--ts is required for {path!r}: a CSV file carries no sample "
-                    "time (or give a 'time_s' column)"
-                )
-            t = np.loadtxt(
-                file, delimiter=",", skiprows=1, usecols=[header.index("time_s")]
+        ts_file = _csv_sample_time(file, header) if "time_s" in header else None
+        if ts is not None and ts_file is not None and not np.isclose(ts, ts_file):
+            raise UsageError(
+                f"--ts {ts:g} contradicts the time_s column of {path!r} (steps of "
+                f"{ts_file:g} s); leave --ts out or correct the file"
             )
-            steps = np.diff(t)
-            if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
-                raise UsageError(f"the time_s column of {path!r} is not evenly spaced")
-            ts = float(steps.mean())
-        return IOData.from_csv(file, input=input, output=output, ts=ts)
+        ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
+        if ts is None:
+            raise UsageError(
+                f"--ts is required for {path!r}: a CSV file carries no sample "
+                "time (or give a 'time_s' column)"
+            )
+        data = IOData.from_csv(file, input=input, output=output, ts=ts)
+        if written_by_us:
+            data = replace(
+                data,
+                input_unit=_UNITS.get(data.input_name, data.input_unit),
+                output_unit=_UNITS.get(data.output_name, data.output_unit),
+            )
+        return data
     if suffix in (".npz", ".mat"):
         if input is None:
             input = "u"
@@ -165,6 +246,31 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
             # The file carries no `ts`: fall back to the caller's default.
             return loader(file, input=input, output=output, ts=default_ts)
     raise UsageError(f"data file {path!r} must end in .csv, .npz or .mat")
+
+
+# Units of the columns `spiralid simulate` writes (their names carry them).
+_UNITS = {
+    "torque_Nm": "N m",
+    "hub_angle_rad": "rad",
+    "hub_velocity_rad_s": "rad/s",
+    "end_acceleration_m_s2": "m/s^2",
+}
+
+
+def _csv_sample_time(file: Path, header: list[str]) -> float:
+    """The step of an evenly spaced ``time_s`` column."""
+    t = np.loadtxt(
+        file,
+        delimiter=",",
+        skiprows=1,
+        usecols=[header.index("time_s")],
+        encoding="utf-8-sig",
+        ndmin=1,
+    )
+    steps = np.diff(t)
+    if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
+        raise UsageError(f"the time_s column of {str(file)!r} is not evenly spaced")
+    return float(steps.mean())
 
 
 def _open_folder(path: str, force: bool):
@@ -284,7 +390,9 @@ def _cmd_identify(args) -> int:
     from spiralid.sysid import identify, validate
     from spiralid.sysid.plots import plot_convergence
 
-    data = _load(args.data, args.input, args.output, args.ts)
+    data = _load_data(args)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
     arx = _structure(args)
     est, val = data.split(args.fraction)
     arx.check_length(est, "estimation part of DATA")
@@ -366,7 +474,9 @@ def _cmd_validate(args) -> int:
         ) from None
     # The data's own sample time wins; validate() refuses one that differs
     # from the model's. Only a file without one borrows the model's.
-    data = _load(args.data, args.input, args.output, args.ts, default_ts=model.ts)
+    data = _load_data(args, default_ts=model.ts)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
     if args.fraction is not None:
         warm, data = data.split(args.fraction)
     else:
@@ -394,14 +504,18 @@ def _cmd_reproduce(args, argv: list[str]) -> int:
 
     data = source = None
     if args.data is not None:
-        data = _load(args.data, args.input, args.output, args.ts)
+        data = _load_data(args)
         source = (
             {"kind": "shipped data set", "name": args.data}
             if not Path(args.data).exists() and args.data in datasets.NAMES
             else {"kind": "user data", "path": str(Path(args.data).resolve())}
         )
-    elif (args.input, args.output, args.ts) != (None, None, None):
-        raise UsageError("--input, --output and --ts describe --data; give --data too")
+    elif (args.input, args.output, args.ts, args.input_unit, args.output_unit) != (
+        (None,) * 5
+    ):
+        raise UsageError(
+            "--input, --output, --ts and the units describe --data; give --data too"
+        )
     with _open_folder(args.out, args.force) as folder:
         bar = _progress(args, 1, "reproduce")
         try:
@@ -444,6 +558,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "simulate",
+        formatter_class=_HelpFormatter,
         help="simulate the flexible manipulator rig and write a CSV or NPZ",
         description="Drive the finite-element flexible manipulator rig with a "
         "torque signal and write time, torque, hub angle, hub velocity and "
@@ -483,6 +598,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "identify",
+        formatter_class=_HelpFormatter,
         help="identify an ARX model from a data file",
         description="Estimate an ARX model on the first --fraction of DATA and "
         "validate it on the rest; write model.json, validation.json, "
@@ -492,23 +608,30 @@ def build_parser() -> argparse.ArgumentParser:
         "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
     )
     _add_data_options(p)
-    p.add_argument("--na", type=_nonneg_int, default=8, help="poles (default 8)")
+    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
+    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
+    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
     p.add_argument(
-        "--nb", type=_positive_int, default=8, help="numerator terms (default 8)"
+        "--method",
+        choices=["ebsda", "sda", "lasda", "de", "ls", "oe"],
+        default="ebsda",
+        help="estimator: a search over the paper's cost, least squares or output error",
     )
-    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (default 0)")
     p.add_argument(
-        "--method", choices=["ebsda", "sda", "lasda", "de", "ls", "oe"], default="ebsda"
-    )
-    p.add_argument(
-        "--predictor", choices=["simulation", "one-step"], default="simulation"
+        "--predictor",
+        choices=["simulation", "one-step"],
+        default="simulation",
+        help="error of the cost: free-run simulation or one-step prediction",
     )
     p.add_argument(
         "--parametrization",
         choices=["coefficients", "reflection"],
         default="coefficients",
+        help="what a search moves: the ARX coefficients (the paper) or the "
+        "denominator's reflection coefficients (every candidate stable)",
     )
     _add_initial_option(p)
+    _add_detrend_option(p)
     p.add_argument(
         "--refine", action="store_true", help="polish a spiral result locally"
     )
@@ -522,16 +645,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--budget", type=_positive_int, default=None, help="max cost evaluations"
     )
-    p.add_argument("--seed", type=_nonneg_int, default=0)
-    p.add_argument("--fraction", type=_fraction, default=2 / 3, help="estimation share")
+    p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
+    p.add_argument(
+        "--fraction",
+        type=_fraction,
+        default="2/3",
+        help="share of the record that estimates; the rest validates",
+    )
     p.add_argument("--out", default="spiralid-identify", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
     p.add_argument("--quiet", action="store_true", help="print nothing")
 
     p = sub.add_parser(
         "validate",
+        formatter_class=_HelpFormatter,
         help="validate a saved model on a data file",
-        description="Fit %%, error range, residual tests, spectra, modes, "
+        description="Fit %, error range, residual tests, spectra, modes, "
         "stability and realisation tests of MODEL on DATA.",
     )
     p.add_argument("model", help="model.json written by `spiralid identify`")
@@ -542,8 +671,9 @@ def build_parser() -> argparse.ArgumentParser:
         type=_fraction,
         default=None,
         help="run the model over the whole record but score only the part after "
-        "this share (e.g. 0.6667 for the validation third); default: score all",
+        "this share (e.g. 2/3 for the validation third); default: score all",
     )
+    _add_detrend_option(p)
     p.add_argument(
         "--out", default=None, help="directory for validation.json and figures"
     )
@@ -552,6 +682,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "reproduce",
+        formatter_class=_HelpFormatter,
         help="the paper's SDA vs Eb-SDA experiment with baselines and statistics",
         description="Identify ARX(8, 8, 0) by SDA and Eb-SDA (paper-faithful and "
         "reflection parametrisations, refine, gain sensitivity) over several "
@@ -559,12 +690,17 @@ def build_parser() -> argparse.ArgumentParser:
         "Table-2, Figures 6-7, results.json and report.html into --out.",
     )
     p.add_argument("--seeds", type=_positive_int, default=6, help="number of seeds")
-    p.add_argument("--first-seed", type=_nonneg_int, default=0)
+    p.add_argument("--first-seed", type=_nonneg_int, default=0, help="first seed")
     p.add_argument(
         "--budget", type=_positive_int, default=20_000, help="cost evaluations per run"
     )
     p.add_argument("--points", type=_positive_int, default=50, help="search points")
-    p.add_argument("--workers", type=_positive_int, default=None, help="processes")
+    p.add_argument(
+        "--workers",
+        type=_positive_int,
+        default=None,
+        help="processes (default: one per core)",
+    )
     p.add_argument(
         "--data",
         default=None,
@@ -597,15 +733,63 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError:  # not the main thread: leave SIGTERM alone
         previous = None
     try:
-        return _run(parser, argv, prefix)
+        with warnings.catch_warnings():
+            return _run(parser, argv, prefix)
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 
 
+# Library messages name arguments as the code does (in backticks); the
+# command line says them as the user typed them.
+_USER_WORDS = {
+    "data": "the data",
+    "path": "DATA",
+    "u": "the input",
+    "y": "the output",
+    "ts": "--ts",
+    "input": "--input",
+    "output": "--output",
+    "fraction": "--fraction",
+    "na": "--na",
+    "nb": "--nb",
+    "nk": "--nk",
+    "n_points": "--points",
+    "max_iter": "--iterations",
+    "max_nfev": "--budget",
+    "rng": "--seed",
+    "lags": "the number of residual-test lags (25)",
+}
+
+
+def _user_message(exc: BaseException) -> str:
+    """One line in the command line's words, without NumPy scalar reprs."""
+    text = " ".join(str(exc).split())
+    text = re.sub(r"np\.(?:float|int|uint|bool_?)\d*\(([^()]*)\)", r"\1", text)
+    text = re.sub(r"`([^`]+)`", lambda m: _USER_WORDS.get(m[1], m[1]), text)
+    # Bare keyword names, as in "must be >= 2 * n_points".
+    return re.sub(
+        r"\b(n_points|max_iter|max_nfev)\b", lambda m: _USER_WORDS[m[1]], text
+    )
+
+
+def _show_warnings(prefix: str, quiet: bool) -> None:
+    """Warnings as one line each, once; none at all with --quiet."""
+    if quiet:
+        warnings.simplefilter("ignore")
+        return
+    warnings.simplefilter("once")
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"{prefix}: warning: {_user_message(message)}", file=sys.stderr)
+
+    warnings.showwarning = show
+
+
 def _run(parser, argv: list[str], prefix: str) -> int:
     try:
         args = parser.parse_args(argv)
+        _show_warnings(prefix, getattr(args, "quiet", False))
         if args.command is None:
             parser.print_help()
             return 2
@@ -617,8 +801,7 @@ def _run(parser, argv: list[str], prefix: str) -> int:
             return _cmd_validate(args)
         return _cmd_reproduce(args, argv)
     except (UsageError, ValueError, OSError) as exc:
-        message = " ".join(str(exc).split())
-        print(f"{prefix}: error: {message}", file=sys.stderr)
+        print(f"{prefix}: error: {_user_message(exc)}", file=sys.stderr)
         return 2
     except _Terminated:
         print(f"{prefix}: terminated", file=sys.stderr)

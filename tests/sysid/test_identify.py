@@ -363,3 +363,24 @@ def test_differential_evolution_shares_the_spiral_methods_start(known):
     assert np.all(np.diff(fit.history) <= 0)
     assert fit.cost == pytest.approx(fit.history[-1])
     assert fit.is_stable
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"refine": "yes"}, "`refine` must be True or False; got 'yes'"),
+        ({"rng": "abc"}, "`rng` must be None, a non-negative integer"),
+        ({"rng": 1.5}, "`rng` must be None"),
+    ],
+)
+def test_bad_refine_and_rng_are_refused_by_name(known, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        identify(known, ARX(2, 2, 1), method="ebsda", **kwargs)
+
+
+def test_search_on_constant_input_does_not_blame_least_squares():
+    d = IOData(np.ones(50), np.random.default_rng(0).standard_normal(50), ts=1.0)
+    with pytest.raises(ValueError) as info:
+        identify(d, ARX(2, 2, 1), method="ebsda", rng=0)
+    assert "least squares" not in str(info.value)
+    assert "constant input" in str(info.value)

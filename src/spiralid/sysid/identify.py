@@ -64,6 +64,7 @@ from typing import Any
 import numpy as np
 from scipy import optimize, signal
 
+from spiralid._checks import generator
 from spiralid.optim import differential_evolution, minimize
 
 from .arx import ARX, arx_least_squares
@@ -651,6 +652,9 @@ def identify(
             f"`parametrization` must be one of {_PARAMETRIZATIONS}; "
             f"got {parametrization!r}"
         )
+    if not isinstance(refine, bool | np.bool_):
+        raise ValueError(f"`refine` must be True or False; got {refine!r}")
+    gen = generator(rng)
     if method not in _SEARCH and optimiser_options:
         raise ValueError(
             f"`optimiser_options` apply to the search methods {_SEARCH}; method "
@@ -720,7 +724,6 @@ def identify(
             **common,
         )
 
-    gen = np.random.default_rng(rng)
     box = (
         default_bounds(data, arx, parametrization)
         if bounds is None

@@ -595,6 +595,11 @@ def validate(
     hardly decays. Pass ``warmup`` to validate such a model from the state
     it has reached.
     """
+    if not all(hasattr(model, k) for k in ("simulate", "predict", "arx", "theta")):
+        raise ValueError(
+            "`model` must be an IdentifiedModel (from identify() or "
+            f"IdentifiedModel.from_dict); got {type(model).__name__}"
+        )
     u, y, ts = _signals_of(data)
     n = y.size
     # Checked here too (the correlation tests would) so a bad `lags` fails
@@ -618,7 +623,8 @@ def validate(
         rms_y = float(np.sqrt(np.mean(y**2)))
         if rms_y == 0.0:
             raise ValueError(
-                "`gain` 'auto' needs a non-zero output; `data.y` is all zero"
+                "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
+                "100 sqrt(K) / rms(y))"
             )
         w = 100.0 * np.sqrt(n) / rms_y
     elif isinstance(gain, str) and gain == "model":
