@@ -384,3 +384,16 @@ def test_search_on_constant_input_does_not_blame_least_squares():
         identify(d, ARX(2, 2, 1), method="ebsda", rng=0)
     assert "least squares" not in str(info.value)
     assert "constant input" in str(info.value)
+
+
+def test_to_control_matches_scipy_and_keeps_the_sample_time(known):
+    control = pytest.importorskip("control", reason="python-control not installed")
+    model = identify(known, ARX(2, 2, 1), method="ls")
+    tf = model.to_control()
+    assert isinstance(tf, control.TransferFunction) and tf.dt == known.ts
+    w = np.array([0.1, 1.0, 10.0, 100.0])  # rad/s, below Nyquist (314 rad/s)
+    _, h_scipy = model.to_dlti().freqresp(w * known.ts)
+    np.testing.assert_allclose(tf(np.exp(1j * w * known.ts)), h_scipy, rtol=1e-10)
+    # The same through a saved model file.
+    again = IdentifiedModel.from_dict(json.loads(json.dumps(model.to_dict())))
+    np.testing.assert_array_equal(again.to_control().num[0][0], tf.num[0][0])
