@@ -442,9 +442,10 @@ def _cmd_identify(args) -> int:
         _save_figures(v_val.plot(), staged, "validation_")
         _save_figures(v_est.plot(), staged, "estimation_")
         if model.history is not None:
-            plot_convergence({args.method: model.history}).savefig(
-                staged / "convergence.png", dpi=110
-            )
+            plot_convergence(
+                {args.method: model.history},
+                cost_label="best cost, eq. (2) (% of rms(y))",
+            ).savefig(staged / "convergence.png", dpi=110)
         written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)

@@ -288,7 +288,10 @@ class Validation:
     poles, zeros : ndarray of complex
         Of the transfer function in ``z``.
     t, u, y, y_sim, y_pred : ndarray
-        Time axis and signals, for plots.
+        Time axis and signals, for plots; after a ``warmup`` the time axis
+        continues from its end.
+    output_name, output_unit : str
+        The record's output name and unit, for figure labels.
     """
 
     label: str
@@ -320,6 +323,8 @@ class Validation:
     y: np.ndarray
     y_sim: np.ndarray
     y_pred: np.ndarray
+    output_name: str = "output"
+    output_unit: str = ""
 
     @property
     def error(self) -> np.ndarray:
@@ -450,7 +455,12 @@ class Validation:
         name = self.label or "model"
         return {
             "time": plots.plot_time_response(
-                self.t, self.y, {name: self.y_sim}, title="Validation, free run"
+                self.t,
+                self.y,
+                {name: self.y_sim},
+                title="Validation, free run",
+                ylabel=self.output_name,
+                unit=self.output_unit,
             ),
             "residuals": plots.plot_residual_tests(self.whiteness, self.independence),
             "spectrum": plots.plot_psd(
@@ -715,9 +725,11 @@ def validate(
         realization=realization_tests(num, den),
         poles=poles,
         zeros=zeros,
-        t=np.arange(n) * ts,
+        t=(np.arange(n) + (0 if warmup is None else wu.size)) * ts,
         u=u,
         y=y,
         y_sim=y_sim,
         y_pred=y_pred,
+        output_name=str(getattr(data, "output_name", "output")),
+        output_unit=str(getattr(data, "output_unit", "")),
     )
