@@ -1,5 +1,6 @@
 """The README's API example runs as written (on the shipped real data)."""
 
+import json
 import re
 from pathlib import Path
 
@@ -27,3 +28,21 @@ def test_readme_figures_exist_and_no_placeholder_is_left():
     assert images
     for image in images:
         assert (ROOT / image).stat().st_size > 10_000, image
+
+
+def test_readme_own_data_commands_run(tmp_path):
+    from clitools import run
+
+    text = (ROOT / "README.md").read_text()
+    block = re.search(
+        r"<!-- own-data-commands -->\n```\n(.*?)```", text, flags=re.S
+    ).group(1)
+    for line in block.strip().splitlines():
+        command = line.split()
+        assert command[0] == "spiralid"
+        proc = run(*command[1:], cwd=tmp_path)
+        assert proc.returncode == 0, (line, proc.stderr)
+    assert proc.stdout.strip().splitlines()[-1].startswith("wrote ")
+    assert (tmp_path / "rig-val" / "validation.json").is_file()
+    fit = json.loads((tmp_path / "rig-val" / "validation.json").read_text())
+    assert fit["fit_percent"] > 50
