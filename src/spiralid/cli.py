@@ -665,7 +665,9 @@ def build_parser() -> argparse.ArgumentParser:
         "stability and realisation tests of MODEL on DATA.",
     )
     p.add_argument("model", help="model.json written by `spiralid identify`")
-    p.add_argument("data", help="CSV, NPZ or MAT file")
+    p.add_argument(
+        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+    )
     _add_data_options(p)
     p.add_argument(
         "--fraction",

@@ -137,7 +137,28 @@ class _Lock:
         self.fd = None
 
 
-class OutputFolder:
+class _Staged:
+    """A context manager that opens on entry and discards what is left
+    uncommitted on exit (an error, Ctrl-C)."""
+
+    path: Path | None = None
+
+    def open(self):
+        raise NotImplementedError
+
+    def close(self) -> None:
+        raise NotImplementedError
+
+    def __enter__(self):
+        if self.path is None:
+            self.open()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class OutputFolder(_Staged):
     """A target folder written atomically (a context manager).
 
     Entering checks the target (new, or empty, or ``force``), takes the lock
@@ -268,16 +289,8 @@ class OutputFolder:
             _remove_empty(self._created)
         self._created = []
 
-    def __enter__(self) -> OutputFolder:
-        if self.path is None:
-            self.open()
-        return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-
-class OutputFile:
+class OutputFile(_Staged):
     """A target file written atomically (a context manager).
 
     Entering checks the target (new unless ``force``), creates its missing
@@ -345,11 +358,3 @@ class OutputFile:
             self.path = None
         _remove_empty(self._created)
         self._created = []
-
-    def __enter__(self) -> OutputFile:
-        if self.path is None:
-            self.open()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
