@@ -1,5 +1,6 @@
 """The same seed gives the same numbers, bit for bit, whatever the thread
-settings of BLAS, OpenMP and Numba, and with other runs loading the machine.
+settings of BLAS, OpenMP and Numba, and with other runs loading the machine
+(one or several worker processes: tests/report/test_experiment.py).
 
 Each run is a fresh interpreter (thread counts are read when the libraries
 load); they run at the same time, so each is also timed under load.
@@ -8,8 +9,6 @@ load); they run at the same time, so each is also timed under load.
 import os
 import subprocess
 import sys
-
-import pytest
 
 SCRIPT = """
 import hashlib
@@ -63,21 +62,3 @@ def test_same_seed_same_bits_under_any_thread_setting():
         assert proc.returncode == 0, err
         digests[t] = out.strip()
     assert len(set(digests.values())) == 1, digests
-
-
-@pytest.mark.parametrize("workers", [2])
-def test_reproduce_does_not_depend_on_the_number_of_workers(workers):
-    from spiralid.report import reproduce
-    from spiralid.report.output import results_dict
-
-    common = dict(seeds=range(2), max_nfev=300, n_points=10)
-    one = results_dict(reproduce(workers=1, **common))
-    many = results_dict(reproduce(workers=workers, **common))
-    for key in ("table2", "statistics", "ranksum", "transfer_functions", "runs"):
-        a, b = one[key], many[key]
-        if key == "runs":  # wall times differ; nothing else may
-            for runs in (a, b):
-                for r in (r for rs in runs.values() for r in rs):
-                    r.pop("times", None)
-                    r.pop("seconds", None)
-        assert a == b, key

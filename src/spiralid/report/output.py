@@ -91,6 +91,8 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
             **rep.source,
             "input": data.input_name,
             "output": data.output_name,
+            "input_unit": data.input_unit,
+            "output_unit": data.output_unit,
             "n_samples": data.n,
             "ts": data.ts,
             "n_estimation": rep.estimation.n,
@@ -198,6 +200,15 @@ _T2_HEAD = [
     "error range (validation)",
     "validation fit %",
 ]
+
+
+def _t2_head(unit: str) -> list[str]:
+    """Table-2's header, its error ranges in the output's unit when known."""
+    if not unit:
+        return _T2_HEAD
+    return [h.replace(")", f", {unit})") if "range" in h else h for h in _T2_HEAD]
+
+
 _STAT_HEAD = [
     "method",
     "mean",
@@ -248,7 +259,7 @@ def summary_text(rep: Reproduction) -> str:
             f"simulation from {d['initial']}.",
             "",
             "Table-2 (best run of each method; cost = eq. (2), % of rms(y))",
-            _table(_T2_HEAD, _table2_rows(rep)),
+            _table(_t2_head(rep.data.output_unit), _table2_rows(rep)),
             "",
             "Estimation cost over seeds",
             _table(_STAT_HEAD, _stat_rows(rep)),
@@ -293,7 +304,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "lacks and least-squares (LS) and output-error (OE) baselines beside the "
         "metaheuristics.</p>",
         f"<p>Command: <code>{e(command or 'spiralid.report.reproduce()')}</code><br>"
-        f"Data: {e(rep.data.input_name)} &rarr; {e(rep.data.output_name)}, "
+        f"Data: {e(rep.data.input_label)} &rarr; {e(rep.data.output_label)}, "
         f"{rep.data.n} samples at ts = {rep.data.ts:g} s; first "
         f"{rep.estimation.n} to estimate, last {rep.validation.n} to validate.<br>"
         f"Model: {e(str(rep.arx))}, predictor: free-run simulation from "
@@ -307,7 +318,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "<h2>Table-2</h2><p>Best run of each method (lowest estimation cost). "
         "Error ranges are min and max of the free-run error y - y&#770; in "
         "output units.</p>",
-        _table(_T2_HEAD, _table2_rows(rep), "html"),
+        _table(_t2_head(rep.data.output_unit), _table2_rows(rep), "html"),
         "<p>The paper's Table-2, on its own rig and record (its gain w is not "
         "stated, so its fitness scale is unknown):</p>",
         _table(

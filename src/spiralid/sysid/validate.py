@@ -356,6 +356,7 @@ class Validation:
             return ", ".join(f"{v:.2f}" for v in x) or "none"
 
         rz = self.realization
+        unit = f", {self.output_unit}" if self.output_unit else ""
         rows = [
             ("samples (N), ts", f"{self.n_samples}, {self.ts:g} s"),
             ("fit % (simulation)", f"{self.fit_percent:.2f}"),
@@ -364,11 +365,11 @@ class Validation:
             ("RMSE (one-step)", f"{self.rmse_one_step:.4g}"),
             (f"paper cost, eq. (2) ({self.cost_predictor})", f"{self.cost:.4g}"),
             (
-                "error range (simulation)",
+                f"error range (simulation{unit})",
                 f"[{self.error_range[0]:.4f}, {self.error_range[1]:.4f}]",
             ),
             (
-                "error range (one-step)",
+                f"error range (one-step{unit})",
                 f"[{self.error_range_one_step[0]:.4f}, "
                 f"{self.error_range_one_step[1]:.4f}]",
             ),
