@@ -1,32 +1,18 @@
 """The `spiralid` console script, run as a user would (subprocess)."""
 
 import json
-import os
-import subprocess
-import sys
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pytest
+from clitools import run
 
 from spiralid import IdentifiedModel, IOData
 from spiralid.fms import FlexibleManipulator, paper_experiment
 
-SCRIPT = Path(sys.executable).parent / "spiralid"
-ARM = (
-    Path(__file__).resolve().parents[1]
-    / ".."
-    / "shared"
-    / "data"
-    / "daisy_robot_arm.csv"
-)
-
-
-def run(*args, cwd):
-    env = {**os.environ, "MPLBACKEND": "Agg"}
-    return subprocess.run(
-        [str(SCRIPT), *map(str, args)], cwd=cwd, env=env, capture_output=True, text=True
-    )
+# The shipped copy of the DaISy robot arm record (spiralid/datasets/).
+ARM = Path(str(resources.files("spiralid.datasets") / "daisy_robot_arm.csv"))
 
 
 @pytest.fixture(scope="module")
@@ -184,12 +170,11 @@ def test_reproduce_force_keeps_the_users_files(tmp_path):
     assert json.loads((out / "results.json").read_text())["seeds"] == [0]
 
 
-@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
 def test_identify_least_squares_on_the_real_arm(tmp_path):
-    proc = run(
-        "identify", ARM, "--ts", "0.01", "--method", "ls", "--out", "arm", cwd=tmp_path
-    )
+    # The shipped record by name: its own ts = 0.01 s.
+    proc = run("identify", "robot_arm", "--method", "ls", "--out", "arm", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
+    assert "robot_arm" in (tmp_path / "arm" / "summary.txt").read_text()
     val = json.loads((tmp_path / "arm" / "validation.json").read_text())["validation"]
     # The data's README: least-squares ARX(8, 8, 0) validates at about 95 %.
     assert abs(val["fit_percent"] - 95.0) <= 1.0
@@ -251,9 +236,9 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
         assert all(len(r["history"]) == r["nit"] + 1 for r in runs)
     # The gain-scaled arms search at w x 10 but are scored at the default w.
     w = results["options"]["gain"]
-    for run in results["runs"]["Eb-SDA (w x 10)"]:
-        assert run["gain"] == pytest.approx(10 * w)
-        assert run["search_cost"] == pytest.approx(10 * run["cost_estimation"])
+    for arm in results["runs"]["Eb-SDA (w x 10)"]:
+        assert arm["gain"] == pytest.approx(10 * w)
+        assert arm["search_cost"] == pytest.approx(10 * arm["cost_estimation"])
     assert results["rules"]["ebsda"]["r_c1"] == 100.0
     assert results["rules"]["sda"]["radius"] == 0.95
     stats = results["statistics"]["SDA"]
@@ -263,7 +248,6 @@ def test_reproduce_on_the_simulated_rig(tmp_path):
     assert results["versions"]["spiralid"]
 
 
-@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
 def test_reproduce_on_the_real_arm(tmp_path):
     # The arm's record is a slice of a periodic sweep: it starts in motion.
     results = _reproduce_ok(
@@ -290,14 +274,12 @@ def test_reproduce_on_the_real_arm(tmp_path):
         (["validate", "nothing.json", "ARM"], "does not exist"),
         (["validate", "garbage.json", "ARM"], "not a valid spiralid model"),
         (["reproduce", "--ts", "0.01"], "give --data"),
-        (["reproduce", "--budget", "10"], "max_nfev"),
+        (["reproduce", "--budget", "10"], "--budget"),
         (["simulate", "--fs", "0"], "--fs"),
         (["frobnicate"], "invalid choice"),
     ],
 )
 def test_bad_arguments_exit_2_with_one_line(tmp_path, args, message):
-    if "ARM" in args and not ARM.is_file():
-        pytest.skip("shared real data not present")
     (tmp_path / "keep.txt").write_text("user data")
     (tmp_path / "garbage.json").write_text('{"theta": ["a"], "na": 1}')
     args = [str(ARM) if a == "ARM" else a for a in args]

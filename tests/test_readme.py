@@ -1,20 +1,17 @@
-"""The README's API example runs as written (on the shared real data)."""
+"""The README's API example runs as written (on the shipped real data)."""
 
+import json
 import re
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[1]
-ARM = ROOT / ".." / "shared" / "data" / "daisy_robot_arm.csv"
 
 
-@pytest.mark.skipif(not ARM.is_file(), reason="shared real data not present")
-def test_readme_api_example_runs(monkeypatch, capsys):
+def test_readme_api_example_runs(monkeypatch, tmp_path, capsys):
     text = (ROOT / "README.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
     assert blocks, "README has no python example"
-    monkeypatch.chdir(ARM.parent)
+    monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MPLBACKEND", "Agg")
     exec(compile(blocks[0], "README.md", "exec"), {})
     lines = capsys.readouterr().out.splitlines()
@@ -33,3 +30,21 @@ def test_readme_figures_exist_and_no_placeholder_is_left():
     assert images
     for image in images:
         assert (ROOT / image).stat().st_size > 10_000, image
+
+
+def test_readme_own_data_commands_run(tmp_path):
+    from clitools import run
+
+    text = (ROOT / "README.md").read_text()
+    block = re.search(
+        r"<!-- own-data-commands -->\n```\n(.*?)```", text, flags=re.S
+    ).group(1)
+    for line in block.strip().splitlines():
+        command = line.split()
+        assert command[0] == "spiralid"
+        proc = run(*command[1:], cwd=tmp_path)
+        assert proc.returncode == 0, (line, proc.stderr)
+    assert proc.stdout.strip().splitlines()[-1].startswith("wrote ")
+    assert (tmp_path / "rig-val" / "validation.json").is_file()
+    fit = json.loads((tmp_path / "rig-val" / "validation.json").read_text())
+    assert fit["fit_percent"] > 50

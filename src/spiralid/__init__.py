@@ -14,25 +14,38 @@ try:
 except PackageNotFoundError:  # running from a source tree without install
     __version__ = "0.0.0+unknown"
 
-# --- optim ---
-from . import optim as optim
-from .optim import SpiralResult as SpiralResult
-from .optim import minimize as minimize
+# The public names load on first use (PEP 562): `import spiralid` stays as
+# cheap as the metadata lookup above, and SciPy, Numba and the compiled
+# kernels are imported only by the parts that need them.
+_SUBPACKAGES = ("datasets", "fms", "optim", "report", "sysid")
+_NAMES = {
+    "SpiralResult": "optim",
+    "minimize": "optim",
+    "FlexibleManipulator": "fms",
+    "Recording": "fms",
+    "ARX": "sysid",
+    "IdentifiedModel": "sysid",
+    "IOData": "sysid",
+    "PaperCost": "sysid",
+    "Validation": "sysid",
+    "arx_least_squares": "sysid",
+    "identify": "sysid",
+    "validate": "sysid",
+}
+__all__ = [*_SUBPACKAGES, *_NAMES]
 
-# isort: split
-# --- fms ---
-from . import fms as fms
-from .fms import FlexibleManipulator as FlexibleManipulator
-from .fms import Recording as Recording
 
-# --- sysid ---
-from .sysid import ARX as ARX
-from .sysid import IdentifiedModel as IdentifiedModel
-from .sysid import IOData as IOData
-from .sysid import PaperCost as PaperCost
-from .sysid import Validation as Validation
-from .sysid import arx_least_squares as arx_least_squares
-from .sysid import identify as identify
-from .sysid import validate as validate
+def __getattr__(name: str):
+    import importlib
 
-# --- report ---
+    if name in _SUBPACKAGES:
+        return importlib.import_module(f".{name}", __name__)
+    if name in _NAMES:
+        value = getattr(importlib.import_module(f".{_NAMES[name]}", __name__), name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -10,8 +10,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import shlex
+import signal
 import sys
+import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +34,22 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+class _HelpFormatter(argparse.HelpFormatter):
+    """--help shows the default of every option that has one."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if (
+            "%(default)" in text
+            or not action.option_strings
+            or action.default is None
+            or action.default is False
+            or action.default is argparse.SUPPRESS
+        ):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
 # -- helpers ------------------------------------------------------------------
 
 
@@ -45,7 +65,13 @@ def _number(kind: type, allowed: str, ok):
         try:
             value = kind(text)
         except ValueError:
-            what = "an integer" if kind is int else "a number"
+            what = (
+                "an integer"
+                if kind is int
+                else "a number such as 0.5 or 2/3"
+                if kind is _ratio
+                else "a number"
+            )
             raise argparse.ArgumentTypeError(f"must be {what}; got {text!r}") from None
         if not (np.isfinite(value) and ok(value)):
             raise argparse.ArgumentTypeError(f"must be {allowed}; got {text!r}")
@@ -57,7 +83,20 @@ def _number(kind: type, allowed: str, ok):
 _positive_float = _number(float, "a positive number", lambda v: v > 0)
 _nonneg_int = _number(int, ">= 0", lambda v: v >= 0)
 _positive_int = _number(int, ">= 1", lambda v: v >= 1)
-_fraction = _number(float, "in (0, 1)", lambda v: 0 < v < 1)
+
+
+def _ratio(text: str) -> float:
+    """A number, or a quotient such as ``2/3`` (the README's split)."""
+    top, slash, bottom = text.partition("/")
+    if not slash:
+        return float(text)
+    try:
+        return float(top) / float(bottom)
+    except ZeroDivisionError:
+        raise ValueError(text) from None
+
+
+_fraction = _number(_ratio, "in (0, 1), e.g. 0.5 or 2/3", lambda v: 0 < v < 1)
 
 
 def _add_initial_option(p: argparse.ArgumentParser) -> None:
@@ -66,7 +105,7 @@ def _add_initial_option(p: argparse.ArgumentParser) -> None:
         choices=["rest", "measured"],
         default="rest",
         help="initial condition of the simulation error: 'rest' (the paper's free "
-        "run; records that start at rest, default) or 'measured' (start from the "
+        "run; records that start at rest) or 'measured' (start from the "
         "first measured samples; records that start in motion)",
     )
 
@@ -93,6 +132,45 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
         help="sample time in seconds (CSV: required unless a time_s column is "
         "present; NPZ/MAT: default the file's 'ts')",
     )
+    p.add_argument(
+        "--input-unit",
+        default=None,
+        help="unit of the input for figures and tables, e.g. 'N m' (default: "
+        "from a CSV header such as 'torque [N m]')",
+    )
+    p.add_argument(
+        "--output-unit",
+        default=None,
+        help="unit of the output, e.g. 'm/s^2' (default: from the CSV header)",
+    )
+
+
+def _add_detrend_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--detrend",
+        action="store_true",
+        help="remove the means of input and output (those of the estimation "
+        "part, or of the part before --fraction, from the whole record) first",
+    )
+
+
+def _load_data(args, default_ts: float | None = None):
+    """The record the options describe, with the units they give."""
+    data = _load(args.data, args.input, args.output, args.ts, default_ts)
+    units = {
+        k: v
+        for k, v in (("input_unit", args.input_unit), ("output_unit", args.output_unit))
+        if v is not None
+    }
+    return replace(data, **units) if units else data
+
+
+def _detrended(data, fraction: float | None):
+    """`data` less the means of its part before `fraction` (all of it if None):
+    the validation part is shifted by the offsets the model was estimated
+    with, as new data would be."""
+    reference = data if fraction is None else data.split(fraction)[0]
+    return data.detrend(like=reference)
 
 
 def _load(path: str, input, output, ts, default_ts: float | None = None):
@@ -101,17 +179,27 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
     The sample time is `ts` if given, else the file's own (a ``time_s`` CSV
     column, a ``ts`` variable), else `default_ts`.
     """
+    from spiralid import datasets
     from spiralid.sysid import IOData
 
     file = Path(path)
+    if not file.exists() and path in datasets.NAMES:
+        if (input, output) != (None, None):
+            raise UsageError(
+                f"--input and --output do not apply to the shipped data set {path!r}"
+            )
+        return datasets.load(path, ts)
     if not file.exists():
-        raise UsageError(f"data file {path!r} does not exist")
+        raise UsageError(
+            f"data file {path!r} does not exist (shipped data sets: "
+            f"{', '.join(datasets.NAMES)})"
+        )
     if not file.is_file():
         raise UsageError(f"data file {path!r} is not a file")
     suffix = file.suffix.lower()
     if suffix == ".csv":
         try:
-            with file.open(encoding="utf-8") as fh:
+            with file.open(encoding="utf-8-sig") as fh:
                 header = [c.strip() for c in fh.readline().strip().split(",")]
         except UnicodeDecodeError:
             raise UsageError(f"data file {path!r} is not a text CSV file") from None
@@ -120,22 +208,26 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
             input = "torque_Nm" if written_by_us else "u"
         if output is None:
             output = "end_acceleration_m_s2" if written_by_us else "y"
-        if ts is None and "time_s" not in header:
-            ts = default_ts
-        if ts is None:
-            if "time_s" not in header:
-                raise UsageError(
-                    f"--ts is required for {path!r}: a CSV file carries no sample "
-                    "time (or give a 'time_s' column)"
-                )
-            t = np.loadtxt(
-                file, delimiter=",", skiprows=1, usecols=[header.index("time_s")]
+        ts_file = _csv_sample_time(file, header) if "time_s" in header else None
+        if ts is not None and ts_file is not None and not np.isclose(ts, ts_file):
+            raise UsageError(
+                f"--ts {ts:g} contradicts the time_s column of {path!r} (steps of "
+                f"{ts_file:g} s); leave --ts out or correct the file"
             )
-            steps = np.diff(t)
-            if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
-                raise UsageError(f"the time_s column of {path!r} is not evenly spaced")
-            ts = float(steps.mean())
-        return IOData.from_csv(file, input=input, output=output, ts=ts)
+        ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
+        if ts is None:
+            raise UsageError(
+                f"--ts is required for {path!r}: a CSV file carries no sample "
+                "time (or give a 'time_s' column)"
+            )
+        data = IOData.from_csv(file, input=input, output=output, ts=ts)
+        if written_by_us:
+            data = replace(
+                data,
+                input_unit=_UNITS.get(data.input_name, data.input_unit),
+                output_unit=_UNITS.get(data.output_name, data.output_unit),
+            )
+        return data
     if suffix in (".npz", ".mat"):
         if input is None:
             input = "u"
@@ -156,34 +248,41 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
     raise UsageError(f"data file {path!r} must end in .csv, .npz or .mat")
 
 
-def _new_file(path: Path, force: bool) -> Path:
-    """`path`, its folder created, refusing to overwrite without `force`."""
-    if path.is_dir():
-        raise UsageError(f"{str(path)!r} is a directory, not a file")
-    if path.exists() and not force:
-        raise UsageError(f"{str(path)!r} exists; pass --force to overwrite it")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return path
+# Units of the columns `spiralid simulate` writes (their names carry them).
+_UNITS = {
+    "torque_Nm": "N m",
+    "hub_angle_rad": "rad",
+    "hub_velocity_rad_s": "rad/s",
+    "end_acceleration_m_s2": "m/s^2",
+}
 
 
-def _out_dir(path: str, force: bool) -> Path:
-    from spiralid.report.output import check_output_dir
+def _csv_sample_time(file: Path, header: list[str]) -> float:
+    """The step of an evenly spaced ``time_s`` column."""
+    t = np.loadtxt(
+        file,
+        delimiter=",",
+        skiprows=1,
+        usecols=[header.index("time_s")],
+        encoding="utf-8-sig",
+        ndmin=1,
+    )
+    steps = np.diff(t)
+    if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
+        raise UsageError(f"the time_s column of {str(file)!r} is not evenly spaced")
+    return float(steps.mean())
 
-    try:
-        out = check_output_dir(path, force)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
-    out.mkdir(parents=True, exist_ok=True)
-    return out
+
+def _open_folder(path: str, force: bool):
+    """The output folder, locked and proved writable before any computation."""
+    from spiralid.report.atomic import OutputFolder
+
+    return OutputFolder(path, force).open()
 
 
-def _save_figures(figures: dict, out: Path, prefix: str = "") -> list[Path]:
-    paths = []
+def _save_figures(figures: dict, folder: Path, prefix: str = "") -> None:
     for name, fig in figures.items():
-        path = out / f"{prefix}{name}.png"
-        fig.savefig(path, dpi=110)
-        paths.append(path)
-    return paths
+        fig.savefig(folder / f"{prefix}{name}.png", dpi=110)
 
 
 def _progress(args, total: int, label: str):
@@ -196,6 +295,25 @@ def _progress(args, total: int, label: str):
 
 
 def _cmd_simulate(args) -> int:
+    suffix = Path(args.out).suffix.lower()
+    if suffix not in (".csv", ".npz"):
+        raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
+    from spiralid.report.atomic import OutputFile
+
+    with OutputFile(args.out, args.force) as target:
+        rec, rig = _simulate_record(args)
+        _write_record(rec, target.path, suffix)
+        target.commit()
+    if not args.quiet:
+        print(
+            f"wrote {args.out} ({rec.u.size} samples at {args.fs:g} Hz; rig modes "
+            + ", ".join(f"{f:.2f}" for f in rig.modes(3))
+            + " Hz)"
+        )
+    return 0
+
+
+def _simulate_record(args):
     from spiralid.fms import (
         Experiment,
         FlexibleManipulator,
@@ -205,10 +323,6 @@ def _cmd_simulate(args) -> int:
         prbs,
     )
 
-    suffix = Path(args.out).suffix.lower()
-    if suffix not in (".csv", ".npz"):
-        raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
-    path = _new_file(Path(args.out), args.force)
     rig = FlexibleManipulator(payload_mass=args.payload)
     fs = args.fs
     paper = Experiment()
@@ -236,6 +350,10 @@ def _cmd_simulate(args) -> int:
         torque = chirp(amp, 1.0, min(100.0, fs / 2), args.duration, fs)
     sensors = Sensors(accel_noise=args.accel_noise, tach_noise=args.tach_noise)
     rec = rig.simulate(torque, fs=fs, rng=args.seed, sensors=sensors)
+    return rec, rig
+
+
+def _write_record(rec, path: Path, suffix: str) -> None:
     columns = {
         "time_s": rec.t,
         "torque_Nm": rec.u,
@@ -260,13 +378,6 @@ def _cmd_simulate(args) -> int:
             comments="",
             fmt="%.10g",
         )
-    if not args.quiet:
-        print(
-            f"wrote {path} ({rec.u.size} samples at {fs:g} Hz; rig modes "
-            + ", ".join(f"{f:.2f}" for f in rig.modes(3))
-            + " Hz)"
-        )
-    return 0
 
 
 def _structure(args):
@@ -279,11 +390,12 @@ def _cmd_identify(args) -> int:
     from spiralid.sysid import METHODS, identify, validate
     from spiralid.sysid.plots import plot_convergence
 
-    data = _load(args.data, args.input, args.output, args.ts)
+    data = _load_data(args)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
     arx = _structure(args)
     est, val = data.split(args.fraction)
     arx.check_length(est, "estimation part of DATA")
-    out = _out_dir(args.out, args.force)
     options = {}
     if METHODS[args.method].search:
         # The budget rule is identify()'s (estimators.search_options).
@@ -293,45 +405,56 @@ def _cmd_identify(args) -> int:
     elif args.refine:
         searches = ", ".join(name for name, m in METHODS.items() if m.search)
         raise UsageError(f"--refine applies to the search methods {searches}")
-    model = identify(
-        est,
-        arx,
-        method=args.method,
-        predictor=args.predictor,
-        initial=args.initial,
-        parametrization=args.parametrization,
-        refine=args.refine,
-        rng=args.seed,
-        **options,
-    )
-    v_est = validate(model, est, label=f"{args.method} (estimation)")
-    v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
-    model_path = out / "model.json"
-    model_path.write_text(json.dumps(model.to_dict(), indent=2))
-    (out / "validation.json").write_text(
-        json.dumps(
-            {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
+    with _open_folder(args.out, args.force) as folder:
+        model = identify(
+            est,
+            arx,
+            method=args.method,
+            predictor=args.predictor,
+            initial=args.initial,
+            parametrization=args.parametrization,
+            refine=args.refine,
+            rng=args.seed,
+            **options,
         )
-    )
-    summary = "\n\n".join(
-        [
-            f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}",
-            f"estimation cost (eq. 2): {model.cost:.6g}",
-            v_est.summary(),
-            v_val.summary(),
-        ]
-    )
-    (out / "summary.txt").write_text(summary + "\n")
-    _save_figures(v_val.plot(), out, "validation_")
-    _save_figures(v_est.plot(), out, "estimation_")
-    if model.history is not None:
-        plot_convergence({args.method: model.history}).savefig(
-            out / "convergence.png", dpi=110
+        v_est = validate(model, est, label=f"{args.method} (estimation)")
+        v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
+        staged = folder.path
+        (staged / "model.json").write_text(json.dumps(model.to_dict(), indent=2))
+        (staged / "validation.json").write_text(
+            json.dumps(
+                {"estimation": v_est.to_dict(), "validation": v_val.to_dict()},
+                indent=2,
+            )
         )
+        summary = "\n\n".join(
+            [
+                f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}",
+                f"estimation cost (eq. 2): {model.cost:.6g}",
+                v_est.summary(),
+                v_val.summary(),
+            ]
+        )
+        (staged / "summary.txt").write_text(summary + "\n")
+        _save_figures(v_val.plot(), staged, "validation_")
+        _save_figures(v_est.plot(), staged, "estimation_")
+        if model.history is not None:
+            plot_convergence(
+                {args.method: model.history},
+                cost_label="best cost, eq. (2) (% of rms(y))",
+            ).savefig(staged / "convergence.png", dpi=110)
+        written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)
-        print(f"\nwrote {model_path} and figures in {out}")
+        print(f"\nwrote {_listing(written, args.out)}")
     return 0
+
+
+def _listing(paths: list[Path], out: str) -> str:
+    """'a, b and c in OUT' for the files a command wrote."""
+    names = [p.name for p in paths]
+    head = ", ".join(names[:-1])
+    return f"{head + ' and ' if head else ''}{names[-1]} in {out}"
 
 
 def _cmd_validate(args) -> int:
@@ -349,53 +472,65 @@ def _cmd_validate(args) -> int:
         ) from None
     # The data's own sample time wins; validate() refuses one that differs
     # from the model's. Only a file without one borrows the model's.
-    data = _load(args.data, args.input, args.output, args.ts, default_ts=model.ts)
+    data = _load_data(args, default_ts=model.ts)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
     if args.fraction is not None:
         warm, data = data.split(args.fraction)
     else:
         warm = None
-    v = validate(model, data, warmup=warm, label=model.method)
-    text = v.summary()
-    if args.out is not None:
-        out = _out_dir(args.out, args.force)
-        (out / "validation.json").write_text(json.dumps(v.to_dict(), indent=2))
-        (out / "summary.txt").write_text(text + "\n")
-        _save_figures(v.plot(), out)
+    if args.out is None:
+        v = validate(model, data, warmup=warm, label=model.method)
+        if not args.quiet:
+            print(v.summary())
+        return 0
+    with _open_folder(args.out, args.force) as folder:
+        v = validate(model, data, warmup=warm, label=model.method)
+        (folder.path / "validation.json").write_text(json.dumps(v.to_dict(), indent=2))
+        (folder.path / "summary.txt").write_text(v.summary() + "\n")
+        _save_figures(v.plot(), folder.path)
+        written = folder.commit(last="validation.json")
     if not args.quiet:
-        print(text)
+        print(v.summary())
+        print(f"\nwrote {_listing(written, args.out)}")
     return 0
 
 
 def _cmd_reproduce(args, argv: list[str]) -> int:
+    from spiralid import datasets
     from spiralid.report import reproduce, summary_text, write_reproduction
-    from spiralid.report.output import check_output_dir
 
-    try:
-        check_output_dir(args.out, args.force)
-    except ValueError as exc:
-        raise UsageError(str(exc)) from None
     data = source = None
     if args.data is not None:
-        data = _load(args.data, args.input, args.output, args.ts)
-        source = {"kind": "user data", "path": str(Path(args.data).resolve())}
-    elif (args.input, args.output, args.ts) != (None, None, None):
-        raise UsageError("--input, --output and --ts describe --data; give --data too")
-    bar = _progress(args, 1, "reproduce")
-    try:
-        rep = reproduce(
-            data,
-            seeds=range(args.first_seed, args.first_seed + args.seeds),
-            max_nfev=args.budget,
-            n_points=args.points,
-            initial=args.initial,
-            source=source,
-            workers=args.workers,
-            progress=bar,
+        data = _load_data(args)
+        source = (
+            {"kind": "shipped data set", "name": args.data}
+            if not Path(args.data).exists() and args.data in datasets.NAMES
+            else {"kind": "user data", "path": str(Path(args.data).resolve())}
         )
-    finally:
-        bar.close()
-    command = "spiralid " + shlex.join(argv)
-    write_reproduction(rep, args.out, force=args.force, command=command)
+    elif (args.input, args.output, args.ts, args.input_unit, args.output_unit) != (
+        (None,) * 5
+    ):
+        raise UsageError(
+            "--input, --output, --ts and the units describe --data; give --data too"
+        )
+    with _open_folder(args.out, args.force) as folder:
+        bar = _progress(args, 1, "reproduce")
+        try:
+            rep = reproduce(
+                data,
+                seeds=range(args.first_seed, args.first_seed + args.seeds),
+                max_nfev=args.budget,
+                n_points=args.points,
+                initial=args.initial,
+                source=source,
+                workers=args.workers,
+                progress=bar,
+            )
+        finally:
+            bar.close()
+        command = "spiralid " + shlex.join(argv)
+        write_reproduction(rep, folder, command=command)
     if not args.quiet:
         print(summary_text(rep))
         print(f"\nwrote figures, results.json and report.html in {args.out}")
@@ -426,6 +561,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "simulate",
+        formatter_class=_HelpFormatter,
         help="simulate the flexible manipulator rig and write a CSV or NPZ",
         description="Drive the finite-element flexible manipulator rig with a "
         "torque signal and write time, torque, hub angle, hub velocity and "
@@ -465,34 +601,41 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "identify",
+        formatter_class=_HelpFormatter,
         help="identify an ARX model from a data file",
         description="Estimate an ARX model on the first --fraction of DATA and "
         "validate it on the rest; write model.json, validation.json, "
         "summary.txt and figures into --out.",
     )
-    p.add_argument("data", help="CSV, NPZ or MAT file")
-    _add_data_options(p)
-    p.add_argument("--na", type=_nonneg_int, default=8, help="poles (default 8)")
     p.add_argument(
-        "--nb", type=_positive_int, default=8, help="numerator terms (default 8)"
+        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
     )
-    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (default 0)")
+    _add_data_options(p)
+    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
+    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
+    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
     p.add_argument(
         "--method",
         choices=list(METHODS),
         default=DEFAULT_METHOD,
-        help=f"estimator (default {DEFAULT_METHOD})",
+        help="estimator: a search over the paper's cost, least squares or output error",
     )
     p.add_argument(
-        "--predictor", choices=["simulation", "one-step"], default="simulation"
+        "--predictor",
+        choices=["simulation", "one-step"],
+        default="simulation",
+        help="error of the cost: free-run simulation or one-step prediction",
     )
     p.add_argument(
         "--parametrization",
         choices=list(PARAMETRIZATIONS),
         default=None,
-        help="what a search moves (default: the method's; modal for spiral)",
+        help="what a search moves: the ARX coefficients (the paper), the "
+        "denominator's reflection coefficients or modal frequencies and dampings "
+        "(every candidate stable); default the method's own (modal for spiral)",
     )
     _add_initial_option(p)
+    _add_detrend_option(p)
     p.add_argument(
         "--refine", action="store_true", help="polish a spiral result locally"
     )
@@ -506,28 +649,37 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--budget", type=_positive_int, default=None, help="max cost evaluations"
     )
-    p.add_argument("--seed", type=_nonneg_int, default=0)
-    p.add_argument("--fraction", type=_fraction, default=2 / 3, help="estimation share")
+    p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
+    p.add_argument(
+        "--fraction",
+        type=_fraction,
+        default="2/3",
+        help="share of the record that estimates; the rest validates",
+    )
     p.add_argument("--out", default="spiralid-identify", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
     p.add_argument("--quiet", action="store_true", help="print nothing")
 
     p = sub.add_parser(
         "validate",
+        formatter_class=_HelpFormatter,
         help="validate a saved model on a data file",
-        description="Fit %%, error range, residual tests, spectra, modes, "
+        description="Fit %, error range, residual tests, spectra, modes, "
         "stability and realisation tests of MODEL on DATA.",
     )
     p.add_argument("model", help="model.json written by `spiralid identify`")
-    p.add_argument("data", help="CSV, NPZ or MAT file")
+    p.add_argument(
+        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+    )
     _add_data_options(p)
     p.add_argument(
         "--fraction",
         type=_fraction,
         default=None,
         help="run the model over the whole record but score only the part after "
-        "this share (e.g. 0.6667 for the validation third); default: score all",
+        "this share (e.g. 2/3 for the validation third); default: score all",
     )
+    _add_detrend_option(p)
     p.add_argument(
         "--out", default=None, help="directory for validation.json and figures"
     )
@@ -536,6 +688,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "reproduce",
+        formatter_class=_HelpFormatter,
         help="the paper's SDA vs Eb-SDA experiment with baselines and statistics",
         description="Identify ARX(8, 8, 0) by SDA and Eb-SDA (paper-faithful and "
         "reflection parametrisations, refine, gain sensitivity) over several "
@@ -543,19 +696,36 @@ def build_parser() -> argparse.ArgumentParser:
         "Table-2, Figures 6-7, results.json and report.html into --out.",
     )
     p.add_argument("--seeds", type=_positive_int, default=6, help="number of seeds")
-    p.add_argument("--first-seed", type=_nonneg_int, default=0)
+    p.add_argument("--first-seed", type=_nonneg_int, default=0, help="first seed")
     p.add_argument(
         "--budget", type=_positive_int, default=20_000, help="cost evaluations per run"
     )
     p.add_argument("--points", type=_positive_int, default=50, help="search points")
-    p.add_argument("--workers", type=_positive_int, default=None, help="processes")
-    p.add_argument("--data", default=None, help="your own CSV/NPZ/MAT record")
+    p.add_argument(
+        "--workers",
+        type=_positive_int,
+        default=None,
+        help="processes (default: one per core)",
+    )
+    p.add_argument(
+        "--data",
+        default=None,
+        help="your own CSV/NPZ/MAT record, or 'robot_arm' (the shipped DaISy arm)",
+    )
     _add_data_options(p)
     _add_initial_option(p)
     p.add_argument("--out", default="spiralid-reproduce", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     return parser
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that partial output is cleaned up."""
+
+
+def _on_sigterm(signum, frame):
+    raise _Terminated
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -565,7 +735,67 @@ def main(argv: list[str] | None = None) -> int:
     command = argv[0] if argv and not argv[0].startswith("-") else None
     prefix = f"spiralid {command}" if command else "spiralid"
     try:
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    except ValueError:  # not the main thread: leave SIGTERM alone
+        previous = None
+    try:
+        with warnings.catch_warnings():
+            return _run(parser, argv, prefix)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+# Library messages name arguments as the code does (in backticks); the
+# command line says them as the user typed them.
+_USER_WORDS = {
+    "data": "the data",
+    "path": "DATA",
+    "u": "the input",
+    "y": "the output",
+    "ts": "--ts",
+    "input": "--input",
+    "output": "--output",
+    "fraction": "--fraction",
+    "na": "--na",
+    "nb": "--nb",
+    "nk": "--nk",
+    "n_points": "--points",
+    "max_iter": "--iterations",
+    "max_nfev": "--budget",
+    "rng": "--seed",
+    "lags": "the number of residual-test lags (25)",
+}
+
+
+def _user_message(exc: BaseException) -> str:
+    """One line in the command line's words, without NumPy scalar reprs."""
+    text = " ".join(str(exc).split())
+    text = re.sub(r"np\.(?:float|int|uint|bool_?)\d*\(([^()]*)\)", r"\1", text)
+    text = re.sub(r"`([^`]+)`", lambda m: _USER_WORDS.get(m[1], m[1]), text)
+    # Bare keyword names, as in "must be >= 2 * n_points".
+    return re.sub(
+        r"\b(n_points|max_iter|max_nfev)\b", lambda m: _USER_WORDS[m[1]], text
+    )
+
+
+def _show_warnings(prefix: str, quiet: bool) -> None:
+    """Warnings as one line each, once; none at all with --quiet."""
+    if quiet:
+        warnings.simplefilter("ignore")
+        return
+    warnings.simplefilter("once")
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"{prefix}: warning: {_user_message(message)}", file=sys.stderr)
+
+    warnings.showwarning = show
+
+
+def _run(parser, argv: list[str], prefix: str) -> int:
+    try:
         args = parser.parse_args(argv)
+        _show_warnings(prefix, getattr(args, "quiet", False))
         if args.command is None:
             parser.print_help()
             return 2
@@ -577,9 +807,11 @@ def main(argv: list[str] | None = None) -> int:
             return _cmd_validate(args)
         return _cmd_reproduce(args, argv)
     except (UsageError, ValueError, OSError) as exc:
-        message = " ".join(str(exc).split())
-        print(f"{prefix}: error: {message}", file=sys.stderr)
+        print(f"{prefix}: error: {_user_message(exc)}", file=sys.stderr)
         return 2
+    except _Terminated:
+        print(f"{prefix}: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print(f"{prefix}: interrupted", file=sys.stderr)
         return 130

@@ -101,3 +101,21 @@ def test_bad_input(data):
         reproduce(data, max_nfev=1, arx=ARX(2, 2, 1))
     with pytest.raises(ValueError, match="`data`"):
         reproduce(np.zeros(10))
+
+
+def test_units_reach_the_tables_and_results(data):
+    from dataclasses import replace
+
+    with_units = replace(data, input_unit="N m", output_unit="m/s^2")
+    r = reproduce(
+        with_units,
+        seeds=1,
+        max_nfev=100,
+        n_points=10,
+        arx=ARX(2, 2, 1),
+        configurations=CONFIGS,
+        workers=1,
+    )
+    assert "error range (modelling, m/s^2)" in summary_text(r)
+    assert results_dict(r)["data"]["output_unit"] == "m/s^2"
+    assert r.validations["SDA"][1].output_unit == "m/s^2"

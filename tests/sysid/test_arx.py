@@ -154,6 +154,6 @@ def test_bad_theta_short_record_constant_input():
         np.full(100, 2.0), np.random.default_rng(0).standard_normal(100), ts=1.0
     )
     with pytest.raises(
-        ValueError, match=r"`data` input is constant .*does not excite the system"
+        ValueError, match=r"`data` has a constant input .*does not excite the system"
     ):
         arx_least_squares(const, ARX(2, 2, 1))

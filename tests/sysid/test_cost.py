@@ -213,7 +213,7 @@ def test_bad_arguments():
         ValueError, match=r"`thetas` must have shape \(4,\) or \(m, 4\)"
     ):
         PaperCost(arx, d)(np.zeros((3, 5)))
-    with pytest.raises(ValueError, match="`gain` 'auto' needs a non-zero output"):
+    with pytest.raises(ValueError, match="`data` has an all-zero output"):
         PaperCost(arx, IOData(d.u, np.zeros(d.n), ts=1.0))
     with pytest.raises(
         ValueError, match=r"`initial` must be one of \('rest', 'measured'\); got 'zero'"

@@ -1,20 +1,17 @@
 """IOData: construction, split, detrend, loaders and bad input."""
 
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.io import savemat
 
+from spiralid import datasets
 from spiralid.sysid import IOData
 
-ARM = (
-    Path(__file__).resolve().parents[2]
-    / ".."
-    / "shared"
-    / "data"
-    / "daisy_robot_arm.csv"
-)
+# The shipped copy of the DaISy robot arm record (spiralid/datasets/).
+ARM = Path(str(resources.files("spiralid.datasets") / "daisy_robot_arm.csv"))
 
 
 def test_accepts_lists_and_column_vectors():
@@ -67,11 +64,14 @@ def test_npz_and_mat(tmp_path):
     np.testing.assert_array_equal(m.y, y)
 
 
-@pytest.mark.skipif(not ARM.exists(), reason="real arm data not available")
 def test_real_arm_loads():
     d = IOData.from_csv(ARM, input="u", output="y", ts=0.01)
     assert d.n == 1024
     np.testing.assert_allclose(d.u[:2], [0.22183165, 0.039027807])
+    shipped = datasets.robot_arm()
+    np.testing.assert_array_equal(shipped.u, d.u)
+    np.testing.assert_array_equal(shipped.y, d.y)
+    assert shipped.ts == 0.01 and datasets.robot_arm(ts=0.1).ts == 0.1
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
@@ -107,7 +107,8 @@ def test_csv_bad_columns(tmp_path):
     p = tmp_path / "r.csv"
     p.write_text("u,y\n1,2\n3,oops\n")
     with pytest.raises(
-        ValueError, match=r"column 'y' must be numeric; got 'oops' on line 3"
+        ValueError,
+        match=r"column 'y' of '.*r.csv' must be numeric; got 'oops' on line 3",
     ):
         IOData.from_csv(p, ts=1.0)
     with pytest.raises(
@@ -148,3 +149,35 @@ def test_signals_are_private_read_only_copies():
     assert d.u[0] == 0.0
     with pytest.raises(ValueError, match="read-only"):
         d.u[0] = 1.0
+
+
+def test_csv_saved_by_excel_with_a_byte_order_mark(tmp_path):
+    p = tmp_path / "excel.csv"
+    p.write_bytes("u,y\n1,2\n3,4\n".encode("utf-8-sig"))
+    d = IOData.from_csv(p, input="u", output="y", ts=1.0)
+    np.testing.assert_array_equal(d.u, [1, 3])
+    assert d.input_name == "u"
+
+
+def test_csv_header_units_go_to_the_record(tmp_path):
+    p = tmp_path / "rig.csv"
+    p.write_text("torque [N m],accel (m/s^2)\n1,2\n3,4\n")
+    d = IOData.from_csv(p, input="torque", output="accel (m/s^2)", ts=1.0)
+    assert (d.input_name, d.input_unit) == ("torque", "N m")
+    assert (d.output_name, d.output_unit) == ("accel", "m/s^2")
+    assert d.output_label == "accel (m/s^2)"
+    assert d.detrend().split(0.5)[1].input_unit == "N m"
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+def test_values_that_overflow_or_vanish_when_squared_are_refused(scale):
+    u = np.arange(10.0) + 1
+    with pytest.raises(ValueError, match="`y` must be rescaled"):
+        IOData(u, u * scale, ts=1.0)
+
+
+def test_non_utf8_csv_is_refused_clearly(tmp_path):
+    p = tmp_path / "r.csv"
+    p.write_bytes(b"\xff\xfe\x00\x01" * 10)
+    with pytest.raises(ValueError, match="is not a UTF-8 text"):
+        IOData.from_csv(p, ts=1.0)

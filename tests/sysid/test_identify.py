@@ -1,12 +1,12 @@
 """identify(): a known ARX(2, 2, 1), the real flexible arm, serialisation, bad input."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy import signal
 
+from spiralid.datasets import robot_arm
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, step_up
 from spiralid.sysid.identify import (
     default_bounds,
@@ -14,13 +14,6 @@ from spiralid.sysid.identify import (
     steiglitz_mcbride,
 )
 
-ARM = (
-    Path(__file__).resolve().parents[2]
-    / ".."
-    / "shared"
-    / "data"
-    / "daisy_robot_arm.csv"
-)
 TRUE = np.array([-1.5, 0.7, 1.0, 0.5])
 
 
@@ -142,9 +135,7 @@ def test_to_dlti_and_dict_round_trip(known):
 
 @pytest.fixture(scope="module")
 def arm():
-    if not ARM.exists():
-        pytest.skip("real arm data not available")
-    return IOData.from_csv(ARM, input="u", output="y", ts=0.01)
+    return robot_arm()
 
 
 @pytest.fixture(scope="module")
@@ -373,3 +364,37 @@ def test_differential_evolution_shares_the_spiral_methods_start(known):
     assert np.all(np.diff(fit.history) <= 0)
     assert fit.cost == pytest.approx(fit.history[-1])
     assert fit.is_stable
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"refine": "yes"}, "`refine` must be True or False; got 'yes'"),
+        ({"rng": "abc"}, "`rng` must be None, a non-negative integer"),
+        ({"rng": 1.5}, "`rng` must be None"),
+    ],
+)
+def test_bad_refine_and_rng_are_refused_by_name(known, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        identify(known, ARX(2, 2, 1), method="ebsda", **kwargs)
+
+
+def test_search_on_constant_input_does_not_blame_least_squares():
+    d = IOData(np.ones(50), np.random.default_rng(0).standard_normal(50), ts=1.0)
+    with pytest.raises(ValueError) as info:
+        identify(d, ARX(2, 2, 1), method="ebsda", rng=0)
+    assert "least squares" not in str(info.value)
+    assert "constant input" in str(info.value)
+
+
+def test_to_control_matches_scipy_and_keeps_the_sample_time(known):
+    control = pytest.importorskip("control", reason="python-control not installed")
+    model = identify(known, ARX(2, 2, 1), method="ls")
+    tf = model.to_control()
+    assert isinstance(tf, control.TransferFunction) and tf.dt == known.ts
+    w = np.array([0.1, 1.0, 10.0, 100.0])  # rad/s, below Nyquist (314 rad/s)
+    _, h_scipy = model.to_dlti().freqresp(w * known.ts)
+    np.testing.assert_allclose(tf(np.exp(1j * w * known.ts)), h_scipy, rtol=1e-10)
+    # The same through a saved model file.
+    again = IdentifiedModel.from_dict(json.loads(json.dumps(model.to_dict())))
+    np.testing.assert_array_equal(again.to_control().num[0][0], tf.num[0][0])

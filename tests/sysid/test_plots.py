@@ -209,3 +209,43 @@ def test_importing_the_library_does_not_import_matplotlib():
         "assert 'matplotlib' in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_figures_carry_units_continue_time_and_label_residuals():
+    from scipy.signal import lfilter
+
+    from spiralid.sysid import ARX, IOData, identify, validate
+
+    u = np.random.default_rng(0).standard_normal(600)
+    y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    data = IOData(u, y, ts=0.01, output_name="accel", output_unit="m/s^2")
+    est, val = data.split(0.5)
+    v = validate(identify(est, ARX(2, 2, 1), method="ls"), val, warmup=est)
+    figs = v.plot()
+    top, err = figs["time"].axes
+    assert top.get_ylabel() == "accel (m/s^2)"
+    assert err.get_ylabel().endswith("(m/s^2)")
+    # The validation part continues the record's time axis after the warm-up.
+    assert top.lines[0].get_xdata()[0] == pytest.approx(300 * 0.01)
+    for ax in figs["residuals"].axes:
+        assert ax.get_ylabel() == "normalised correlation"
+        legend = ax.get_legend()
+        assert legend is not None and legend.get_bbox_to_anchor().x0 > 0
+
+
+def test_log_cost_axis_keeps_several_labelled_ticks():
+    from spiralid.sysid.plots import plot_convergence
+
+    # Costs within less than a decade: plain log ticks would label one value.
+    h = [np.linspace(90.0, 60.0, 40), np.linspace(95.0, 70.0, 40)]
+    fig = plot_convergence({"SDA": h}, cost_label="best cost (%)")
+    ax = fig.axes[0]
+    fig.canvas.draw()
+    lo, hi = ax.get_ylim()
+    labels = [
+        t.get_text()
+        for t in ax.get_yticklabels()
+        if t.get_text() and lo <= t.get_position()[1] <= hi
+    ]
+    assert len(labels) >= 3, labels
+    assert ax.get_ylabel() == "best cost (%)"

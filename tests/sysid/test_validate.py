@@ -261,3 +261,9 @@ def test_validate_bad_input():
         validate(m, (data.u, data.y))
     with pytest.raises(ValueError, match="`warmup` must be an IOData"):
         validate(m, data, warmup=(data.u, data.y))
+
+
+@pytest.mark.parametrize("bad", [None, "model.json", np.zeros(4)])
+def test_validate_names_a_model_that_is_not_one(bad):
+    with pytest.raises(ValueError, match="`model` must be an IdentifiedModel"):
+        validate(bad, record(200))

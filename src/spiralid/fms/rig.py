@@ -31,6 +31,12 @@ from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
 __all__ = ["FlexibleManipulator", "Recording"]
 
 _OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
+_UNITS = {
+    "hub_angle": "rad",
+    "hub_velocity": "rad/s",
+    "end_acceleration": "m/s^2",
+    "tip_deflection": "m",
+}
 
 
 @dataclass(frozen=True)
@@ -87,8 +93,8 @@ class Recording:
         >>> from spiralid.fms import FlexibleManipulator, bang_bang
         >>> u = bang_bang(0.3, 0.05, 0.1, 1.0, 500.0)
         >>> d = FlexibleManipulator().simulate(u).iodata("end_acceleration")
-        >>> d.n, d.ts, d.output_name
-        (500, 0.002, 'end_acceleration')
+        >>> d.n, d.ts, d.output_name, d.output_unit
+        (500, 0.002, 'end_acceleration', 'm/s^2')
         """
         from spiralid.sysid.data import IOData
 
@@ -100,6 +106,8 @@ class Recording:
             ts=self.ts,
             input_name="torque",
             output_name=name,
+            input_unit="N m",
+            output_unit=_UNITS[name],
         )
 
 

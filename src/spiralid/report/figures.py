@@ -29,7 +29,9 @@ def convergence(rep: Reproduction, labels=PAPER_PAIR) -> Figure:
     """Figure 6a: best cost against iteration and wall time, median and IQR."""
     hist = {label: [r.history for r in rep.runs[label]] for label in labels}
     times = {label: [r.times for r in rep.runs[label]] for label in labels}
-    fig = plots.plot_convergence(hist, times=times)
+    fig = plots.plot_convergence(
+        hist, times=times, cost_label="best cost, eq. (2) (% of rms(y))"
+    )
     fig.axes[0].set_title(
         f"Convergence over {len(rep.seeds)} seeds (median and interquartile band)"
     )
@@ -46,6 +48,7 @@ def estimation_response(rep: Reproduction) -> Figure:
         outs,
         title="Modelling (estimation part), free run",
         ylabel=est.output_name,
+        unit=est.output_unit,
     )
 
 
@@ -63,6 +66,7 @@ def validation_response(rep: Reproduction) -> Figure:
         outs,
         title="Validation part, free run",
         ylabel=val.output_name,
+        unit=val.output_unit,
     )
 
 
@@ -99,8 +103,8 @@ def distributions(rep: Reproduction) -> Figure:
         for j, (name, run) in enumerate(rep.baselines.items()):
             ax.axhline(getattr(run, attr), ls="--", lw=1, color=f"C{j + 1}", label=name)
         ax.legend(loc="best", fontsize="small")
-    ax_cost.set_ylabel("estimation cost, eq. (2) (%)")
-    ax_cost.set_yscale("log")
+    ax_cost.set_ylabel("estimation cost, eq. (2) (% of rms(y))")
+    plots.set_log_scale(ax_cost)
     ax_fit.set_ylabel("validation fit (%)")
     ax_fit.tick_params(axis="x", rotation=20)
     fig.suptitle(f"Every run over {len(rep.seeds)} seeds")

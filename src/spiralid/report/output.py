@@ -1,8 +1,9 @@
 """Write a reproduction to disk: PNG figures, ``results.json``, ``report.html``.
 
-The output directory must be new or empty unless ``force`` is given; with
+The output folder must be new or empty unless ``force`` is given; with
 ``force`` the files this module writes are replaced and nothing else in the
-directory is touched.
+folder is touched. The files are written atomically
+(:class:`~spiralid.report.atomic.OutputFolder`): all of them or none.
 """
 
 from __future__ import annotations
@@ -16,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 
+from spiralid.report.atomic import OutputFolder
 from spiralid.report.experiment import Reproduction
 from spiralid.sysid.polynomials import format_pole_radius
 
 __all__ = [
     "OUTPUT_FILES",
-    "check_output_dir",
     "results_dict",
     "summary_text",
     "verdict",
@@ -35,25 +36,6 @@ PAPER_TABLE2 = {
     "SDA": (35.85, (-0.1159, 0.1074), (-0.1355, 0.1458)),
     "Eb-SDA": (17.83, (-0.0614, 0.0638), (-0.0642, 0.0629)),
 }
-
-
-def check_output_dir(path: str | Path, force: bool) -> Path:
-    """Return `path` as a Path, refusing a non-empty directory without `force`.
-
-    Raises
-    ------
-    ValueError
-        `path` is a file, or a non-empty directory and `force` is false.
-    """
-    out = Path(path)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"`out` must be a directory; {str(out)!r} is a file")
-    if out.is_dir() and any(out.iterdir()) and not force:
-        raise ValueError(
-            f"`out` directory {str(out)!r} is not empty; choose another or pass "
-            "--force to overwrite the files this command writes there"
-        )
-    return out
 
 
 def _versions() -> dict:
@@ -110,6 +92,8 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
             **rep.source,
             "input": data.input_name,
             "output": data.output_name,
+            "input_unit": data.input_unit,
+            "output_unit": data.output_unit,
             "n_samples": data.n,
             "ts": data.ts,
             "n_estimation": rep.estimation.n,
@@ -214,6 +198,15 @@ _T2_HEAD = [
     "error range (validation)",
     "validation fit %",
 ]
+
+
+def _t2_head(unit: str) -> list[str]:
+    """Table-2's header, its error ranges in the output's unit when known."""
+    if not unit:
+        return _T2_HEAD
+    return [h.replace(")", f", {unit})") if "range" in h else h for h in _T2_HEAD]
+
+
 _STAT_HEAD = [
     "method",
     "mean",
@@ -264,7 +257,7 @@ def summary_text(rep: Reproduction) -> str:
             f"simulation from {d['initial']}.",
             "",
             "Table-2 (best run of each method; cost = eq. (2), % of rms(y))",
-            _table(_T2_HEAD, _table2_rows(rep)),
+            _table(_t2_head(rep.data.output_unit), _table2_rows(rep)),
             "",
             "Estimation cost over seeds",
             _table(_STAT_HEAD, _stat_rows(rep)),
@@ -309,7 +302,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "lacks and least-squares (LS) and output-error (OE) baselines beside the "
         "metaheuristics.</p>",
         f"<p>Command: <code>{e(command or 'spiralid.report.reproduce()')}</code><br>"
-        f"Data: {e(rep.data.input_name)} &rarr; {e(rep.data.output_name)}, "
+        f"Data: {e(rep.data.input_label)} &rarr; {e(rep.data.output_label)}, "
         f"{rep.data.n} samples at ts = {rep.data.ts:g} s; first "
         f"{rep.estimation.n} to estimate, last {rep.validation.n} to validate.<br>"
         f"Model: {e(str(rep.arx))}, predictor: free-run simulation from "
@@ -323,7 +316,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "<h2>Table-2</h2><p>Best run of each method (lowest estimation cost). "
         "Error ranges are min and max of the free-run error y - y&#770; in "
         "output units.</p>",
-        _table(_T2_HEAD, _table2_rows(rep), "html"),
+        _table(_t2_head(rep.data.output_unit), _table2_rows(rep), "html"),
         "<p>The paper's Table-2, on its own rig and record (its gain w is not "
         "stated, so its fitness scale is unknown):</p>",
         _table(
@@ -448,30 +441,46 @@ def ranksums(rep: Reproduction) -> list[dict]:
 
 def write_reproduction(
     rep: Reproduction,
-    out: str | Path,
+    out: str | Path | OutputFolder,
     *,
     force: bool = False,
     command: str | None = None,
 ) -> list[Path]:
     """Write figures (PNG), ``results.json`` and ``report.html`` into `out`.
 
-    Returns the paths written. Refuses a non-empty directory unless `force`.
+    Parameters
+    ----------
+    rep : Reproduction
+    out : path-like or OutputFolder
+        The target folder, or an open :class:`OutputFolder` (the command
+        line opens it before computing, so a locked or unwritable target is
+        refused before the experiment runs).
+    force : bool
+        Write into a non-empty folder (ignored for an open OutputFolder).
+    command : str, optional
+        The command line recorded in the report.
+
+    Returns
+    -------
+    list of Path
+        The files written, at their final place.
     """
+    if isinstance(out, OutputFolder):
+        return _write_files(rep, out, command)
+    with OutputFolder(out, force) as folder:
+        return _write_files(rep, folder, command)
+
+
+def _write_files(rep: Reproduction, folder: OutputFolder, command) -> list[Path]:
     from spiralid.report.figures import all_figures
 
-    out = check_output_dir(out, force)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
     images = {}
     for stem, fig in all_figures(rep).items():
         images[stem] = _png(fig)
-        path = out / f"{stem}.png"
-        path.write_bytes(images[stem])
-        written.append(path)
-    path = out / "results.json"
-    path.write_text(json.dumps(results_dict(rep, command), indent=2, allow_nan=True))
-    written.append(path)
-    path = out / "report.html"
-    path.write_text(_html(rep, images, command), encoding="utf-8")
-    written.append(path)
-    return written
+        (folder.path / f"{stem}.png").write_bytes(images[stem])
+    results = json.dumps(results_dict(rep, command), indent=2, allow_nan=True)
+    (folder.path / "results.json").write_text(results)
+    (folder.path / "report.html").write_text(
+        _html(rep, images, command), encoding="utf-8"
+    )
+    return folder.commit(last="report.html")

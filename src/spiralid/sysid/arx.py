@@ -352,8 +352,8 @@ def arx_least_squares(data: IOData, arx: ARX) -> np.ndarray:
     arx.check_length(data)
     if np.ptp(data.u) == 0.0:
         raise ValueError(
-            f"`data` input is constant ({data.u[0]!r}): the input does not excite "
-            "the system, so least squares is singular"
+            f"`data` has a constant input ({float(data.u[0])!r}): it does not excite "
+            f"the system, so no {arx} model can be identified from it"
         )
     t0 = arx.max_lag
     phi = arx.regressors(data)[t0:]

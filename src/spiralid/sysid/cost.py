@@ -165,7 +165,8 @@ class PaperCost:
             rms = float(np.sqrt(np.mean(y * y)))
             if rms == 0.0:
                 raise ValueError(
-                    "`gain` 'auto' needs a non-zero output; `data.y` is all zero"
+                    "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
+                    "100 sqrt(K) / rms(y))"
                 )
             self.w = 100.0 * np.sqrt(self.K) / rms
         else:

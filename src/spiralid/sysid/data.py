@@ -65,6 +65,38 @@ def _frozen_signal(x, name: str) -> np.ndarray:
     return arr
 
 
+# Sums of squares of N samples overflow beyond about 1e154 / sqrt(N), and
+# products of small samples underflow below about 1e-154; the limits leave
+# room for the regression's cross products on records of any practical size.
+_LARGEST = 1e100
+_SMALLEST = 1e-100
+
+
+def _check_magnitude(x: np.ndarray, name: str) -> None:
+    """Refuse a signal whose squares overflow or underflow in double precision."""
+    peak = float(np.max(np.abs(x))) if x.size else 0.0
+    if peak > _LARGEST or 0.0 < peak < _SMALLEST:
+        raise ValueError(
+            f"`{name}` must be rescaled: its largest magnitude {peak:.3g} is "
+            f"outside [{_SMALLEST:g}, {_LARGEST:g}], where sums of squares "
+            "overflow or vanish in double precision (e.g. convert it to SI units)"
+        )
+
+
+def _label(name: str, unit: str) -> str:
+    return f"{name} ({unit})" if unit else name
+
+
+def _split_unit(header: str) -> tuple[str, str]:
+    """``"torque [N m]"`` or ``"torque (N m)"`` -> ``("torque", "N m")``."""
+    text = header.strip()
+    for open_, close in ("[]", "()"):
+        if text.endswith(close) and open_ in text:
+            i = text.rindex(open_)
+            return text[:i].strip(), text[i + 1 : -1].strip()
+    return text, ""
+
+
 def _check_ts(ts) -> float:
     try:
         val = float(ts)
@@ -89,6 +121,9 @@ class IOData:
         Sample time in seconds (> 0).
     input_name, output_name : str
         Labels used in tables and plots.
+    input_unit, output_unit : str
+        Units of `u` and `y` (e.g. ``"N m"``, ``"m/s^2"``), shown in every
+        figure and table; empty when unknown.
     u_offset, y_offset : float
         Offsets already removed from the signals (set by :meth:`detrend`);
         add them back to recover the raw signals.
@@ -110,6 +145,8 @@ class IOData:
     output_name: str = "y"
     u_offset: float = field(default=0.0)
     y_offset: float = field(default=0.0)
+    input_unit: str = ""
+    output_unit: str = ""
 
     def __post_init__(self) -> None:
         u = _frozen_signal(self.u, "u")
@@ -118,6 +155,8 @@ class IOData:
             raise ValueError(
                 f"`u` and `y` must have the same length; got {u.size} and {y.size}"
             )
+        _check_magnitude(u, "u")
+        _check_magnitude(y, "y")
         object.__setattr__(self, "u", u)
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "ts", _check_ts(self.ts))
@@ -125,6 +164,8 @@ class IOData:
         object.__setattr__(self, "output_name", str(self.output_name))
         object.__setattr__(self, "u_offset", float(self.u_offset))
         object.__setattr__(self, "y_offset", float(self.y_offset))
+        object.__setattr__(self, "input_unit", str(self.input_unit))
+        object.__setattr__(self, "output_unit", str(self.output_unit))
 
     @property
     def n(self) -> int:
@@ -139,6 +180,16 @@ class IOData:
         """Sample instants ``0, ts, 2 ts, ...`` in seconds."""
         return np.arange(self.n) * self.ts
 
+    @property
+    def input_label(self) -> str:
+        """``"name (unit)"``, or the name alone when the unit is unknown."""
+        return _label(self.input_name, self.input_unit)
+
+    @property
+    def output_label(self) -> str:
+        """``"name (unit)"``, or the name alone when the unit is unknown."""
+        return _label(self.output_name, self.output_unit)
+
     def __repr__(self) -> str:
         return (
             f"IOData(n={self.n}, ts={self.ts!r}, input_name={self.input_name!r}, "
@@ -152,6 +203,8 @@ class IOData:
             output_name=self.output_name,
             u_offset=self.u_offset,
             y_offset=self.y_offset,
+            input_unit=self.input_unit,
+            output_unit=self.output_unit,
         )
         args.update(kw)
         return IOData(u, y, **args)
@@ -192,16 +245,36 @@ class IOData:
             )
         return self[:k], self[k:]
 
-    def detrend(self) -> IOData:
+    def detrend(self, like: IOData | None = None) -> IOData:
         """Remove the means of input and output, remembering them as offsets.
+
+        Parameters
+        ----------
+        like : IOData, optional
+            Remove this record's means instead of our own: detrend a whole
+            record by its estimation part, ``data.detrend(like=est)``, so the
+            validation part is shifted by the offsets the model was
+            estimated with, as new data would be.
 
         Returns
         -------
         IOData
-            Zero-mean signals; ``u_offset`` / ``y_offset`` accumulate the
+            Shifted signals; ``u_offset`` / ``y_offset`` accumulate the
             removed means so ``data.y + data.y_offset`` is the raw output.
+
+        Examples
+        --------
+        >>> d = IOData([1.0, 3.0, 5.0, 7.0], [10.0, 10.0, 12.0, 12.0], ts=1.0)
+        >>> d.detrend().y.tolist(), d.detrend().y_offset
+        ([-1.0, -1.0, 1.0, 1.0], 11.0)
+        >>> est, _ = d.split(0.5)
+        >>> d.detrend(like=est).u.tolist()
+        [-1.0, 1.0, 3.0, 5.0]
         """
-        mu, my = float(self.u.mean()), float(self.y.mean())
+        ref = self if like is None else like
+        if not isinstance(ref, IOData):
+            raise ValueError(f"`like` must be an IOData; got {type(like).__name__}")
+        mu, my = float(ref.u.mean()), float(ref.y.mean())
         return self._replace(
             self.u - mu,
             self.y - my,
@@ -227,7 +300,10 @@ class IOData:
         path : path-like
             The file. A first line that is not all numbers is read as a header.
         input, output : str or int
-            Column names (needs a header) or 0-based column indices.
+            Column names (needs a header) or 0-based column indices. A header
+        may carry units as ``name [unit]`` or ``name (unit)``; the column is
+        then named by either the whole header or ``name``, and the unit goes
+        to ``input_unit`` / ``output_unit``.
         ts : float
             Sample time in seconds; required, as a CSV file carries none.
         delimiter : str
@@ -238,17 +314,22 @@ class IOData:
                 "`ts` must be given for a CSV file (the sample time in seconds); "
                 "got None"
             )
-        with open(path, newline="") as fh:
-            rows = [r for r in csv.reader(fh, delimiter=delimiter) if r]
+        where = repr(str(path))
+        try:
+            # utf-8-sig: a file saved by Excel starts with a byte-order mark.
+            with open(path, newline="", encoding="utf-8-sig") as fh:
+                rows = [r for r in csv.reader(fh, delimiter=delimiter) if r]
+        except UnicodeDecodeError:
+            raise ValueError(f"{where} is not a UTF-8 text (CSV) file") from None
         if not rows:
-            raise ValueError(
-                f"`path` must name a non-empty file; {str(path)!r} is empty"
-            )
+            raise ValueError(f"{where} is empty")
         header = None
         if not all(_is_number(c) for c in rows[0]):
             header = [c.strip() for c in rows[0]]
             rows = rows[1:]
         ncol = len(header) if header is not None else len(rows[0])
+        # A column is named by its full header or by the name before its unit.
+        names = [_split_unit(h)[0] for h in header] if header else []
 
         def column(key, argname):
             if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
@@ -257,20 +338,24 @@ class IOData:
                         f"`{argname}` column index must be in [0, {ncol - 1}]; "
                         f"got {key!r}"
                     )
-                return int(key), (header[key] if header else f"column {key}")
-            if header is None:
+                j = int(key)
+            elif header is None:
                 raise ValueError(
-                    f"`{argname}` must be a column index: {str(path)!r} has no header "
+                    f"`{argname}` must be a column index: {where} has no header "
                     f"line; got {key!r}"
                 )
-            if key not in header:
+            elif key in header:
+                j = header.index(key)
+            elif key in names:
+                j = names.index(key)
+            else:
                 raise ValueError(
                     f"`{argname}` must be one of the columns {header}; got {key!r}"
                 )
-            return header.index(key), str(key)
+            return j, *(_split_unit(header[j]) if header else (f"column {j}", ""))
 
-        iu, name_u = column(input, "input")
-        iy, name_y = column(output, "output")
+        iu, name_u, unit_u = column(input, "input")
+        iy, name_y, unit_y = column(output, "output")
         first_row = 2 if header is not None else 1
 
         def values(j, name):
@@ -281,12 +366,20 @@ class IOData:
                     out[r] = float(cell)
                 except ValueError:
                     raise ValueError(
-                        f"`path` column {name!r} must be numeric; got {cell!r} on line "
-                        f"{r + first_row} of {str(path)!r}"
+                        f"column {name!r} of {where} must be numeric; got {cell!r} "
+                        f"on line {r + first_row}"
                     ) from None
             return out
 
-        return cls(values(iu, name_u), values(iy, name_y), ts, name_u, name_y)
+        return cls(
+            values(iu, name_u),
+            values(iy, name_y),
+            ts,
+            name_u,
+            name_y,
+            input_unit=unit_u,
+            output_unit=unit_y,
+        )
 
     @classmethod
     def from_npz(
@@ -300,8 +393,21 @@ class IOData:
 
         ``ts=None`` reads the sample time from a scalar array named ``ts``.
         """
-        with np.load(path, allow_pickle=False) as z:
-            return cls._from_mapping(dict(z.items()), input, output, ts, path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                mapping = dict(z.items())
+        except ValueError as exc:
+            if "allow_pickle" not in str(exc):
+                raise
+            raise ValueError(
+                f"{str(path)!r} holds Python objects, which spiralid never "
+                "unpickles (they can run code); save plain numeric arrays"
+            ) from None
+        except (OSError, EOFError) as exc:
+            raise ValueError(
+                f"{str(path)!r} is not a readable .npz file ({exc})"
+            ) from None
+        return cls._from_mapping(mapping, input, output, ts, path)
 
     @classmethod
     def from_mat(
@@ -317,7 +423,13 @@ class IOData:
         """
         from scipy.io import loadmat
 
-        mat = {k: v for k, v in loadmat(path).items() if not k.startswith("__")}
+        try:
+            raw = loadmat(path)
+        except (ValueError, TypeError, NotImplementedError, EOFError) as exc:
+            raise ValueError(
+                f"{str(path)!r} is not a readable .mat file ({exc})"
+            ) from None
+        mat = {k: v for k, v in raw.items() if not k.startswith("__")}
         return cls._from_mapping(mat, input, output, ts, path)
 
     @classmethod

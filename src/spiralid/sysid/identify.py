@@ -37,6 +37,8 @@ import time
 
 import numpy as np
 
+from spiralid._checks import generator
+
 from .arx import ARX
 from .cost import PaperCost
 from .data import IOData
@@ -195,6 +197,8 @@ def identify(
         raise ValueError(
             f"`safe_start` must be True, False or None; got {safe_start!r}"
         )
+    if not isinstance(refine, bool | np.bool_):
+        raise ValueError(f"`refine` must be True or False; got {refine!r}")
     spec = METHODS[method]
     cost = PaperCost(
         arx, data, predictor=predictor, gain=gain, penalty=penalty, initial=initial
@@ -208,7 +212,7 @@ def identify(
         gain=gain,
         penalty=penalty,
         parametrization=par,
-        rng=np.random.default_rng(rng),
+        rng=generator(rng),
         bounds=None if bounds is None else _check_bounds(bounds, par.n_search),
         refine=bool(refine),
         safe_start=spec.safe_start if safe_start is None else bool(safe_start),

@@ -140,6 +140,21 @@ class IdentifiedModel:
         num = num[nz[0] :] if nz.size else num[-1:]
         return signal.dlti(num, den, dt=self.ts)
 
+    def to_control(self):
+        """The model as a python-control ``TransferFunction`` in z, ``dt = ts``.
+
+        Needs python-control, an optional dependency:
+        ``pip install "spiralid[control]"``.
+        """
+        try:
+            import control
+        except ImportError:
+            raise ImportError(
+                'to_control() needs python-control: pip install "spiralid[control]"'
+            ) from None
+        dlti = self.to_dlti()
+        return control.tf(dlti.num, dlti.den, self.ts)
+
     # -- serialisation -----------------------------------------------------------
 
     def to_dict(self) -> dict:

@@ -49,6 +49,7 @@ def plot_time_response(
     error: bool = True,
     title: str | None = None,
     ylabel: str = "output",
+    unit: str = "",
 ) -> Figure:
     """Measured output against one or several model outputs, and their errors.
 
@@ -65,6 +66,8 @@ def plot_time_response(
         Figures 6c and 7b).
     title, ylabel : str, optional
         Labels.
+    unit : str, optional
+        Unit of `y` (e.g. ``"m/s^2"``), added to both y axes.
 
     Returns
     -------
@@ -92,7 +95,8 @@ def plot_time_response(
     ax.plot(t, y, color="k", lw=1.2, label="measured")
     for label, yhat in outs.items():
         ax.plot(t, yhat, lw=1.0, label=label)
-    ax.set_ylabel(ylabel)
+    units = f" ({unit})" if unit else ""
+    ax.set_ylabel(ylabel + units)
     ax.legend(loc="best", fontsize="small")
     if title:
         ax.set_title(title)
@@ -101,7 +105,7 @@ def plot_time_response(
         for label, yhat in outs.items():
             ax.plot(t, y - yhat, lw=0.9, label=label)
         ax.axhline(0.0, color="k", lw=0.6)
-        ax.set_ylabel("error")
+        ax.set_ylabel(f"error, measured - model{units}")
         ax.legend(loc="best", fontsize="small")
     axes[-1].set_xlabel("time (s)")
     return fig
@@ -170,7 +174,9 @@ def plot_residual_tests(*tests: CorrelationTest) -> Figure:
         )
         ax.set_title(f"{what}: {verdict} (p = {tst.p_value:.3g})", fontsize="medium")
         ax.set_xlabel("lag (samples)")
-        ax.legend(loc="upper right", fontsize="small")
+        ax.set_ylabel("normalised correlation")
+        # Beside the axes: inside, the legend hides stems at some lags.
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     return fig
 
 
@@ -339,6 +345,23 @@ def plot_pole_zero(models, *, radius: float | None = None) -> Figure:
     return fig
 
 
+def set_log_scale(ax) -> None:
+    """A logarithmic y axis that keeps several labelled ticks.
+
+    Over less than a decade or two, matplotlib's log axis labels one or two
+    powers of ten at most; there the ticks are placed as on a linear axis
+    and labelled in plain numbers.
+    """
+    from matplotlib.ticker import FuncFormatter, MaxNLocator, NullFormatter
+
+    ax.set_yscale("log")
+    lo, hi = ax.get_ylim()
+    if lo > 0 and hi / lo < 30:
+        ax.yaxis.set_major_locator(MaxNLocator(nbins=6))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+
+
 def _step_on_grid(times: np.ndarray, values: np.ndarray, grid: np.ndarray):
     # Best-so-far is a step function: at time g it is the last value logged
     # at or before g (NaN before the first log).
@@ -382,6 +405,7 @@ def plot_convergence(
     times=None,
     log: bool = True,
     band: tuple[float, float] = (25.0, 75.0),
+    cost_label: str = "best cost",
 ) -> Figure:
     """Best cost against iteration (and wall time), one curve per method.
 
@@ -407,6 +431,9 @@ def plot_convergence(
         Logarithmic cost axis.
     band : (float, float), default (25, 75)
         Percentiles of the shaded band.
+    cost_label : str, default "best cost"
+        Label of the cost axis; give the cost's unit, e.g. ``"best cost,
+        eq. (2) (% of rms(y))"``.
 
     Returns
     -------
@@ -507,9 +534,9 @@ def plot_convergence(
             draw(ax, grid, stack, label)
         ax.set_xlabel("wall time (s)")
     for ax in axes:
-        ax.set_ylabel("best cost")
+        ax.set_ylabel(cost_label)
         if log:
-            ax.set_yscale("log")
+            set_log_scale(ax)
         ax.legend(loc="best", fontsize="small")
     axes[0].set_title("Convergence")
     return fig

@@ -292,7 +292,10 @@ class Validation:
     poles, zeros : ndarray of complex
         Of the transfer function in ``z``.
     t, u, y, y_sim, y_pred : ndarray
-        Time axis and signals, for plots.
+        Time axis and signals, for plots; after a ``warmup`` the time axis
+        continues from its end.
+    output_name, output_unit : str
+        The record's output name and unit, for figure labels.
     """
 
     label: str
@@ -324,6 +327,8 @@ class Validation:
     y: np.ndarray
     y_sim: np.ndarray
     y_pred: np.ndarray
+    output_name: str = "output"
+    output_unit: str = ""
 
     @property
     def error(self) -> np.ndarray:
@@ -355,6 +360,7 @@ class Validation:
             return ", ".join(f"{v:.2f}" for v in x) or "none"
 
         rz = self.realization
+        unit = f", {self.output_unit}" if self.output_unit else ""
         rows = [
             ("samples (N), ts", f"{self.n_samples}, {self.ts:g} s"),
             ("fit % (simulation)", f"{self.fit_percent:.2f}"),
@@ -363,11 +369,11 @@ class Validation:
             ("RMSE (one-step)", f"{self.rmse_one_step:.4g}"),
             (f"paper cost, eq. (2) ({self.cost_predictor})", f"{self.cost:.4g}"),
             (
-                "error range (simulation)",
+                f"error range (simulation{unit})",
                 f"[{self.error_range[0]:.4f}, {self.error_range[1]:.4f}]",
             ),
             (
-                "error range (one-step)",
+                f"error range (one-step{unit})",
                 f"[{self.error_range_one_step[0]:.4f}, "
                 f"{self.error_range_one_step[1]:.4f}]",
             ),
@@ -457,7 +463,12 @@ class Validation:
         name = self.label or "model"
         return {
             "time": plots.plot_time_response(
-                self.t, self.y, {name: self.y_sim}, title="Validation, free run"
+                self.t,
+                self.y,
+                {name: self.y_sim},
+                title="Validation, free run",
+                ylabel=self.output_name,
+                unit=self.output_unit,
             ),
             "residuals": plots.plot_residual_tests(self.whiteness, self.independence),
             "spectrum": plots.plot_psd(
@@ -602,6 +613,11 @@ def validate(
     hardly decays. Pass ``warmup`` to validate such a model from the state
     it has reached.
     """
+    if not all(hasattr(model, k) for k in ("simulate", "predict", "arx", "theta")):
+        raise ValueError(
+            "`model` must be an IdentifiedModel (from identify() or "
+            f"IdentifiedModel.from_dict); got {type(model).__name__}"
+        )
     u, y, ts = _signals_of(data)
     n = y.size
     # Checked here too (the correlation tests would) so a bad `lags` fails
@@ -625,7 +641,8 @@ def validate(
         rms_y = float(np.sqrt(np.mean(y**2)))
         if rms_y == 0.0:
             raise ValueError(
-                "`gain` 'auto' needs a non-zero output; `data.y` is all zero"
+                "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
+                "100 sqrt(K) / rms(y))"
             )
         w = 100.0 * np.sqrt(n) / rms_y
     elif isinstance(gain, str) and gain == "model":
@@ -721,9 +738,11 @@ def validate(
         realization=realization_tests(num, den),
         poles=poles,
         zeros=zeros,
-        t=np.arange(n) * ts,
+        t=(np.arange(n) + (0 if warmup is None else wu.size)) * ts,
         u=u,
         y=y,
         y_sim=y_sim,
         y_pred=y_pred,
+        output_name=str(getattr(data, "output_name", "output")),
+        output_unit=str(getattr(data, "output_unit", "")),
     )
