@@ -96,7 +96,7 @@ class ResultStore:
 
     def _lock(self) -> None:
         lock_path = self.path.with_name(self.path.name + ".lock")
-        fh = open(lock_path, "a+")  # noqa: SIM115 - held until close()
+        fh = open(lock_path, "a+")  # held until close()
         try:
             fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
