@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .spec import StudySpec
 from .statistics import holm, rank_sum
 
 __all__ = ["CLAIM", "StudyResults", "analyse"]
@@ -32,7 +33,7 @@ class StudyResults:
     ----------
     readings : list of (data, predictor, parametrization)
     labels : list of str
-        Search configurations, in the order first met.
+        Search configurations.
     cells : dict of (reading, label) to dict
         ``cost``, ``fit_val``, ``seconds``, ``seeds`` arrays over seeds (seed
         order) and ``history``, the runs' convergence histories.
@@ -74,13 +75,37 @@ def _verdict(p_holm: float, effect: float, claim, alpha: float) -> str:
     return f"{claim[0]} better" if effect > 0.5 else f"{claim[1]} better"
 
 
-def analyse(rows: list[dict], claim=CLAIM, alpha: float = 0.05) -> StudyResults:
+def _orders(spec: StudySpec | None) -> tuple[dict, dict]:
+    """Rank of each reading and label in the specification (its own order)."""
+    if spec is None:
+        return {}, {}
+    readings = [
+        (d.name, p, par)
+        for d in spec.data
+        for p in spec.predictors
+        for par in spec.parametrizations
+    ]
+    return (
+        {r: i for i, r in enumerate(readings)},
+        {o.label: i for i, o in enumerate(spec.optimizers)},
+    )
+
+
+def analyse(
+    rows: list[dict],
+    spec: StudySpec | None = None,
+    claim=CLAIM,
+    alpha: float = 0.05,
+) -> StudyResults:
     """Group a store's rows and test the claim per reading.
 
     Parameters
     ----------
     rows : list of dict
         :meth:`~spiralid.study.ResultStore.rows`.
+    spec : StudySpec, optional
+        The study's specification: readings and configurations are listed in
+        its order (else sorted by name).
     claim : (str, str)
         Labels of the configuration claimed better and its reference.
     alpha : float
@@ -88,20 +113,20 @@ def analyse(rows: list[dict], claim=CLAIM, alpha: float = 0.05) -> StudyResults:
     """
     if not 0 < alpha < 1:
         raise ValueError(f"`alpha` must be in (0, 1); got {alpha!r}")
-    searches = sorted(
-        (r for r in rows if r["seed"] is not None),
-        key=lambda r: (r["data"], r["predictor"], r["parametrization"], r["seed"]),
-    )
-    readings: list[Reading] = []
-    labels: list[str] = []
+    reading_rank, label_rank = _orders(spec)
     grouped: dict = {}
-    for r in searches:
+    for r in sorted(
+        (r for r in rows if r["seed"] is not None), key=lambda r: r["seed"]
+    ):
         reading = (r["data"], r["predictor"], r["parametrization"])
-        if reading not in readings:
-            readings.append(reading)
-        if r["label"] not in labels:
-            labels.append(r["label"])
         grouped.setdefault((reading, r["label"]), []).append(r)
+    readings = sorted(
+        {rd for rd, _ in grouped}, key=lambda rd: (reading_rank.get(rd, 1 << 30), rd)
+    )
+    labels = sorted(
+        {label for _, label in grouped},
+        key=lambda label: (label_rank.get(label, 1 << 30), label),
+    )
     cells = {
         key: {
             "seeds": np.array([r["seed"] for r in group]),
