@@ -169,7 +169,7 @@ def _oe_variant(data, arx, theta0, initial, kmax=1.0 - 1e-6):
     from scipy import optimize, signal
 
     from spiralid.sysid import step_up
-    from spiralid.sysid.identify import _stabilise
+    from spiralid.sysid.parametrizations import stabilise
 
     na, t0 = arx.na, arx.max_lag
     ulags = arx.input_lags(data.u)
@@ -186,7 +186,7 @@ def _oe_variant(data, arx, theta0, initial, kmax=1.0 - 1e-6):
         zi = signal.lfiltic([1.0], den, x[arx.n_params :])
         return signal.lfilter([1.0], den, b @ ulags[:, t0:], zi=zi)[0] - y[t0:]
 
-    start = _stabilise(theta0, arx)
+    start = stabilise(theta0, arx)
     k = np.clip(start[:na] / kmax, -1 + 1e-12, 1 - 1e-12)
     x0 = np.r_[np.arctanh(k), start[na:]]
     if initial == "estimated":
@@ -212,7 +212,7 @@ def oe_initial_state_study() -> None:
     (from rest over the whole record, last third) and the largest pole
     radius.
     """
-    import spiralid.sysid.identify  # noqa: F401 - the module, not the function
+    import spiralid.sysid.outputerror as mod
     from spiralid.sysid import (
         IdentifiedModel,
         arx_least_squares,
@@ -220,7 +220,6 @@ def oe_initial_state_study() -> None:
         validate,
     )
 
-    mod = sys.modules["spiralid.sysid.identify"]
     arx = ARX(8, 8, 0)
     records = {}
     if ARM.exists():
@@ -240,7 +239,7 @@ def oe_initial_state_study() -> None:
         for sname, start in starts.items():
             for initial in ("rest", "measured", "estimated", "rest-from-t0"):
                 if initial in ("rest", "measured"):
-                    theta, res = mod._local_polish(
+                    theta, res = mod.local_polish(
                         start, arx, est, "simulation", initial
                     )
                     own = float(np.sqrt(np.mean(res.fun**2)))
@@ -257,11 +256,11 @@ def oe_initial_state_study() -> None:
     if "arm" in records:
         est, val = records["arm"]
         print("  arm, measured-past criterion from least squares, bound on |k|:")
-        saved = mod._KMAX
+        saved = mod.KMAX
         try:
             for kmax in (1 - 1e-6, 1 - 1e-4, 1 - 1e-3, 1 - 1e-2):
-                mod._KMAX = kmax
-                theta, _ = mod._local_polish(
+                mod.KMAX = kmax
+                theta, _ = mod.local_polish(
                     arx_least_squares(est, arx), arx, est, "simulation", "measured"
                 )
                 model = IdentifiedModel(theta, arx, est.ts, "oe")
@@ -273,7 +272,7 @@ def oe_initial_state_study() -> None:
                     f"max|pole| {np.abs(model.poles).max():.7f}"
                 )
         finally:
-            mod._KMAX = saved
+            mod.KMAX = saved
 
 
 if __name__ == "__main__":

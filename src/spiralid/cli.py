@@ -276,7 +276,7 @@ def _structure(args):
 
 
 def _cmd_identify(args) -> int:
-    from spiralid.sysid import identify, validate
+    from spiralid.sysid import METHODS, identify, validate
     from spiralid.sysid.plots import plot_convergence
 
     data = _load(args.data, args.input, args.output, args.ts)
@@ -285,17 +285,14 @@ def _cmd_identify(args) -> int:
     arx.check_length(est, "estimation part of DATA")
     out = _out_dir(args.out, args.force)
     options = {}
-    if args.method in ("sda", "ebsda", "lasda", "de"):
-        options = {"n_points": args.points}
-        if args.budget is not None:
-            options["max_nfev"] = args.budget
+    if METHODS[args.method].search:
+        # The budget rule is identify()'s (estimators.search_options).
+        options = {"n_points": args.points, "max_nfev": args.budget}
         if args.iterations is not None:
             options["max_iter"] = args.iterations
-        elif args.budget is not None:
-            # A budget of evaluations is the stop; iterations must not cut it.
-            options["max_iter"] = args.budget
     elif args.refine:
-        raise UsageError("--refine applies to the search methods sda, ebsda, lasda, de")
+        searches = ", ".join(name for name, m in METHODS.items() if m.search)
+        raise UsageError(f"--refine applies to the search methods {searches}")
     model = identify(
         est,
         arx,
@@ -515,6 +512,9 @@ def _check_study_dir(out: Path, store: Path, force: bool) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``spiralid`` command."""
+    from spiralid.sysid.estimators import DEFAULT_METHOD, METHODS
+    from spiralid.sysid.parametrizations import PARAMETRIZATIONS
+
     parser = _Parser(
         prog="spiralid",
         description="System identification with spiral dynamic optimisation "
@@ -581,14 +581,17 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (default 0)")
     p.add_argument(
-        "--method", choices=["ebsda", "sda", "lasda", "de", "ls", "oe"], default="ebsda"
+        "--method",
+        choices=list(METHODS),
+        default=DEFAULT_METHOD,
+        help=f"estimator (default {DEFAULT_METHOD})",
     )
     p.add_argument(
         "--predictor", choices=["simulation", "one-step"], default="simulation"
     )
     p.add_argument(
         "--parametrization",
-        choices=["coefficients", "reflection"],
+        choices=list(PARAMETRIZATIONS),
         default="coefficients",
     )
     _add_initial_option(p)

@@ -14,9 +14,10 @@ from spiralid.optim.rules import (
     SpiralRule,
     exponential_rule,
 )
-from spiralid.optim.spiral import SpiralResult, SpiralSearch, minimize
+from spiralid.optim.spiral import RULES, SpiralResult, SpiralSearch, minimize
 
 __all__ = [
+    "RULES",
     "ConstantSpiral",
     "ExponentialSpiral",
     "LinearSpiral",

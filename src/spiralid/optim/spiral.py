@@ -35,7 +35,7 @@ from spiralid.optim.rules import (
     SpiralRule,
 )
 
-__all__ = ["SpiralResult", "SpiralSearch", "minimize"]
+__all__ = ["RULES", "SpiralResult", "SpiralSearch", "minimize"]
 
 # Every stop message comes from here, so `message` is always one of these
 # (plus the notes below).
@@ -56,6 +56,9 @@ _NOTES = {
 }
 
 _METHODS = {"sda": ConstantSpiral, "ebsda": ExponentialSpiral, "lasda": LinearSpiral}
+# The one list of rule names: minimize() accepts them, and
+# spiralid.sysid.identify() offers each as an identification method.
+RULES = _METHODS
 _POLICIES = ("none", "clip", "reflect")
 
 
@@ -150,9 +153,9 @@ def _parse_method(method) -> SpiralRule:
         return method
     if isinstance(method, str) and method.lower() in _METHODS:
         return _METHODS[method.lower()]()
+    names = ", ".join(repr(name) for name in _METHODS)
     raise ValueError(
-        f"`method` must be 'sda', 'ebsda', 'lasda' or a SpiralRule instance; "
-        f"got {method!r}"
+        f"`method` must be {names} or a SpiralRule instance; got {method!r}"
     )
 
 

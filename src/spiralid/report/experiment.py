@@ -20,6 +20,7 @@ import numpy as np
 from scipy import stats
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
+from spiralid.sysid.estimators import search_options
 from spiralid.sysid.validate import Validation, fit_percent, validate
 
 __all__ = [
@@ -35,13 +36,18 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Configuration:
-    """One arm of the comparison: an optimiser, what it searches, the gain."""
+    """One arm of the comparison: an optimiser, what it searches, the gain.
+
+    ``safe_start`` None takes the method's default (off for the paper's
+    methods, see :mod:`spiralid.sysid.estimators`).
+    """
 
     label: str
     method: str
     parametrization: str = "coefficients"
     gain_scale: float = 1.0
     refine: bool = False
+    safe_start: bool | None = None
 
 
 # The paper's comparison first (raw coefficients with the stability penalty),
@@ -95,6 +101,9 @@ class Run:
             "gain": self.model.gain,
             "theta": self.model.theta.tolist(),
             "stable": bool(self.model.is_stable),
+            "max_pole_radius": self.model.max_pole_radius,
+            "status": getattr(res, "status", None),
+            "refine_status": getattr(refined, "status", None),
             "nfev": getattr(res, "nfev", None),
             "nit": getattr(res, "nit", None),
             "message": getattr(res, "message", None),
@@ -254,6 +263,7 @@ def _run_one(job) -> tuple[str, int, IdentifiedModel, np.ndarray]:
         initial=initial,
         parametrization=config.parametrization,
         refine=config.refine,
+        safe_start=config.safe_start,
         gain=gain * config.gain_scale,
         rng=seed,
         callback=clock,
@@ -288,8 +298,8 @@ def reproduce(
         Seeds of the spiral runs (an int ``n`` means ``0..n-1``).
     max_nfev : int, default 20000
         Budget of cost evaluations of every search run, the same for all so
-        that the algorithms compare at equal cost. ``max_iter`` is set high
-        enough never to stop a run first.
+        that the algorithms compare at equal cost; no iteration cap stops a
+        run first (:func:`spiralid.sysid.estimators.search_options`).
     n_points : int, default 50
         Search points ``m``.
     arx : ARX, default ARX(8, 8, 0)
@@ -342,11 +352,7 @@ def reproduce(
     est, val = data.split(fraction)
     arx.check_length(est, "data")
     gain = PaperCost(arx, est, predictor="simulation", initial=initial).w
-    options = {
-        "n_points": n_points,
-        "max_nfev": max_nfev,
-        "max_iter": 10 * max_nfev,
-    }
+    options = search_options({"n_points": n_points, "max_nfev": max_nfev})
     jobs = [
         (config, seed, est, arx, options, gain, initial)
         for seed in seed_list

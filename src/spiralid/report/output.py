@@ -126,6 +126,7 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
                 "parametrization": c.parametrization,
                 "gain_scale": c.gain_scale,
                 "refine": c.refine,
+                "safe_start": c.safe_start,
             }
             for c in rep.configurations
         ],
@@ -152,16 +153,12 @@ def _penalty(rep: Reproduction) -> float:
 
 
 def _rules() -> dict:
-    """The radius and angle rules' constants (SDA, eq. (7)-(8), linear)."""
+    """The radius and angle rules' constants (SDA, eq. (7)-(8), linear...)."""
     from dataclasses import asdict
 
-    from spiralid.optim.rules import ConstantSpiral, ExponentialSpiral, LinearSpiral
+    from spiralid.optim import RULES
 
-    return {
-        "sda": asdict(ConstantSpiral()),
-        "ebsda": asdict(ExponentialSpiral()),
-        "lasda": asdict(LinearSpiral()),
-    }
+    return {name: asdict(rule()) for name, rule in RULES.items()}
 
 
 def _bounds(rep: Reproduction) -> dict:

@@ -1,0 +1,416 @@
+"""Estimators: one function per method, chosen by name from :data:`METHODS`.
+
+As ``scipy.optimize`` has one ``_minimize_<method>`` per method,
+:func:`~spiralid.sysid.identify` checks its arguments, gathers them in a
+:class:`Problem` and calls ``METHODS[method].estimate(problem, **options)``.
+Every estimator returns an :class:`EstimatorResult`, an ``OptimizeResult``
+whose ``x`` is the ARX theta.
+
+Methods
+-------
+``"sda"``, ``"ebsda"``, ``"lasda"`` (and every other rule in
+:data:`spiralid.optim.RULES`)
+    The spiral optimisers of :func:`spiralid.optim.minimize` over the
+    paper's cost :class:`~spiralid.sysid.PaperCost` (eq. (2)-(3)), in a
+    parametrisation of :mod:`spiralid.sysid.parametrizations`.
+``"de"``
+    SciPy's differential evolution over the same cost, box and initial
+    points (:func:`spiralid.optim.differential_evolution`), a baseline.
+``"ls"``
+    Least squares, the exact minimiser of the one-step error.
+``"oe"``
+    Output error (:mod:`spiralid.sysid.outputerror`): Levenberg-Marquardt on
+    the simulation error from the least-squares and the Steiglitz-McBride
+    starts, keeping the lower estimation cost.
+
+Budget
+------
+:func:`search_options` is the one budget rule (``identify``, the command
+line and ``spiralid reproduce`` use it): a budget of evaluations
+``max_nfev`` is the stop; without an explicit ``max_iter`` the iteration
+cap is set to ``max_nfev``, which never binds first (every iteration costs
+at least one evaluation). Without ``max_nfev`` the optimiser's own
+``max_iter`` default (500) applies.
+
+Safe start
+----------
+With ``safe_start=True`` a search's first population holds the stabilised
+least-squares estimate and the zero model (mapped into the searched
+coordinates and clipped into the box), and ``refine`` polishes from the
+least-squares and Steiglitz-McBride starts too, beside the search's best.
+The centre of a spiral search and the best member of DE never get worse,
+and a polish is kept only if it lowers the cost, so the result costs no
+more than either model (when the box holds them, as the default boxes
+do). The paper's configurations leave it off (``Method.safe_start=False``
+for ``sda``, ``ebsda``, ``lasda`` and ``de``): their first populations are
+the paper's, so their numbers per seed stay as printed. A method added for
+usable models turns it on in its table entry.
+
+Status
+------
+``status`` is a key of :data:`STATUS`: ``1`` when the estimator stopped at
+its evaluation cap (a search's ``max_nfev``; the Levenberg-Marquardt polish
+of ``"oe"`` and ``refine`` at ``least_squares``' ``max_nfev``, before its
+tolerances were met), ``2`` at an iteration cap, ``0`` otherwise. The polish
+of ``refine`` is in ``result.refine`` with its own status.
+
+Adding a method
+---------------
+Write ``_estimate_<name>(problem, **options) -> EstimatorResult`` here (or
+in a module of its own that this one imports): a population search builds
+on :func:`_search` with its optimiser, which gives it the parametrisation,
+the box, the initial points, the safe start, the status and ``refine``.
+Then add one entry to :data:`METHODS`::
+
+    METHODS["name"] = Method(_estimate_name, search=True, safe_start=True,
+                             summary="...")
+
+``identify(method=...)``, the command line's ``--method`` choices and
+``spiralid reproduce``'s configurations read that table; nothing else lists
+methods. :data:`DEFAULT_METHOD` is the default of ``identify`` and of
+``spiralid identify``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+from scipy import optimize
+
+from spiralid.optim import RULES, differential_evolution, minimize
+
+from .arx import ARX, arx_least_squares
+from .cost import PaperCost
+from .data import IOData
+from .outputerror import local_polish, steiglitz_mcbride
+from .parametrizations import Parametrization
+
+__all__ = [
+    "DEFAULT_METHOD",
+    "METHODS",
+    "STATUS",
+    "EstimatorResult",
+    "Method",
+    "Problem",
+    "search_options",
+]
+
+STATUS = {
+    0: "Finished: exact, converged, or stopped by the target or the callback.",
+    1: "Stopped at the evaluation cap (max_nfev).",
+    2: "Stopped at the iteration cap (max_iter).",
+}
+
+
+class EstimatorResult(optimize.OptimizeResult):
+    """What every estimator returns; behaves like ``scipy.optimize.OptimizeResult``.
+
+    Attributes
+    ----------
+    x : ndarray, shape (p,)
+        The ARX theta ``[a_1..a_na, b_0..b_(nb-1)]``.
+    fun : float
+        Its cost on the estimation data (eq. (2)-(3), the problem's predictor).
+    status : int
+        A key of :data:`STATUS` (``1``: stopped at the evaluation cap).
+    success : bool
+        As the underlying optimiser says (a search that used its budget
+        succeeded).
+    message : str
+        Why it stopped.
+    nfev, nit : int
+        Cost evaluations and iterations (the kept start's, for ``"oe"``).
+    history : ndarray or None
+        Best cost after each iteration of a search (index 0: the initial
+        population).
+    elapsed : float
+        Seconds (the search alone, without ``refine``).
+    x_search : ndarray, optional
+        A search's best point in its searched coordinates.
+    bounds : ndarray, optional
+        A search's box, in its searched coordinates.
+    safe_start : bool, optional
+        Whether a search's first population held the safe start.
+    start : str, optional
+        Which start a polish kept (``"ls"``, ``"steiglitz-mcbride"``,
+        ``"search"``); ``starts`` gives each start's cost.
+    refine : EstimatorResult or None
+        The polish of ``refine=True``; ``refine.accepted`` says whether it
+        lowered the cost (otherwise ``x`` is the search's).
+    raw : object
+        The underlying optimiser's own result.
+    """
+
+
+@dataclass
+class Problem:
+    """Everything an estimator needs, checked by :func:`identify`."""
+
+    data: IOData
+    arx: ARX
+    cost: PaperCost
+    predictor: str
+    initial: str
+    gain: str | float
+    penalty: float
+    parametrization: Parametrization
+    rng: np.random.Generator
+    bounds: np.ndarray | None = None
+    refine: bool = False
+    safe_start: bool = False
+
+    def simulation_cost(self) -> PaperCost:
+        """The simulation cost output error minimises, whatever `predictor`."""
+        if self.predictor == "simulation":
+            return self.cost
+        return PaperCost(
+            self.arx,
+            self.data,
+            gain=self.gain,
+            penalty=self.penalty,
+            initial=self.initial,
+        )
+
+
+@dataclass(frozen=True)
+class Method:
+    """One entry of :data:`METHODS`.
+
+    Attributes
+    ----------
+    estimate : callable
+        ``estimate(problem, **options) -> EstimatorResult``.
+    search : bool
+        A population search over a parametrisation: takes optimiser options,
+        ``rng``, ``bounds``, ``refine`` and ``safe_start``.
+    options : tuple of str or None
+        The optimiser options it accepts; None: any of
+        :func:`spiralid.optim.minimize`'s.
+    safe_start : bool
+        Default of ``identify(safe_start=None)`` (see the module docstring).
+    summary : str
+        One line for help texts.
+    """
+
+    estimate: Callable[..., EstimatorResult]
+    search: bool = True
+    options: tuple[str, ...] | None = None
+    safe_start: bool = False
+    summary: str = ""
+
+
+def search_options(options: dict) -> dict:
+    """The one budget rule: `options` with the iteration cap a budget implies.
+
+    Examples
+    --------
+    >>> search_options({"n_points": 50, "max_nfev": 20_000})
+    {'n_points': 50, 'max_nfev': 20000, 'max_iter': 20000}
+    >>> search_options({"max_nfev": 1000, "max_iter": 10})   # both given: kept
+    {'max_nfev': 1000, 'max_iter': 10}
+    """
+    out = dict(options)
+    if out.get("max_nfev") is not None and out.get("max_iter") is None:
+        # Every iteration costs at least one evaluation: this cap never
+        # stops a run before its budget does.
+        out["max_iter"] = out["max_nfev"]
+    return out
+
+
+# -- least squares and output error ---------------------------------------------
+
+
+def _estimate_ls(problem: Problem) -> EstimatorResult:
+    t0 = time.perf_counter()
+    theta = arx_least_squares(problem.data, problem.arx)
+    return EstimatorResult(
+        x=theta,
+        fun=float(problem.cost(theta)),
+        status=0,
+        success=True,
+        message="Least-squares solution (exact minimiser of the one-step error).",
+        nfev=0,
+        nit=0,
+        history=None,
+        elapsed=time.perf_counter() - t0,
+        raw=None,
+    )
+
+
+def _polish(
+    problem: Problem, starts: dict[str, np.ndarray], predictor: str, cost: PaperCost
+) -> EstimatorResult:
+    """Levenberg-Marquardt from every start; keep the lowest `cost` (ties:
+    the first start). The simulation error is not convex, so each start may
+    stop in a different local minimum; the choice is on the estimation cost,
+    never on validation data."""
+    t0 = time.perf_counter()
+    best = None
+    costs = {}
+    for name, start in starts.items():
+        theta, res = local_polish(
+            start, problem.arx, problem.data, predictor, problem.initial
+        )
+        costs[name] = float(cost(theta))
+        if best is None or costs[name] < best[0]:
+            best = (costs[name], name, theta, res)
+    _, name, theta, res = best
+    res.start = name
+    capped = res.status == 0  # least_squares: max_nfev reached
+    return EstimatorResult(
+        x=theta,
+        fun=float(problem.cost(theta)),
+        status=1 if capped else 0,
+        success=bool(res.success),
+        message=(
+            f"Stopped at the evaluation cap (max_nfev = {res.max_nfev}) before "
+            "the tolerances were met."
+            if capped
+            else res.message
+        ),
+        nfev=int(res.nfev),
+        nit=None,
+        history=None,
+        elapsed=time.perf_counter() - t0,
+        start=name,
+        starts=costs,
+        raw=res,
+    )
+
+
+def _standard_starts(problem: Problem) -> dict[str, np.ndarray]:
+    theta_ls = problem.parametrization.theta_ls
+    return {
+        "ls": theta_ls,
+        "steiglitz-mcbride": steiglitz_mcbride(problem.data, problem.arx, theta_ls),
+    }
+
+
+def _estimate_oe(problem: Problem) -> EstimatorResult:
+    # With a one-step `predictor` the selection is still on the simulation
+    # error OE minimises, not on the reported cost.
+    return _polish(
+        problem, _standard_starts(problem), "simulation", problem.simulation_cost()
+    )
+
+
+# -- population searches -----------------------------------------------------------
+
+
+def _safe_start_points(problem: Problem, box: np.ndarray) -> np.ndarray:
+    """The stabilised least-squares estimate and the zero model, searched
+    coordinates, clipped into the box."""
+    par = problem.parametrization
+    models = (par.theta_ls, np.zeros(problem.arx.n_params))
+    points = np.array([par.from_theta(theta) for theta in models])
+    return np.clip(points, box[:, 0], box[:, 1])
+
+
+def _search(
+    problem: Problem,
+    optimiser: Callable,
+    options: dict,
+    per_iteration: Callable[[int], int],
+) -> EstimatorResult:
+    """A population search over the problem's parametrisation.
+
+    ``optimiser(fun, box, x0=..., **options)`` runs it;
+    ``per_iteration(n_points)`` is its evaluations per iteration (for the
+    status).
+    """
+    t0 = time.perf_counter()
+    par = problem.parametrization
+    box = par.default_bounds() if problem.bounds is None else problem.bounds
+    options = search_options(options)
+    m = int(options.get("n_points", 50))
+    seeds = _safe_start_points(problem, box) if problem.safe_start else None
+    x0 = options.pop("x0", None)
+    if x0 is None:
+        n_seeds = 0 if seeds is None else seeds.shape[0]
+        drawn = par.initial_points(box, m - n_seeds, problem.rng)
+        parts = [p for p in (seeds, drawn) if p is not None]
+        x0 = np.concatenate(parts) if parts else None
+    elif seeds is not None:
+        x0 = np.concatenate([seeds, np.atleast_2d(np.asarray(x0, dtype=float))])
+    raw = optimiser(par.objective(problem.cost), box, x0=x0, **options)
+    theta = par.to_theta(raw.x)
+    nit, nfev = int(raw.nit), int(raw.nfev)
+    if nit >= options.get("max_iter", 500):
+        status = 2
+    elif options.get("max_nfev") is not None and (
+        nfev + per_iteration(m) > options["max_nfev"]
+    ):
+        status = 1
+    else:
+        status = 0
+    history = getattr(raw, "history", None)
+    result = EstimatorResult(
+        x=theta,
+        fun=float(problem.cost(theta)),
+        status=status,
+        success=bool(raw.success),
+        message=str(raw.message),
+        nfev=nfev,
+        nit=nit,
+        history=None if history is None else np.asarray(history, dtype=float),
+        elapsed=time.perf_counter() - t0,
+        x_search=np.asarray(raw.x, dtype=float),
+        bounds=box,
+        safe_start=problem.safe_start,
+        refine=None,
+        raw=raw,
+    )
+    if problem.refine:
+        _refine(problem, result)
+    return result
+
+
+def _refine(problem: Problem, result: EstimatorResult) -> None:
+    """Polish the search's best locally; keep it only if it lowers the cost."""
+    starts = {"search": result.x}
+    if problem.safe_start:
+        starts.update(_standard_starts(problem))
+    polished = _polish(problem, starts, problem.predictor, problem.cost)
+    polished.accepted = bool(polished.fun <= result.fun)
+    if polished.accepted:
+        result.x, result.fun = polished.x, polished.fun
+    result.refine = polished
+
+
+def _estimate_spiral(problem: Problem, *, rule: str, **options) -> EstimatorResult:
+    def run(fun, box, **opts):
+        return minimize(fun, box, method=rule, rng=problem.rng, vectorized=True, **opts)
+
+    return _search(problem, run, options, per_iteration=lambda m: m - 1)
+
+
+def _estimate_de(problem: Problem, **options) -> EstimatorResult:
+    def run(fun, box, **opts):
+        return differential_evolution(fun, box, rng=problem.rng, **opts)
+
+    return _search(problem, run, options, per_iteration=lambda m: m)
+
+
+# One entry per method; its key is the name users pass.
+METHODS: dict[str, Method] = {
+    **{
+        name: Method(
+            partial(_estimate_spiral, rule=name),
+            summary=f"spiral search with the {rule.__name__} rule",
+        )
+        for name, rule in RULES.items()
+    },
+    "de": Method(
+        _estimate_de,
+        options=("n_points", "max_iter", "max_nfev", "x0", "callback"),
+        summary="SciPy's differential evolution (baseline)",
+    ),
+    "ls": Method(_estimate_ls, search=False, summary="least squares"),
+    "oe": Method(_estimate_oe, search=False, summary="output error"),
+}
+
+DEFAULT_METHOD = "ebsda"

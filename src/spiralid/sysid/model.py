@@ -1,0 +1,239 @@
+"""The result of an identification: :class:`IdentifiedModel`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy import signal
+
+from .arx import ARX
+from .cost import INITIAL_CONDITIONS
+from .data import IOData
+from .polynomials import max_pole_radius
+
+__all__ = ["IdentifiedModel"]
+
+
+@dataclass(eq=False)
+class IdentifiedModel:
+    """An estimated ARX model with how it was obtained.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (p,)
+        ``[a_1..a_na, b_0..b_(nb-1)]``.
+    arx : ARX
+        The structure.
+    ts : float
+        Sample time in seconds.
+    method, predictor, parametrization : str
+        How it was estimated (``predictor`` is the one the cost uses).
+    initial : {"rest", "measured"}
+        Initial condition of the cost's simulation (see :class:`PaperCost`).
+        :meth:`from_dict` reads a dict without it (saved before the option
+        existed) as ``"measured"``, the rule that produced it.
+    gain : float
+        The cost's gain ``w``.
+    penalty : float
+        The cost's stability penalty.
+    cost : float
+        The paper's cost, eq. (2)-(3), of ``theta`` on the estimation data.
+    result : EstimatorResult or None
+        What the estimator returned
+        (:class:`~spiralid.sysid.estimators.EstimatorResult`, an
+        ``OptimizeResult`` whose ``x`` is ``theta``; ``status`` says whether
+        it stopped at an evaluation cap, ``start`` which start ``"oe"`` kept);
+        ``None`` after :meth:`from_dict`.
+    refine_result : EstimatorResult or None
+        The local polish's result when ``refine=True`` (``result.refine``).
+    history : ndarray or None
+        Best cost after each iteration of the spiral search.
+    timings : dict
+        Wall times in seconds: ``"search"``, ``"refine"``, ``"total"``.
+    bounds : ndarray or None, shape (p, 2)
+        The search box of a spiral method (in the searched parameters).
+    """
+
+    theta: np.ndarray
+    arx: ARX
+    ts: float
+    method: str
+    predictor: str = "simulation"
+    parametrization: str = "coefficients"
+    gain: float = float("nan")
+    penalty: float = 1e6
+    cost: float = float("nan")
+    result: Any = None
+    refine_result: Any = None
+    history: np.ndarray | None = None
+    timings: dict = field(default_factory=dict)
+    bounds: np.ndarray | None = None
+    input_name: str = "u"
+    output_name: str = "y"
+    # Last, so positional construction keeps its meaning.
+    initial: str = "rest"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
+            raise ValueError(
+                f"`initial` must be one of {INITIAL_CONDITIONS}; got {self.initial!r}"
+            )
+        self.theta = np.asarray(self.theta, dtype=float).copy()
+        if self.theta.shape != (self.arx.n_params,):
+            raise ValueError(
+                f"`theta` must have shape ({self.arx.n_params},) for {self.arx}; "
+                f"got {self.theta.shape}"
+            )
+        if not np.all(np.isfinite(self.theta)):
+            bad = int(np.flatnonzero(~np.isfinite(self.theta))[0])
+            raise ValueError(
+                f"`theta` must be finite; got {self.theta[bad]!r} at index {bad}"
+            )
+
+    # -- model behaviour ---------------------------------------------------------
+
+    def simulate(self, u) -> np.ndarray:
+        """Free-run output from zero initial conditions (``IOData`` gives its u)."""
+        return self.arx.simulate(self.theta, u)
+
+    def predict(self, data: IOData) -> np.ndarray:
+        """One-step-ahead prediction on `data`."""
+        return self.arx.predict(self.theta, data)
+
+    @property
+    def polynomials(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(num, den)`` in ``z^-1``, equal lengths (see ``ARX.polynomials``)."""
+        return self.arx.polynomials(self.theta)
+
+    @property
+    def poles(self) -> np.ndarray:
+        return self.arx.poles(self.theta)
+
+    @property
+    def zeros(self) -> np.ndarray:
+        return self.arx.zeros(self.theta)
+
+    @property
+    def is_stable(self) -> bool:
+        """Every pole strictly inside the unit circle: spiralid's one
+        stability verdict (see :mod:`spiralid.sysid.polynomials`)."""
+        return bool(self.arx.is_stable(self.theta))
+
+    @property
+    def max_pole_radius(self) -> float:
+        """Largest ``|pole|``, on the verdict's side of the unit circle
+        (:func:`~spiralid.sysid.polynomials.max_pole_radius`)."""
+        return float(max_pole_radius(self.theta[: self.arx.na]))
+
+    def tf_string(self, digits: int = 4) -> str:
+        """Transfer function in z as eq. (9)-(10) print it."""
+        return self.arx.tf_string(self.theta, digits=digits)
+
+    def to_dlti(self) -> signal.dlti:
+        """The model as a ``scipy.signal.dlti`` transfer function with ``dt = ts``."""
+        num, den = self.polynomials
+        # Leading zeros (nk > 0) are exact in positive powers of z; dropping
+        # them avoids SciPy's "badly conditioned" warning.
+        nz = np.flatnonzero(num)
+        num = num[nz[0] :] if nz.size else num[-1:]
+        return signal.dlti(num, den, dt=self.ts)
+
+    # -- serialisation -----------------------------------------------------------
+
+    def to_dict(self) -> dict:
+        """A JSON-safe summary (the optimiser result is reduced to its history)."""
+        summary = _summary(self.result)
+        if summary is not None and self.refine_result is not None:
+            summary["refine"] = _summary(self.refine_result)
+        return {
+            "theta": [float(v) for v in self.theta],
+            "na": self.arx.na,
+            "nb": self.arx.nb,
+            "nk": self.arx.nk,
+            "ts": float(self.ts),
+            "method": self.method,
+            "predictor": self.predictor,
+            "parametrization": self.parametrization,
+            "initial": self.initial,
+            "gain": float(self.gain),
+            "penalty": float(self.penalty),
+            "cost": float(self.cost),
+            "history": None
+            if self.history is None
+            else [float(v) for v in self.history],
+            "timings": {k: float(v) for k, v in self.timings.items()},
+            "bounds": None if self.bounds is None else np.asarray(self.bounds).tolist(),
+            "input_name": self.input_name,
+            "output_name": self.output_name,
+            "result": summary,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> IdentifiedModel:
+        """Rebuild from :meth:`to_dict` output (``result`` is not restored)."""
+        try:
+            arx = ARX(d["na"], d["nb"], d["nk"])
+            return cls(
+                theta=np.asarray(d["theta"], dtype=float),
+                arx=arx,
+                ts=float(d["ts"]),
+                method=d["method"],
+                predictor=d.get("predictor", "simulation"),
+                parametrization=d.get("parametrization", "coefficients"),
+                # Dicts saved before `initial` existed came from the
+                # measured-past rule, which was then the only one.
+                initial=d.get("initial", "measured"),
+                gain=float(d.get("gain", float("nan"))),
+                penalty=float(d.get("penalty", 1e6)),
+                cost=float(d.get("cost", float("nan"))),
+                history=None if d.get("history") is None else np.asarray(d["history"]),
+                timings=dict(d.get("timings", {})),
+                bounds=None if d.get("bounds") is None else np.asarray(d["bounds"]),
+                input_name=d.get("input_name", "u"),
+                output_name=d.get("output_name", "y"),
+            )
+        except KeyError as exc:
+            raise ValueError(f"`d` must contain the key {exc.args[0]!r}") from None
+
+    def __repr__(self) -> str:
+        return (
+            f"IdentifiedModel({self.arx}, method={self.method!r}, "
+            f"predictor={self.predictor!r}, initial={self.initial!r}, "
+            f"cost={self.cost:.6g}, "
+            f"stable={self.is_stable})"
+        )
+
+
+_SUMMARY_KEYS = (
+    "fun",
+    "nit",
+    "nfev",
+    "status",
+    "success",
+    "message",
+    "start",
+    "safe_start",
+    "accepted",
+)
+
+
+def _summary(res) -> dict | None:
+    """The scalars of an optimiser result (a residual vector would bloat a
+    saved model by a record's worth of numbers)."""
+    if res is None:
+        return None
+    return {
+        k: _jsonable(getattr(res, k))
+        for k in _SUMMARY_KEYS
+        if hasattr(res, k) and np.ndim(getattr(res, k)) == 0
+    }
+
+
+def _jsonable(v):
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, np.generic):
+        return v.item()
+    return v

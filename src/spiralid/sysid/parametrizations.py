@@ -1,0 +1,271 @@
+"""What a population search moves: parametrisations of an ARX model.
+
+A parametrisation maps the searched coordinates ``x`` to the ARX parameter
+vector ``theta = [a_1..a_na, b_0..b_(nb-1)]`` that the cost, the model and
+every result hold. Each one knows its default search box, its stable initial
+points, its map to theta and back (the back map seeds a search with a known
+model, see the safe start in :mod:`spiralid.sysid.estimators`).
+
+``"coefficients"`` (paper-faithful, DESIGN.md item 12)
+    ``x = theta``: the optimiser moves the raw coefficients and unstable
+    candidates pay the penalty of eq. (3). The initial denominators are
+    drawn uniformly in reflection coefficients and mapped by the step-up
+    recursion, so every initial point is stable ("feasible").
+``"reflection"`` (DESIGN.md item 13)
+    ``x = [k_1..k_na, b]``; each ``k`` is folded into ``(-1, 1)``
+    (:func:`~spiralid.sysid.polynomials.fold_reflection`, clipped to
+    ``KMAX = 1 - 1e-6``) and mapped by step-up, so every candidate is stable
+    and the penalty never fires. The initial points are uniform in the box.
+
+Default box: ``|a_i| <= binom(na, i)`` (every stable monic polynomial of
+degree na lies in that box, so it loses no stable model), ``k_i`` in
+``[-1, 1]``, and ``|b_j| <= s`` with ``s = 2 max_j |b_j^LS|`` scaled from
+the least-squares estimate (``2 rms(y) / rms(u)`` if that is zero). The RMS
+ratio alone is a poor scale for a sparse input: for the simulated rig's
+bang-bang record it is 567 while the largest LS numerator coefficient is 43.
+
+Adding a parametrisation
+------------------------
+Subclass :class:`Parametrization` in this module, set ``name``, implement
+:meth:`~Parametrization.default_bounds`, :meth:`~Parametrization.to_theta`
+and :meth:`~Parametrization.from_theta` (override
+:meth:`~Parametrization.initial_points` for stable initial points and
+:meth:`~Parametrization.objective` when the cost of a population can be
+computed faster than ``cost(to_theta(x))``), and add one entry to
+:data:`PARAMETRIZATIONS`. ``identify(parametrization=...)``, the command
+line's ``--parametrization`` choices and ``default_bounds`` read that table;
+nothing else lists parametrisations. Heavy mathematics (a modal map,
+variable projection) can live in a module of its own that this one imports.
+"""
+
+from __future__ import annotations
+
+from math import comb
+from typing import ClassVar
+
+import numpy as np
+
+from .arx import ARX, arx_least_squares
+from .data import IOData
+from .polynomials import fold_reflection, step_down, step_up
+
+__all__ = [
+    "KMAX",
+    "PARAMETRIZATIONS",
+    "Coefficients",
+    "Parametrization",
+    "Reflection",
+    "default_bounds",
+    "feasible_initial_points",
+    "make_parametrization",
+    "stabilise",
+]
+
+# Largest |k| of a stable-by-construction denominator: reflection search,
+# output error and the stabilised least-squares start.
+KMAX = 1.0 - 1e-6
+
+
+class Parametrization:
+    """Searched coordinates ``x`` of an ARX model on one record.
+
+    Parameters
+    ----------
+    data : IOData
+        The estimation record (scales the default numerator box).
+    arx : ARX
+        The model structure.
+
+    Attributes
+    ----------
+    name : str
+        Its key in :data:`PARAMETRIZATIONS`.
+    n_search : int
+        Number of searched coordinates (``arx.n_params`` unless a
+        parametrisation solves for some of theta itself).
+    """
+
+    name: ClassVar[str] = ""
+
+    def __init__(self, data: IOData, arx: ARX):
+        self.data = data
+        self.arx = arx
+        self._theta_ls: np.ndarray | None = None
+
+    @property
+    def n_search(self) -> int:
+        return self.arx.n_params
+
+    @property
+    def theta_ls(self) -> np.ndarray:
+        """The least-squares estimate (computed once)."""
+        if self._theta_ls is None:
+            self._theta_ls = arx_least_squares(self.data, self.arx)
+        return self._theta_ls
+
+    def numerator_scale(self) -> float:
+        """``s = 2 max |b^LS|`` (``2 rms(y) / rms(u)`` if that is zero)."""
+        s = 2.0 * float(np.max(np.abs(self.theta_ls[self.arx.na :])))
+        if s == 0.0:
+            # An exactly zero estimate gives no scale: fall back to the RMS ratio.
+            y, u = self.data.y, self.data.u
+            s = 2.0 * float(np.sqrt(np.mean(y**2) / np.mean(u**2)))
+        return s
+
+    def default_bounds(self) -> np.ndarray:
+        """The default search box, shape ``(n_search, 2)``."""
+        raise NotImplementedError
+
+    def initial_points(self, box: np.ndarray, m: int, rng) -> np.ndarray | None:
+        """``m`` initial points in `box`, or None to let the optimiser draw
+        them uniformly in the box."""
+        return None
+
+    def to_theta(self, x) -> np.ndarray:
+        """Searched ``x`` -> ARX theta; ``(m, n_search)`` gives ``(m, p)``,
+        a 1-D ``x`` a 1-D theta."""
+        raise NotImplementedError
+
+    def from_theta(self, theta) -> np.ndarray:
+        """ARX theta -> searched ``x`` with ``to_theta(x) == theta`` (up to
+        rounding) for a stable theta; an unstable one is stabilised first."""
+        raise NotImplementedError
+
+    def objective(self, cost):
+        """The searched function: the cost of a population ``x`` (m, n_search)."""
+
+        def fun(x):
+            return cost(self.to_theta(x))
+
+        return fun
+
+
+class Coefficients(Parametrization):
+    """``x = theta``, the paper's search (see the module docstring)."""
+
+    name = "coefficients"
+
+    def default_bounds(self) -> np.ndarray:
+        na = self.arx.na
+        box = np.empty((self.arx.n_params, 2))
+        for i in range(na):
+            half = float(comb(na, i + 1))
+            box[i] = (-half, half)
+        s = self.numerator_scale()
+        box[na:] = (-s, s)
+        return box
+
+    def initial_points(self, box: np.ndarray, m: int, rng) -> np.ndarray:
+        return feasible_initial_points(box, self.arx, m, rng)
+
+    def to_theta(self, x) -> np.ndarray:
+        return np.asarray(x, dtype=float)
+
+    def from_theta(self, theta) -> np.ndarray:
+        th = np.asarray(theta, dtype=float)
+        na = self.arx.na
+        return np.r_[step_up(stabilise(th, self.arx)[:na]), th[na:]]
+
+    def objective(self, cost):
+        # The cost itself: no per-call copy of the population.
+        return cost
+
+
+class Reflection(Parametrization):
+    """``x = [k, b]``, stable by construction (see the module docstring)."""
+
+    name = "reflection"
+
+    def default_bounds(self) -> np.ndarray:
+        na = self.arx.na
+        box = np.empty((self.arx.n_params, 2))
+        box[:na] = (-1.0, 1.0)
+        s = self.numerator_scale()
+        box[na:] = (-s, s)
+        return box
+
+    def to_theta(self, x) -> np.ndarray:
+        xx = np.asarray(x, dtype=float)
+        x2 = np.atleast_2d(xx)
+        na = self.arx.na
+        a = step_up(fold_reflection(x2[:, :na], KMAX))
+        theta = np.concatenate([a, x2[:, na:]], axis=1)
+        return theta[0] if xx.ndim == 1 else theta
+
+    def from_theta(self, theta) -> np.ndarray:
+        return stabilise(np.asarray(theta, dtype=float), self.arx)
+
+
+# One entry per parametrisation; its key is the name users pass.
+PARAMETRIZATIONS: dict[str, type[Parametrization]] = {
+    Coefficients.name: Coefficients,
+    Reflection.name: Reflection,
+}
+
+
+def make_parametrization(name, data: IOData, arx: ARX) -> Parametrization:
+    """The parametrisation called `name` on this record and structure."""
+    if not isinstance(name, str) or name not in PARAMETRIZATIONS:
+        raise ValueError(
+            f"`parametrization` must be one of {tuple(PARAMETRIZATIONS)}; got {name!r}"
+        )
+    return PARAMETRIZATIONS[name](data, arx)
+
+
+def default_bounds(
+    data: IOData, arx: ARX, parametrization: str = "coefficients"
+) -> np.ndarray:
+    """The default search box, shape (p, 2) (see the module docstring).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.signal import lfilter
+    >>> u = np.random.default_rng(0).standard_normal(200)
+    >>> y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    >>> default_bounds(IOData(u, y, ts=1.0), ARX(2, 2, 1))[:2]
+    array([[-2.,  2.],
+           [-1.,  1.]])
+    """
+    return make_parametrization(parametrization, data, arx).default_bounds()
+
+
+def feasible_initial_points(box: np.ndarray, arx: ARX, m: int, rng=None) -> np.ndarray:
+    """``m`` initial points "in the feasible region" (DESIGN.md item 12).
+
+    Denominators: reflection coefficients uniform in (-1, 1) mapped by
+    step-up, so every point is stable (a uniform draw in the coefficient box
+    almost never is for na = 8); numerators uniform in their box.
+
+    Returns
+    -------
+    ndarray, shape (m, p)
+    """
+    gen = np.random.default_rng(rng)
+    na = arx.na
+    k = gen.uniform(-1.0, 1.0, size=(m, na))
+    b = gen.uniform(box[na:, 0], box[na:, 1], size=(m, arx.nb))
+    return np.clip(np.concatenate([step_up(k), b], axis=1), box[:, 0], box[:, 1])
+
+
+def stabilise(theta: np.ndarray, arx: ARX) -> np.ndarray:
+    """Reflect poles with ``|z| >= 1`` into the unit circle; return ``[k, b]``.
+
+    A pole ``z`` outside goes to ``1 / conj(z)``; one on the circle is
+    pulled just inside; every ``|k|`` is then at most :data:`KMAX`.
+    """
+    na = arx.na
+    a, b = theta[:na], theta[na:]
+    if na == 0:
+        return theta.copy()
+    if not arx.is_stable(theta):
+        roots = np.roots(np.r_[1.0, a])
+        mag = np.abs(roots)
+        out = mag >= 1.0
+        roots[out] = 1.0 / np.conj(roots[out])
+        # A root on the circle reflects onto itself: pull it just inside.
+        roots = np.where(np.abs(roots) >= KMAX, roots * KMAX / np.abs(roots), roots)
+        a = np.real(np.poly(roots))[1:]
+    k = step_down(a)
+    k = np.clip(np.nan_to_num(k, nan=0.0), -KMAX, KMAX)
+    return np.r_[k, b]
