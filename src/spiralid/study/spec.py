@@ -265,9 +265,9 @@ def _optimizer(entry: Any, methods, where: str) -> OptimizerSpec:
 
 
 def _search_methods() -> list[str]:
-    from spiralid.sysid.identify import _SEARCH
+    from spiralid.sysid import METHODS
 
-    return list(_SEARCH)
+    return [name for name, m in METHODS.items() if m.search]
 
 
 def parse_spec(
@@ -288,7 +288,7 @@ def parse_spec(
     -------
     StudySpec
     """
-    from spiralid.sysid.identify import _PARAMETRIZATIONS
+    from spiralid.sysid import PARAMETRIZATIONS
 
     try:
         doc = tomllib.loads(text)
@@ -338,8 +338,8 @@ def parse_spec(
             grid.get("predictors", list(PREDICTORS)), PREDICTORS, where, "predictors"
         ),
         parametrizations=_names(
-            grid.get("parametrizations", list(_PARAMETRIZATIONS)),
-            _PARAMETRIZATIONS,
+            grid.get("parametrizations", list(PARAMETRIZATIONS)),
+            list(PARAMETRIZATIONS),
             where,
             "parametrizations",
         ),

@@ -140,8 +140,8 @@ def run_task(task: Task, data) -> dict:
     record scored on the validation part, the evaluations used, the wall
     time, the convergence history and the model as a dict.
     """
-    from spiralid.sysid import ARX, PaperCost, identify
-    from spiralid.sysid.validate import fit_percent
+    from spiralid.sysid import ARX, PaperCost, fit_percent, identify
+    from spiralid.sysid.estimators import search_options
 
     arx = ARX(*task.arx)
     est, _ = data.split(task.fraction)
@@ -154,10 +154,9 @@ def run_task(task: Task, data) -> dict:
             refine=task.refine,
             gain=scorer.w * task.gain_scale,
             rng=task.seed,
-            n_points=task.points,
-            max_nfev=task.budget,
-            max_iter=10 * task.budget,
-            **dict(task.options),
+            **search_options(
+                {"n_points": task.points, "max_nfev": task.budget, **dict(task.options)}
+            ),
         )
     start = time.perf_counter()
     model = identify(est, arx, method=task.method, **kwargs)
