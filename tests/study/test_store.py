@@ -19,8 +19,7 @@ ROW = {
     "nfev": 500,
     "seconds": 0.5,
     "stable": True,
-    "history": [20.0, 12.5],
-    "model": {"theta": [0.1, 0.2]},
+    "model": {"theta": [0.1, 0.2], "history": [20.0, 12.5]},
 }
 
 

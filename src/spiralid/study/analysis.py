@@ -133,7 +133,7 @@ def analyse(
             "cost": np.array([r["cost"] for r in group]),
             "fit_val": np.array([r["fit_val"] for r in group]),
             "seconds": np.array([r["seconds"] for r in group]),
-            "history": [r["history"] for r in group],
+            "history": [r["model"]["history"] for r in group],
         }
         for key, group in grouped.items()
     }

@@ -69,7 +69,7 @@ def _dask_client(scheduler: str | None, workers: int | None):
     return Client(cluster), cluster
 
 
-def _execute_dask(tasks, records, scheduler, workers):
+def _execute_dask(tasks, records, scheduler, workers, detail):
     from distributed import as_completed as dask_completed
 
     client, cluster = _dask_client(scheduler, workers)
@@ -80,7 +80,12 @@ def _execute_dask(tasks, records, scheduler, workers):
         }
         futures = {
             client.submit(
-                run_task, t, shared[t.data], key=f"spiralid-run-{t.key}", pure=False
+                run_task,
+                t,
+                shared[t.data],
+                detail,
+                key=f"spiralid-run-{t.key}",
+                pure=False,
             ): t
             for t in tasks
         }
@@ -99,9 +104,9 @@ def _outcome(fut):
         return exc
 
 
-def _execute_processes(tasks, records, workers):
+def _execute_processes(tasks, records, workers, detail):
     with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1) as pool:
-        futures = {pool.submit(run_task, t, records[t.data]): t for t in tasks}
+        futures = {pool.submit(run_task, t, records[t.data], detail): t for t in tasks}
         for fut in as_completed(futures):
             yield futures[fut], _outcome(fut)
 
@@ -113,6 +118,7 @@ def execute(
     engine: str = "dask",
     scheduler: str | None = None,
     workers: int | None = None,
+    detail: bool = False,
 ) -> Iterator[tuple[Task, dict | Exception]]:
     """Run `tasks` and yield ``(task, row)`` as each finishes.
 
@@ -128,6 +134,9 @@ def execute(
         default a ``LocalCluster`` is started and stopped.
     workers : int, optional
         Worker processes of the local cluster or pool; default the CPU count.
+    detail : bool
+        Rows also carry the model object and iteration times (see
+        :func:`~spiralid.study.run_task`).
 
     Yields
     ------
@@ -146,13 +155,13 @@ def execute(
     if not tasks:
         return
     if engine == "dask":
-        yield from _execute_dask(tasks, records, scheduler, workers)
+        yield from _execute_dask(tasks, records, scheduler, workers, detail)
     elif engine == "processes" and (workers or os.cpu_count() or 1) > 1:
-        yield from _execute_processes(tasks, records, workers)
+        yield from _execute_processes(tasks, records, workers, detail)
     else:
         for t in tasks:
             try:
-                yield t, run_task(t, records[t.data])
+                yield t, run_task(t, records[t.data], detail)
             except Exception as exc:
                 yield t, exc
 

@@ -47,7 +47,7 @@ _DATA_KEYS = {
     "arm": ("name", "kind", "ts"),
     "csv": ("name", "kind", "path", "input", "output", "ts", "detrend"),
 }
-_OPTIMIZER_KEYS = ("label", "method", "refine", "gain_scale", "options")
+_OPTIMIZER_KEYS = ("label", "method", "refine", "gain_scale", "safe_start", "options")
 _BASELINES = ("ls", "oe")
 
 
@@ -91,6 +91,7 @@ class OptimizerSpec:
     method: str
     refine: bool = False
     gain_scale: float = 1.0
+    safe_start: bool | None = None
     options: dict = field(default_factory=dict)
 
 
@@ -138,7 +139,7 @@ class StudySpec:
             "predictors": self.predictors,
             "parametrizations": self.parametrizations,
             "optimizers": [
-                (o.label, o.method, o.refine, o.gain_scale, o.options)
+                (o.label, o.method, o.refine, o.gain_scale, o.safe_start, o.options)
                 for o in self.optimizers
             ],
             "seeds": self.seeds,
@@ -253,15 +254,17 @@ def _optimizer(entry: Any, methods, where: str) -> OptimizerSpec:
     if not isinstance(label, str) or not label:
         _fail(where, f"[[optimizer]] `label` must be a non-empty string; got {label!r}")
     refine = entry.get("refine", False)
-    if not isinstance(refine, bool):
-        _fail(where, f"[[optimizer]] {label!r}: `refine` must be true or false")
+    safe_start = entry.get("safe_start")
+    for name, value in (("refine", refine), ("safe_start", safe_start)):
+        if value is not None and not isinstance(value, bool):
+            _fail(where, f"[[optimizer]] {label!r}: `{name}` must be true or false")
     scale = entry.get("gain_scale", 1.0)
     if isinstance(scale, bool) or not isinstance(scale, int | float) or scale <= 0:
         _fail(where, f"[[optimizer]] {label!r}: `gain_scale` must be a number > 0")
     options = entry.get("options", {})
     if not isinstance(options, dict):
         _fail(where, f"[[optimizer]] {label!r}: `options` must be a table")
-    return OptimizerSpec(label, method, refine, float(scale), dict(options))
+    return OptimizerSpec(label, method, refine, float(scale), safe_start, dict(options))
 
 
 def _search_methods() -> list[str]:

@@ -35,10 +35,9 @@ _COLUMNS = (
     ("nfev", "INTEGER"),
     ("seconds", "REAL"),
     ("stable", "INTEGER"),
-    ("history", "TEXT"),
     ("model", "TEXT"),
 )
-_JSON = ("history", "model")
+_JSON = ("model",)
 
 
 class StoreLockedError(ValueError):

@@ -37,6 +37,7 @@ class Task:
     seed: int | None
     refine: bool = False
     gain_scale: float = 1.0
+    safe_start: bool | None = None
     options: tuple = ()
     budget: int = 20_000
     points: int = 50
@@ -123,6 +124,7 @@ def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
                                 seed,
                                 refine=opt.refine,
                                 gain_scale=opt.gain_scale,
+                                safe_start=opt.safe_start,
                                 options=tuple(sorted(opt.options.items())),
                                 data_digest=digest,
                                 **common,
@@ -131,14 +133,17 @@ def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
     return tasks
 
 
-def run_task(task: Task, data) -> dict:
+def run_task(task: Task, data, detail: bool = False) -> dict:
     """Run one task on its record and return its row for the store.
 
     The row holds the estimation cost (the paper's eq. (2)-(3) on the
     estimation part at the reading's default gain, whatever gain the search
     used), the validation fit % of the free run from rest over the whole
     record scored on the validation part, the evaluations used, the wall
-    time, the convergence history and the model as a dict.
+    time and the model as a dict (with its convergence history). With
+    `detail`, also ``model_object`` (the
+    :class:`~spiralid.sysid.IdentifiedModel` itself) and ``times`` (the wall
+    time of every history entry, for Figure 6a), which a store does not keep.
     """
     from spiralid.sysid import ARX, PaperCost, fit_percent, identify
     from spiralid.sysid.estimators import search_options
@@ -148,12 +153,20 @@ def run_task(task: Task, data) -> dict:
     predictor, initial = PREDICTORS[task.predictor]
     scorer = PaperCost(arx, est, predictor=predictor, initial=initial)
     kwargs = dict(predictor=predictor, initial=initial)
+    stamps: list[float] = []
+
+    def clock(_intermediate) -> bool:
+        stamps.append(time.perf_counter())
+        return False
+
     if task.seed is not None:
         kwargs.update(
             parametrization=task.parametrization,
             refine=task.refine,
+            safe_start=task.safe_start,
             gain=scorer.w * task.gain_scale,
             rng=task.seed,
+            callback=clock,
             **search_options(
                 {"n_points": task.points, "max_nfev": task.budget, **dict(task.options)}
             ),
@@ -163,8 +176,7 @@ def run_task(task: Task, data) -> dict:
     seconds = time.perf_counter() - start
     y_sim = model.simulate(data.u)
     res = model.result
-    history = model.history
-    return {
+    row = {
         "key": task.key,
         "data": task.data,
         "predictor": task.predictor,
@@ -177,6 +189,10 @@ def run_task(task: Task, data) -> dict:
         "nfev": getattr(res, "nfev", None),
         "seconds": seconds,
         "stable": bool(model.is_stable),
-        "history": None if history is None else [float(h) for h in history],
         "model": model.to_dict(),
     }
+    if detail:
+        # Index 0 of the history (the initial population) is put at t = 0.
+        times = np.array([start, *stamps]) - start if stamps else None
+        row.update(model_object=model, times=times)
+    return row
