@@ -10,21 +10,20 @@ model and every number. It computes only: figures are drawn by
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import stats
 
+from spiralid.study.runner import execute
+from spiralid.study.tasks import Task
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
 from spiralid.sysid.estimators import search_options
 from spiralid.sysid.parametrizations import DEFAULT_PARAMETRIZATION
-from spiralid.sysid.validate import Validation, fit_percent, validate
+from spiralid.sysid.validate import Validation, validate
 
 __all__ = [
     "CONFIGURATIONS",
@@ -246,63 +245,6 @@ def default_data_source(seed: int = 0) -> dict:
     }
 
 
-def _fit_on_validation(model: IdentifiedModel, data: IOData, n_est: int) -> float:
-    """Free-run the model over the whole record, score the validation part."""
-    y_sim = model.simulate(data.u)
-    return fit_percent(data.y[n_est:], y_sim[n_est:])
-
-
-def _run_one(job) -> tuple[str, int, IdentifiedModel, np.ndarray]:
-    """Worker: one configuration, one seed (module level so it pickles)."""
-    config, seed, est, arx, options, gain, initial = job
-    stamps: list[float] = []
-
-    def clock(_intermediate) -> bool:
-        stamps.append(time.perf_counter())
-        return False
-
-    start = time.perf_counter()
-    model = identify(
-        est,
-        arx,
-        method=config.method,
-        predictor="simulation",
-        initial=initial,
-        parametrization=config.parametrization,
-        refine=config.refine,
-        safe_start=config.safe_start,
-        gain=gain * config.gain_scale,
-        rng=seed,
-        callback=clock,
-        **options,
-    )
-    # Index 0 of the history (the initial population) is put at t = 0.
-    times = np.array([start, *stamps]) - start
-    return config.label, seed, model, times
-
-
-@contextmanager
-def _single_threaded_blas():
-    """One BLAS thread in the worker processes started inside the block.
-
-    The workers already run one identification per core; a threaded BLAS
-    inside each oversubscribes the cores and its small least-squares solves
-    (safe starts, output-error polish) become 10-50x slower. The workers are
-    spawned, so they load BLAS afresh and read these variables; a user's own
-    setting is kept.
-    """
-    names = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-    saved = {name: os.environ.get(name) for name in names}
-    for name in names:
-        os.environ.setdefault(name, "1")
-    try:
-        yield
-    finally:
-        for name, value in saved.items():
-            if value is None:
-                os.environ.pop(name, None)
-
-
 def _warm_up(est: IOData, arx: ARX, kinds, initial: str) -> None:
     """Compile (or load) every Numba kernel the runs use, before any is timed.
 
@@ -409,62 +351,60 @@ def reproduce(
         configurations = [c for c in configurations if c.parametrization != "modal"]
     gain = PaperCost(arx, est, predictor="simulation", initial=initial).w
     options = search_options({"n_points": n_points, "max_nfev": max_nfev})
-    jobs = [
-        (config, seed, est, arx, options, gain, initial)
-        for seed in seed_list
-        for config in configurations
-    ]
-    total = len(jobs) + 2
-    done = 0
-
-    def tick():
-        nonlocal done
-        done += 1
-        if progress is not None:
-            progress(done, total)
-
-    scorer = PaperCost(arx, est, predictor="simulation", gain=gain, initial=initial)
-
-    def as_run(label, seed, model, times=None) -> Run:
-        return Run(
-            label,
-            seed,
-            model,
-            cost=float(scorer(model.theta)),
-            fit_val=_fit_on_validation(model, data, est.n),
-            times=times,
+    # The same tasks and runner as `spiralid study`: one execution path.
+    common = dict(
+        data="record",
+        predictor=f"simulation-{initial}",
+        budget=max_nfev,
+        points=n_points,
+        arx=(arx.na, arx.nb, arx.nk),
+        fraction=fraction,
+    )
+    tasks = [
+        Task(label=label, method=method, parametrization=None, seed=None, **common)
+        for label, method in (("LS", "ls"), ("OE", "oe"))
+    ] + [
+        Task(
+            label=c.label,
+            method=c.method,
+            parametrization=c.parametrization,
+            seed=seed,
+            refine=c.refine,
+            gain_scale=c.gain_scale,
+            safe_start=c.safe_start,
+            **common,
         )
-
-    baselines = {}
-    for label, method in (("LS", "ls"), ("OE", "oe")):
-        model = identify(est, arx, method=method, initial=initial)
-        baselines[label] = as_run(label, None, model)
-        tick()
-
+        for seed in seed_list
+        for c in configurations
+    ]
     n_workers = (os.cpu_count() or 1) if workers is None else int(workers)
     kinds = sorted({(c.method, c.parametrization) for c in configurations})
     warm_up = (est, arx, kinds, initial)
     results = {}
-    if n_workers <= 1:
-        _warm_up(*warm_up)
-        for job in jobs:
-            label, seed, model, times = _run_one(job)
-            results[label, seed] = as_run(label, seed, model, times)
-            tick()
-    else:
-        with (
-            _single_threaded_blas(),
-            ProcessPoolExecutor(
-                max_workers=n_workers,
-                mp_context=multiprocessing.get_context("spawn"),
-                initializer=_warm_up,
-                initargs=warm_up,
-            ) as pool,
-        ):
-            for label, seed, model, times in pool.map(_run_one, jobs):
-                results[label, seed] = as_run(label, seed, model, times)
-                tick()
+    for task, row in execute(
+        tasks,
+        {"record": data},
+        engine="processes" if n_workers > 1 else "local",
+        workers=n_workers,
+        detail=True,
+        initializer=_warm_up,
+        initargs=warm_up,
+    ):
+        if isinstance(row, Exception):
+            raise row
+        times = None if row["times"] is None else np.asarray(row["times"])
+        results[task.label, task.seed] = Run(
+            task.label,
+            task.seed,
+            row["model_object"],
+            row["cost"],
+            row["fit_val"],
+            times,
+        )
+        if progress is not None:
+            progress(len(results), len(tasks))
 
+    baselines = {label: results[label, None] for label in ("LS", "OE")}
     runs = {c.label: [results[c.label, s] for s in seed_list] for c in configurations}
     rep = Reproduction(
         data=data,

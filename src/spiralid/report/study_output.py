@@ -1,0 +1,232 @@
+"""Write a study's report: PNG figures, ``results.json``, ``report.html``.
+
+The same three kinds of file as a reproduction (:mod:`spiralid.report.output`),
+computed from a study's store by :func:`spiralid.study.analyse`.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+from pathlib import Path
+
+from spiralid.report.output import _CSS, _png, _table, _versions, check_output_dir
+from spiralid.study import StudyResults
+
+__all__ = ["STUDY_FILES", "study_results_dict", "study_summary", "write_study_report"]
+
+STUDY_FILES = (
+    "results.json",
+    "report.html",
+    "study_convergence.png",
+    "study_claim_a12.png",
+)
+
+_CLAIM_HEAD = [
+    "record",
+    "predictor",
+    "parametrisation",
+    "n",
+    "median {a}",
+    "median {b}",
+    "LS",
+    "OE",
+    "p",
+    "p (Holm)",
+    "A12",
+    "verdict",
+]
+_CELL_HEAD = ["configuration", "n", "median", "IQR", "best", "worst", "fit %", "s"]
+
+
+def _g(x) -> str:
+    return "-" if x is None else f"{x:.4g}"
+
+
+def _baseline_cost(res: StudyResults, data: str, predictor: str, label: str):
+    row = res.baselines.get((data, predictor), {}).get(label)
+    return None if row is None else row["cost"]
+
+
+def _claim_rows(res: StudyResults) -> list[list]:
+    a, b = res.claim
+    return [
+        [
+            c["data"],
+            c["predictor"],
+            c["parametrization"],
+            "/".join(map(str, c["n"])),
+            _g(c[f"median {a}"]),
+            _g(c[f"median {b}"]),
+            _g(_baseline_cost(res, c["data"], c["predictor"], "LS")),
+            _g(_baseline_cost(res, c["data"], c["predictor"], "OE")),
+            f"{c['p_two_sided']:.3g}",
+            f"{c['p_holm']:.3g}",
+            f"{c['a12']:.2f}",
+            c["verdict"],
+        ]
+        for c in res.claims
+    ]
+
+
+def _claim_head(res: StudyResults) -> list[str]:
+    a, b = res.claim
+    return [h.format(a=a, b=b) for h in _CLAIM_HEAD]
+
+
+def _cell_rows(res: StudyResults, reading) -> list[list]:
+    rows = []
+    for label in res.labels:
+        if (reading, label) not in res.cells:
+            continue
+        s = res.statistics(reading, label)
+        rows.append(
+            [
+                label,
+                s["n"],
+                _g(s["cost_median"]),
+                f"[{s['cost_q1']:.4g}, {s['cost_q3']:.4g}]",
+                _g(s["cost_best"]),
+                _g(s["cost_worst"]),
+                f"{s['fit_val_median']:.1f}",
+                f"{s['seconds_median']:.2f}",
+            ]
+        )
+    for label, row in res.baselines.get(reading[:2], {}).items():
+        rows.append(
+            [
+                label,
+                1,
+                _g(row["cost"]),
+                "-",
+                "-",
+                "-",
+                f"{row['fit_val']:.1f}",
+                f"{row['seconds']:.2f}",
+            ]
+        )
+    return rows
+
+
+def study_summary(res: StudyResults) -> str:
+    """The "where the claim holds" table as text."""
+    a, b = res.claim
+    lines = [
+        f"Where the claim holds: {a} against {b}, estimation cost over seeds "
+        f"(rank-sum test, Holm-adjusted over {len(res.claims)} readings, "
+        f"alpha = {res.alpha:g}; A12 > 0.5 favours {a})",
+        "",
+        _table(_claim_head(res), _claim_rows(res)),
+    ]
+    wins = [c for c in res.claims if c["verdict"] == f"{a} better"]
+    lines += [
+        "",
+        f"{a} is significantly better than {b} on {len(wins)} of "
+        f"{len(res.claims)} readings.",
+    ]
+    return "\n".join(lines)
+
+
+def study_results_dict(res: StudyResults, spec_text: str, command=None) -> dict:
+    """Everything the report shows, as JSON-ready data."""
+    return {
+        "command": command,
+        "versions": _versions(),
+        "specification": spec_text,
+        "claim": list(res.claim),
+        "alpha": res.alpha,
+        "claims": res.claims,
+        "cells": [
+            {
+                "data": rd[0],
+                "predictor": rd[1],
+                "parametrization": rd[2],
+                "label": label,
+                **res.statistics(rd, label),
+                "seeds": res.cells[rd, label]["seeds"].tolist(),
+                "cost": res.cells[rd, label]["cost"].tolist(),
+                "fit_val": res.cells[rd, label]["fit_val"].tolist(),
+            }
+            for rd in res.readings
+            for label in res.labels
+            if (rd, label) in res.cells
+        ],
+        "baselines": [
+            {
+                "data": d,
+                "predictor": p,
+                "label": label,
+                "cost": row["cost"],
+                "fit_val": row["fit_val"],
+            }
+            for (d, p), rows in res.baselines.items()
+            for label, row in rows.items()
+        ],
+    }
+
+
+def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
+    e = html.escape
+    a, b = res.claim
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        "<title>spiralid study: where does the paper's claim hold?</title>",
+        f"<style>{_CSS}</style></head><body>",
+        f"<h1>Where does the paper's claim hold? {e(a)} against {e(b)}</h1>",
+        f"<p>Command: <code>{e(command or 'spiralid study')}</code></p>",
+        "<p>Each reading of the paper's cost (record, predictor, "
+        "parametrisation) ran every configuration over the seeds at one "
+        "budget. Costs are eq. (2)-(3) on the estimation part at the default "
+        "gain (100 = the zero model). The rank-sum test compares the two "
+        "configurations' costs per reading; the p-values are Holm-adjusted over "
+        "all readings; A12 is the probability that a run of "
+        f"{e(a)} ends below a run of {e(b)}.</p>",
+        "<h2>Where the claim holds</h2>",
+        _table(_claim_head(res), _claim_rows(res), "html"),
+    ]
+    for stem, png in images.items():
+        b64 = base64.b64encode(png).decode("ascii")
+        parts.append(
+            f"<h3>{e(stem)}</h3><img alt='{e(stem)}' src='data:image/png;base64,{b64}'>"
+        )
+    parts.append("<h2>Every reading</h2>")
+    for rd in res.readings:
+        parts.append(f"<h3>{e(', '.join(map(str, rd)))}</h3>")
+        parts.append(_table(_CELL_HEAD, _cell_rows(res, rd), "html"))
+    parts.append(f"<h2>Specification</h2><pre>{e(spec_text)}</pre></body></html>")
+    return "".join(parts)
+
+
+def write_study_report(
+    res: StudyResults,
+    out: str | Path,
+    *,
+    spec_text: str = "",
+    force: bool = False,
+    command: str | None = None,
+) -> list[Path]:
+    """Write figures (PNG), ``results.json`` and ``report.html`` into `out`.
+
+    Returns the paths written. Refuses a non-empty directory unless `force`
+    (the command line passes `force` once it has checked that the folder
+    holds only the study's own files).
+    """
+    from spiralid.report.study_figures import study_figures
+
+    out = check_output_dir(out, force)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    images = {}
+    for stem, fig in study_figures(res).items():
+        images[stem] = _png(fig)
+        path = out / f"{stem}.png"
+        path.write_bytes(images[stem])
+        written.append(path)
+    path = out / "results.json"
+    path.write_text(json.dumps(study_results_dict(res, spec_text, command), indent=2))
+    written.append(path)
+    path = out / "report.html"
+    path.write_text(_html(res, images, spec_text, command), encoding="utf-8")
+    written.append(path)
+    return written

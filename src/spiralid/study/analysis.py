@@ -1,0 +1,170 @@
+"""Where does the paper's claim hold? The statistics of a study's store.
+
+:func:`analyse` turns a store's rows into a :class:`StudyResults`: per
+reading (record, predictor, parametrisation) and configuration the costs,
+fits and wall times over seeds; the baselines of each record and predictor;
+and, per reading, the claim's test (Eb-SDA against SDA by default): the
+rank-sum p-value, the Vargha-Delaney A12 effect size and the Holm-adjusted
+p-value over all readings tested together, with a verdict.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .spec import StudySpec
+from .statistics import holm, rank_sum
+
+__all__ = ["CLAIM", "StudyResults", "analyse"]
+
+# The paper's claim: Eb-SDA (first) ends at a lower cost than SDA (second).
+CLAIM = ("Eb-SDA", "SDA")
+
+Reading = tuple[str, str, str]
+
+
+@dataclass
+class StudyResults:
+    """A study's numbers, ready for tables and figures.
+
+    Attributes
+    ----------
+    readings : list of (data, predictor, parametrization)
+    labels : list of str
+        Search configurations.
+    cells : dict of (reading, label) to dict
+        ``cost``, ``fit_val``, ``seconds``, ``seeds`` arrays over seeds (seed
+        order) and ``history``, the runs' convergence histories.
+    baselines : dict of (data, predictor) to dict of label to row
+    claims : list of dict
+        Per reading where both labels of `claim` ran: the medians, ``n``,
+        ``p_two_sided``, ``p_holm``, ``a12`` and ``verdict``.
+    claim : (str, str)
+    alpha : float
+    """
+
+    readings: list[Reading]
+    labels: list[str]
+    cells: dict
+    baselines: dict
+    claims: list[dict] = field(default_factory=list)
+    claim: tuple[str, str] = CLAIM
+    alpha: float = 0.05
+
+    def statistics(self, reading: Reading, label: str) -> dict:
+        """Median, best, worst and quartiles of cost; median fit and time."""
+        c = self.cells[reading, label]
+        cost = c["cost"]
+        return {
+            "n": int(cost.size),
+            "cost_median": float(np.median(cost)),
+            "cost_q1": float(np.percentile(cost, 25)),
+            "cost_q3": float(np.percentile(cost, 75)),
+            "cost_best": float(cost.min()),
+            "cost_worst": float(cost.max()),
+            "fit_val_median": float(np.median(c["fit_val"])),
+            "seconds_median": float(np.median(c["seconds"])),
+        }
+
+
+def _verdict(p_holm: float, effect: float, claim, alpha: float) -> str:
+    if p_holm >= alpha:
+        return "no significant difference"
+    return f"{claim[0]} better" if effect > 0.5 else f"{claim[1]} better"
+
+
+def _orders(spec: StudySpec | None) -> tuple[dict, dict]:
+    """Rank of each reading and label in the specification (its own order)."""
+    if spec is None:
+        return {}, {}
+    readings = [
+        (d.name, p, par)
+        for d in spec.data
+        for p in spec.predictors
+        for par in spec.parametrizations
+    ]
+    return (
+        {r: i for i, r in enumerate(readings)},
+        {o.label: i for i, o in enumerate(spec.optimizers)},
+    )
+
+
+def analyse(
+    rows: list[dict],
+    spec: StudySpec | None = None,
+    claim=CLAIM,
+    alpha: float = 0.05,
+) -> StudyResults:
+    """Group a store's rows and test the claim per reading.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :meth:`~spiralid.study.ResultStore.rows`.
+    spec : StudySpec, optional
+        The study's specification: readings and configurations are listed in
+        its order (else sorted by name).
+    claim : (str, str)
+        Labels of the configuration claimed better and its reference.
+    alpha : float
+        Family-wise significance level of the Holm-adjusted tests.
+    """
+    if not 0 < alpha < 1:
+        raise ValueError(f"`alpha` must be in (0, 1); got {alpha!r}")
+    reading_rank, label_rank = _orders(spec)
+    grouped: dict = {}
+    for r in sorted(
+        (r for r in rows if r["seed"] is not None), key=lambda r: r["seed"]
+    ):
+        reading = (r["data"], r["predictor"], r["parametrization"])
+        grouped.setdefault((reading, r["label"]), []).append(r)
+    readings = sorted(
+        {rd for rd, _ in grouped}, key=lambda rd: (reading_rank.get(rd, 1 << 30), rd)
+    )
+    labels = sorted(
+        {label for _, label in grouped},
+        key=lambda label: (label_rank.get(label, 1 << 30), label),
+    )
+    cells = {
+        key: {
+            "seeds": np.array([r["seed"] for r in group]),
+            "cost": np.array([r["cost"] for r in group]),
+            "fit_val": np.array([r["fit_val"] for r in group]),
+            "seconds": np.array([r["seconds"] for r in group]),
+            "history": [r["model"]["history"] for r in group],
+        }
+        for key, group in grouped.items()
+    }
+    baselines: dict = {}
+    for r in rows:
+        if r["seed"] is None:
+            baselines.setdefault((r["data"], r["predictor"]), {})[r["label"]] = r
+    res = StudyResults(
+        readings, labels, cells, baselines, claim=tuple(claim), alpha=alpha
+    )
+    tested = [
+        rd for rd in readings if (rd, claim[0]) in cells and (rd, claim[1]) in cells
+    ]
+    tests = [
+        rank_sum(cells[rd, claim[0]]["cost"], cells[rd, claim[1]]["cost"])
+        for rd in tested
+    ]
+    adjusted = holm([t["p_two_sided"] for t in tests]) if tests else []
+    for rd, t, p_adj in zip(tested, tests, adjusted, strict=True):
+        res.claims.append(
+            {
+                "data": rd[0],
+                "predictor": rd[1],
+                "parametrization": rd[2],
+                "n": [int(cells[rd, c]["cost"].size) for c in claim],
+                f"median {claim[0]}": t["median_x"],
+                f"median {claim[1]}": t["median_y"],
+                "p_two_sided": t["p_two_sided"],
+                "p_holm": float(p_adj),
+                "a12": t["a12"],
+                "verdict": _verdict(float(p_adj), t["a12"], claim, alpha),
+            }
+        )
+    return res

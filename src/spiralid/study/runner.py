@@ -1,0 +1,268 @@
+"""Run a study's tasks on Dask, storing each result as it finishes.
+
+:func:`execute` is the one runner: it runs tasks in this process
+(``engine="local"``), in a process pool (``"processes"``) or on a Dask
+cluster (``"dask"``: a fresh ``LocalCluster`` of single-threaded worker
+processes, or an existing scheduler's address), and yields each finished
+task's row in the order of completion. Results depend on the seed alone, not
+on the engine or the order (each run draws from its own seeded generator).
+
+:func:`run_study` opens the store, skips the runs it already holds, and
+commits every new row as it arrives, so an interrupted study resumes where
+it stopped.
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import os
+from collections.abc import Callable, Iterator
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .spec import StudySpec
+from .store import ResultStore
+from .tasks import Task, load_records, run_task, study_tasks
+
+__all__ = ["ENGINES", "StudyRun", "execute", "run_study"]
+
+ENGINES = ("dask", "processes", "local")
+
+
+@dataclass
+class StudyRun:
+    """What :func:`run_study` did.
+
+    Attributes
+    ----------
+    store : Path
+    total : int
+        Runs in the specification.
+    reused : int
+        Runs already in the store, not recomputed.
+    computed : int
+        Runs computed and stored now.
+    failures : list of (Task, str)
+        Runs that raised, with the message; not stored, so a rerun retries.
+    """
+
+    store: Path
+    total: int
+    reused: int
+    computed: int
+    failures: list[tuple[Task, str]] = field(default_factory=list)
+
+
+def _dask_client(scheduler: str | None, workers: int | None):
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        return Client(scheduler), None
+    with _single_threaded_blas():
+        cluster = LocalCluster(
+            n_workers=workers or os.cpu_count() or 1,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
+    return Client(cluster), cluster
+
+
+def _execute_dask(tasks, records, scheduler, workers, detail, initializer, initargs):
+    from distributed import as_completed as dask_completed
+
+    client, cluster = _dask_client(scheduler, workers)
+    try:
+        if initializer is not None:
+            client.run(initializer, *initargs)
+        needed = {t.data for t in tasks}
+        shared = {
+            name: client.scatter(records[name], broadcast=True) for name in needed
+        }
+        futures = {
+            client.submit(
+                run_task,
+                t,
+                shared[t.data],
+                detail,
+                key=f"spiralid-run-{t.key}",
+                pure=False,
+            ): t
+            for t in tasks
+        }
+        for fut in dask_completed(futures):
+            yield futures[fut], _outcome(fut)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _outcome(fut):
+    try:
+        return fut.result()
+    except Exception as exc:  # a failed run is reported, not fatal to the study
+        return exc
+
+
+@contextmanager
+def _single_threaded_blas():
+    """One BLAS thread in the worker processes started inside the block.
+
+    The workers already run one identification per core; a threaded BLAS
+    inside each oversubscribes the cores and its small least-squares solves
+    (safe starts, output-error polish) become 10-50x slower. The workers are
+    spawned, so they load BLAS afresh and read these variables; a user's own
+    setting is kept.
+    """
+    names = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+    saved = {name: os.environ.get(name) for name in names}
+    for name in names:
+        os.environ.setdefault(name, "1")
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+
+
+def _execute_processes(tasks, records, workers, detail, initializer, initargs):
+    with (
+        _single_threaded_blas(),
+        ProcessPoolExecutor(
+            max_workers=workers or os.cpu_count() or 1,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=initializer,
+            initargs=initargs,
+        ) as pool,
+    ):
+        futures = {pool.submit(run_task, t, records[t.data], detail): t for t in tasks}
+        for fut in as_completed(futures):
+            yield futures[fut], _outcome(fut)
+
+
+def execute(
+    tasks: list[Task],
+    records: dict,
+    *,
+    engine: str = "dask",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    detail: bool = False,
+    initializer: Callable | None = None,
+    initargs: tuple = (),
+) -> Iterator[tuple[Task, dict | Exception]]:
+    """Run `tasks` and yield ``(task, row)`` as each finishes.
+
+    Parameters
+    ----------
+    tasks : list of Task
+    records : dict of str to IOData
+        The records the tasks name (see :func:`~spiralid.study.load_records`).
+    engine : {"dask", "processes", "local"}
+        Where the tasks run (see the module docstring).
+    scheduler : str, optional
+        Address of a running Dask scheduler (``engine="dask"`` only); by
+        default a ``LocalCluster`` is started and stopped.
+    workers : int, optional
+        Worker processes of the local cluster or pool; default the CPU count.
+    detail : bool
+        Rows also carry the model object and iteration times (see
+        :func:`~spiralid.study.run_task`).
+    initializer, initargs : callable and tuple, optional
+        Run as ``initializer(*initargs)`` once in every worker process (or
+        here, for ``engine="local"``) before any task, e.g. to compile
+        kernels so that no task's wall time includes the compilation. The
+        process pool and the local cluster's workers run with one BLAS thread
+        each (a user's own setting is kept).
+
+    Yields
+    ------
+    (Task, dict or Exception)
+        The row of :func:`~spiralid.study.run_task`, or the exception the run
+        raised.
+    """
+    if engine not in ENGINES:
+        raise ValueError(f"`engine` must be one of {ENGINES}; got {engine!r}")
+    if scheduler is not None and engine != "dask":
+        raise ValueError("`scheduler` needs engine='dask'")
+    if workers is not None and (
+        isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
+    ):
+        raise ValueError(f"`workers` must be an integer >= 1; got {workers!r}")
+    if not tasks:
+        return
+    if engine == "dask":
+        yield from _execute_dask(
+            tasks, records, scheduler, workers, detail, initializer, initargs
+        )
+    elif engine == "processes" and (workers or os.cpu_count() or 1) > 1:
+        yield from _execute_processes(
+            tasks, records, workers, detail, initializer, initargs
+        )
+    else:
+        if initializer is not None:
+            initializer(*initargs)
+        for t in tasks:
+            try:
+                yield t, run_task(t, records[t.data], detail)
+            except Exception as exc:
+                yield t, exc
+
+
+def run_study(
+    spec: StudySpec,
+    store: str | os.PathLike,
+    *,
+    engine: str = "dask",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> StudyRun:
+    """Run every task of `spec` not yet in `store`, storing each as it ends.
+
+    Parameters
+    ----------
+    spec : StudySpec
+        From :func:`~spiralid.study.load_spec`.
+    store : path-like
+        The SQLite file (created if missing). Rerunning the same `spec` on
+        the same store resumes: finished runs are neither recomputed nor
+        lost.
+    engine, scheduler, workers
+        See :func:`execute`.
+    progress : callable, optional
+        ``progress(done, total)`` after each stored run (and once at the
+        start, counting the runs the store already held).
+
+    Returns
+    -------
+    StudyRun
+    """
+    records = load_records(spec)
+    tasks = study_tasks(spec, records)
+    with ResultStore.open(store, spec.digest(), spec.source) as db:
+        finished = db.keys()
+        todo = [t for t in tasks if t.key not in finished]
+        reused = len(tasks) - len(todo)
+        done = reused
+        if progress is not None:
+            progress(done, len(tasks))
+        outcome = StudyRun(Path(store), len(tasks), reused, 0)
+        for task, row in execute(
+            todo, records, engine=engine, scheduler=scheduler, workers=workers
+        ):
+            if isinstance(row, Exception):
+                outcome.failures.append((task, " ".join(str(row).split())))
+                continue
+            db.add(row)
+            outcome.computed += 1
+            done += 1
+            if progress is not None:
+                progress(done, len(tasks))
+    return outcome

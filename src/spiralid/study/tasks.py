@@ -1,0 +1,198 @@
+"""One run of a study: a task, and the function a worker runs for it.
+
+A :class:`Task` names one configuration (optimiser or baseline) on one
+reading (record, predictor, parametrisation) with one seed; its :attr:`key`
+is a hash of everything that decides the result, so a store can tell a
+finished run from one still to do. :func:`run_task` is a plain module-level
+function of picklable arguments: a worker needs nothing but spiralid.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .spec import PREDICTORS, StudySpec
+
+__all__ = ["Task", "load_records", "run_task", "study_tasks"]
+
+
+@dataclass(frozen=True)
+class Task:
+    """One run: a configuration on a reading with a seed.
+
+    ``seed`` and ``parametrization`` are None for the deterministic
+    baselines (least squares, output error), which search no parameters.
+    """
+
+    data: str
+    predictor: str
+    parametrization: str | None
+    label: str
+    method: str
+    seed: int | None
+    refine: bool = False
+    gain_scale: float = 1.0
+    safe_start: bool | None = None
+    options: tuple = ()
+    budget: int = 20_000
+    points: int = 50
+    arx: tuple[int, int, int] = (8, 8, 0)
+    fraction: float = 2 / 3
+    data_digest: str = ""
+
+    @property
+    def key(self) -> str:
+        """A hash of every field: equal keys mean the same computation."""
+        text = json.dumps(asdict(self), sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+    @property
+    def reading(self) -> tuple[str, str, str | None]:
+        return (self.data, self.predictor, self.parametrization)
+
+
+def _digest(data) -> str:
+    h = hashlib.sha256()
+    for part in (data.u, data.y, np.array([data.ts])):
+        h.update(np.ascontiguousarray(part, dtype=float).tobytes())
+    return h.hexdigest()[:16]
+
+
+def load_records(spec: StudySpec) -> dict:
+    """Read every record of `spec` and check the ARX orders fit each.
+
+    Returns a dict of record name to :class:`~spiralid.sysid.IOData`. Any
+    failure is a one-line ValueError naming the record, raised before any
+    run starts.
+    """
+    from spiralid.sysid import ARX
+
+    arx = ARX(spec.na, spec.nb, spec.nk)
+    records = {}
+    for d in spec.data:
+        try:
+            data = d.load()
+            est, _ = data.split(spec.fraction)
+            arx.check_length(est, f"the estimation part of record {d.name!r}")
+        except (ValueError, OSError, TypeError) as exc:
+            message = " ".join(str(exc).split())
+            raise ValueError(f"record {d.name!r} ({d.kind}): {message}") from None
+        records[d.name] = data
+    return records
+
+
+def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
+    """Every run of `spec`, baselines first, in a fixed order."""
+    common = dict(
+        budget=spec.budget,
+        points=spec.points,
+        arx=(spec.na, spec.nb, spec.nk),
+        fraction=spec.fraction,
+    )
+    tasks = []
+    for d in spec.data:
+        digest = _digest(records[d.name])
+        for predictor in spec.predictors:
+            for method in spec.baselines:
+                tasks.append(
+                    Task(
+                        d.name,
+                        predictor,
+                        None,
+                        method.upper(),
+                        method,
+                        None,
+                        data_digest=digest,
+                        **common,
+                    )
+                )
+            for par in spec.parametrizations:
+                for opt in spec.optimizers:
+                    for seed in spec.seeds:
+                        tasks.append(
+                            Task(
+                                d.name,
+                                predictor,
+                                par,
+                                opt.label,
+                                opt.method,
+                                seed,
+                                refine=opt.refine,
+                                gain_scale=opt.gain_scale,
+                                safe_start=opt.safe_start,
+                                options=tuple(sorted(opt.options.items())),
+                                data_digest=digest,
+                                **common,
+                            )
+                        )
+    return tasks
+
+
+def run_task(task: Task, data, detail: bool = False) -> dict:
+    """Run one task on its record and return its row for the store.
+
+    The row holds the estimation cost (the paper's eq. (2)-(3) on the
+    estimation part at the reading's default gain, whatever gain the search
+    used), the validation fit % of the free run from rest over the whole
+    record scored on the validation part, the evaluations used, the wall
+    time and the model as a dict (with its convergence history). With
+    `detail`, also ``model_object`` (the
+    :class:`~spiralid.sysid.IdentifiedModel` itself) and ``times`` (the wall
+    time of every history entry, for Figure 6a), which a store does not keep.
+    """
+    from spiralid.sysid import ARX, PaperCost, fit_percent, identify
+    from spiralid.sysid.estimators import search_options
+
+    arx = ARX(*task.arx)
+    est, _ = data.split(task.fraction)
+    predictor, initial = PREDICTORS[task.predictor]
+    scorer = PaperCost(arx, est, predictor=predictor, initial=initial)
+    kwargs = dict(predictor=predictor, initial=initial)
+    stamps: list[float] = []
+
+    def clock(_intermediate) -> bool:
+        stamps.append(time.perf_counter())
+        return False
+
+    if task.seed is not None:
+        kwargs.update(
+            parametrization=task.parametrization,
+            refine=task.refine,
+            safe_start=task.safe_start,
+            gain=scorer.w * task.gain_scale,
+            rng=task.seed,
+            callback=clock,
+            **search_options(
+                {"n_points": task.points, "max_nfev": task.budget, **dict(task.options)}
+            ),
+        )
+    start = time.perf_counter()
+    model = identify(est, arx, method=task.method, **kwargs)
+    seconds = time.perf_counter() - start
+    y_sim = model.simulate(data.u)
+    res = model.result
+    row = {
+        "key": task.key,
+        "data": task.data,
+        "predictor": task.predictor,
+        "parametrization": task.parametrization,
+        "label": task.label,
+        "method": task.method,
+        "seed": task.seed,
+        "cost": float(scorer(model.theta)),
+        "fit_val": float(fit_percent(data.y[est.n :], y_sim[est.n :])),
+        "nfev": getattr(res, "nfev", None),
+        "seconds": seconds,
+        "stable": bool(model.is_stable),
+        "model": model.to_dict(),
+    }
+    if detail:
+        # Index 0 of the history (the initial population) is put at t = 0.
+        times = np.array([start, *stamps]) - start if stamps else None
+        row.update(model_object=model, times=times)
+    return row
