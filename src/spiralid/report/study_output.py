@@ -11,7 +11,8 @@ import html
 import json
 from pathlib import Path
 
-from spiralid.report.output import _CSS, _png, _table, _versions, check_output_dir
+from spiralid.report.atomic import OutputFolder
+from spiralid.report.output import _CSS, _png, _table, _versions
 from spiralid.study import StudyResults
 
 __all__ = ["STUDY_FILES", "study_results_dict", "study_summary", "write_study_report"]
@@ -214,19 +215,15 @@ def write_study_report(
     """
     from spiralid.report.study_figures import study_figures
 
-    out = check_output_dir(out, force)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    images = {}
-    for stem, fig in study_figures(res).items():
-        images[stem] = _png(fig)
-        path = out / f"{stem}.png"
-        path.write_bytes(images[stem])
-        written.append(path)
-    path = out / "results.json"
-    path.write_text(json.dumps(study_results_dict(res, spec_text, command), indent=2))
-    written.append(path)
-    path = out / "report.html"
-    path.write_text(_html(res, images, spec_text, command), encoding="utf-8")
-    written.append(path)
-    return written
+    with OutputFolder(out, force) as folder:
+        images = {}
+        for stem, fig in study_figures(res).items():
+            images[stem] = _png(fig)
+            (folder.path / f"{stem}.png").write_bytes(images[stem])
+        (folder.path / "results.json").write_text(
+            json.dumps(study_results_dict(res, spec_text, command), indent=2)
+        )
+        (folder.path / "report.html").write_text(
+            _html(res, images, spec_text, command), encoding="utf-8"
+        )
+        return folder.commit(last="report.html")

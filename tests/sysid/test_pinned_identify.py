@@ -2,7 +2,7 @@
 configurations (and of LS, OE, DE, refine) is bit for bit what the code gave
 before it (pinned at commit fb69ef2).
 
-`python tests/sysid/test_pinned.py` rewrote data/pinned_identify.json from
+`python tests/sysid/test_pinned_identify.py` rewrote data/pinned_identify.json from
 the code of commit fb69ef2 (identify() as one function); it must not be
 rerun to make this test pass.
 """
