@@ -188,7 +188,7 @@ def test_help_shows_defaults_and_no_doubled_percent(capsys, flag):
     with pytest.raises(SystemExit):
         cli.main(["identify", flag])
     text = " ".join(capsys.readouterr().out.split())
-    assert "(default: 2/3)" in text and "(default: ebsda)" in text
+    assert "(default: 2/3)" in text and "(default: spiral)" in text
 
 
 def test_readme_fraction_and_excel_csv_work(files, capsys):

@@ -46,7 +46,10 @@ def test_show_default_prints_the_shipped_grid(tmp_path):
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        (("seeds = 2", "seeds = 0"), "`seeds` must be an integer >= 1"),
+        (
+            ("seeds = 2", "seeds = 0"),
+            "seeds must be an integer >= 1",
+        ),
         (('method = "sda"', 'method = "sdb"'), "unknown method 'sdb'"),
         (("[grid]", "[grid]\nspeed = 3"), "unknown key 'speed'"),
         (

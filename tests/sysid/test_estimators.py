@@ -2,13 +2,13 @@
 result type, one budget rule, the safe start and capped polishes."""
 
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy import optimize, signal
 
 from spiralid.cli import build_parser
+from spiralid.datasets import robot_arm
 from spiralid.sysid import (
     ARX,
     IOData,
@@ -190,18 +190,11 @@ def test_bad_safe_start_is_rejected(record):
         identify(record, ARX4, method="sda", safe_start="yes")
 
 
-ARM = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
-
-
-@pytest.mark.skipif(
-    not (ARM / "daisy_robot_arm.csv").is_file(), reason="real arm data not available"
-)
 @pytest.mark.parametrize("parametrization", list(PARAMETRIZATIONS))
 @pytest.mark.parametrize("method", ["sda", "ebsda"])
 def test_safe_searches_on_the_real_arm(method, parametrization):
     # The record where the paper's searches can end far above the zero model.
-    data = IOData.from_csv(ARM / "daisy_robot_arm.csv", input="u", output="y",
-                           ts=0.01).split()[0]  # fmt: skip
+    data = robot_arm().split()[0]
     arx = ARX(8, 8, 0)
     cost = PaperCost(arx, data, initial="measured")
     floor = min(cost(np.zeros(arx.n_params)), cost(_stabilised_ls(data, arx)))
