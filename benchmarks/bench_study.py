@@ -17,17 +17,17 @@ import time
 from pathlib import Path
 
 from spiralid.report.study_output import study_summary
-from spiralid.study import ResultStore, analyse, load_spec, run_study
+from spiralid.study import (
+    ResultStore,
+    analyse,
+    load_spec,
+    reproducible_part,
+    run_study,
+)
 
 
 def _comparable(rows):
-    out = []
-    for r in rows:
-        r = dict(r, model=dict(r["model"]))
-        r.pop("seconds")
-        r["model"].pop("timings", None)
-        out.append(r)
-    return out
+    return [reproducible_part(r) for r in rows]
 
 
 def main() -> None:

@@ -16,6 +16,7 @@ from spiralid.study import (
     execute,
     load_records,
     load_spec,
+    reproducible_part,
     run_study,
     study_tasks,
 )
@@ -26,15 +27,7 @@ SCRIPT = Path(sys.executable).parent / "spiralid"
 
 
 def _comparable(rows):
-    # Wall times and the model's own timings differ between runs of the same
-    # computation; every other field must not.
-    out = []
-    for r in rows:
-        r = dict(r, model=dict(r["model"]))
-        r.pop("seconds")
-        r["model"].pop("timings", None)
-        out.append(r)
-    return out
+    return [reproducible_part(r) for r in rows]
 
 
 def test_dask_cluster_gives_the_same_rows_as_this_process(small_spec, tmp_path):

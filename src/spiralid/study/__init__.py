@@ -14,7 +14,7 @@ from .runner import ENGINES, StudyRun, execute, run_study
 from .spec import DEFAULT_SPEC, PREDICTORS, StudySpec, load_spec, parse_spec
 from .statistics import a12, holm, rank_sum
 from .store import ResultStore, StoreLockedError
-from .tasks import Task, load_records, run_task, study_tasks
+from .tasks import Task, load_records, reproducible_part, run_task, study_tasks
 
 __all__ = [
     "CLAIM",
@@ -35,6 +35,7 @@ __all__ = [
     "load_spec",
     "parse_spec",
     "rank_sum",
+    "reproducible_part",
     "run_study",
     "run_task",
     "study_tasks",

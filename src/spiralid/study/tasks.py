@@ -18,7 +18,7 @@ import numpy as np
 
 from .spec import PREDICTORS, StudySpec
 
-__all__ = ["Task", "load_records", "run_task", "study_tasks"]
+__all__ = ["Task", "load_records", "reproducible_part", "run_task", "study_tasks"]
 
 
 @dataclass(frozen=True)
@@ -196,3 +196,15 @@ def run_task(task: Task, data, detail: bool = False) -> dict:
         times = np.array([start, *stamps]) - start if stamps else None
         row.update(model_object=model, times=times)
     return row
+
+
+def reproducible_part(row: dict) -> dict:
+    """A row without its wall times: what the seed alone decides.
+
+    Two runs of the same task agree on this part bit for bit, whatever the
+    engine, the worker count or the order of completion.
+    """
+    out = dict(row, model=dict(row["model"]))
+    out.pop("seconds")
+    out["model"].pop("timings", None)
+    return out
