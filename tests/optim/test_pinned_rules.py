@@ -2,8 +2,13 @@
 
 Captured from the code before the convergent rules, restarts and the
 scale-free Eb-SDA option were added (issue 8): new options must leave the
-existing rules' results, and so the reproduction's numbers, exactly where
-they were. Floats are stored in hexadecimal so that the comparison is exact.
+existing rules' results, and so the reproduction's numbers, where they
+were. Floats are stored in hexadecimal so that the stored values are exact;
+the comparison allows a relative 1e-9, because SDA's rotations go through
+BLAS, whose last bits depend on the processor (OpenBLAS's Prescott and
+SandyBridge kernels give differences up to 4e-12 here, see
+docs/design-notes.md, "Tests that hold on any machine"), while any change
+to a rule moves these numbers by far more.
 """
 
 import numpy as np
@@ -265,24 +270,24 @@ def test_existing_rules_unchanged_per_seed(method, name, policy, seed, x, fun):
         vectorized=True,
         bounds_policy=policy,
     )
-    assert res.x.tolist() == [float.fromhex(v) for v in x]
-    assert res.fun == float.fromhex(fun)
+    assert_close_to_pin(res, x, fun)
     assert res.nfev == 20 + 150 * 19
 
 
+def assert_close_to_pin(res, x, fun) -> None:
+    want = np.array([float.fromhex(v) for v in x])
+    np.testing.assert_allclose(res.x, want, rtol=1e-9, atol=1e-12)
+    assert res.fun == pytest.approx(float.fromhex(fun), rel=1e-9, abs=1e-12)
+
+
 def test_pinned_scalar_objective_matches_vectorised():
-    # The per-point path evaluates the same points in the same order.
+    # The per-point path evaluates the same points in the same order: both
+    # runs are made here, on one machine, so they agree bit for bit.
     p = PROBLEMS["rosenbrock"]
-    res = minimize(
-        lambda v: float(p.fun(v)),
-        p.bounds(4),
-        "ebsda",
-        n_points=20,
-        max_iter=150,
-        rng=0,
-    )
+    options = dict(n_points=20, max_iter=150, rng=0)
+    res = minimize(lambda v: float(p.fun(v)), p.bounds(4), "ebsda", **options)
+    vec = minimize(p.fun, p.bounds(4), "ebsda", vectorized=True, **options)
+    assert res.x.tolist() == vec.x.tolist() and res.fun == vec.fun
     method, _, _, _, x, fun = PINNED[6]
     assert method == "ebsda"
-    assert res.x.tolist() == [float.fromhex(v) for v in x]
-    assert res.fun == float.fromhex(fun)
-    assert np.isfinite(res.fun)
+    assert_close_to_pin(res, x, fun)

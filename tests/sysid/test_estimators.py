@@ -143,7 +143,10 @@ def test_no_safe_search_is_worse_than_the_zero_model_or_least_squares(
     kw = dict(method=method, parametrization=parametrization, n_points=10)
     for seed in range(3):
         fit = identify(record, ARX4, rng=seed, max_nfev=100, safe_start=True, **kw)
-        assert fit.cost <= floor
+        # The safe start enters the search through the parametrisation's
+        # round trip (reflection coefficients and back), which may move the
+        # last bits of its cost on another processor's BLAS.
+        assert fit.cost <= floor * (1 + 1e-12)
         assert fit.result.safe_start
     if method == "spiral":
         # Its polish reaches below least squares without the safe start too,
