@@ -33,7 +33,7 @@ import numpy as np
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IOData, PaperCost, identify, validate
-from spiralid.sysid.parametrizations import (
+from spiralid.sysid.estimation.parametrizations import (
     default_bounds,
     feasible_initial_points,
 )

@@ -69,12 +69,12 @@ import numpy as np
 
 from spiralid.optim import minimize
 from spiralid.sysid import ARX, IOData, PaperCost, identify
-from spiralid.sysid.identify import default_bounds
-from spiralid.sysid.memetic import projected_spiral
-from spiralid.sysid.modal import ModalParametrization
-from spiralid.sysid.polynomials import fold_reflection, step_up
-from spiralid.sysid.validate import fit_percent
-from spiralid.sysid.varpro import ProjectedCost
+from spiralid.sysid.estimation.identify import default_bounds
+from spiralid.sysid.estimation.memetic import projected_spiral
+from spiralid.sysid.estimation.modal import ModalParametrization
+from spiralid.sysid.estimation.varpro import ProjectedCost
+from spiralid.sysid.models.polynomials import fold_reflection, step_up
+from spiralid.sysid.validation.validate import fit_percent
 
 ARX_8 = ARX(8, 8, 0)
 ARM_CSV = (
@@ -195,7 +195,7 @@ def _identify(method, parametrization=None, budget_cap=None, **kw):
 def _cma_coefficients(est, seed, budget):
     import cma
 
-    from spiralid.sysid.parametrizations import Coefficients
+    from spiralid.sysid.estimation.parametrizations import Coefficients
 
     cost = PaperCost(ARX_8, est)
     box = default_bounds(est, ARX_8)

@@ -9,8 +9,9 @@ from scipy import signal
 
 from spiralid.report import Configuration, reproduce
 from spiralid.report.output import _html, results_dict
-from spiralid.sysid import ARX, IdentifiedModel, IOData, estimators, validate
-from spiralid.sysid.polynomials import format_pole_radius
+from spiralid.sysid import ARX, IdentifiedModel, IOData, validate
+from spiralid.sysid.estimation import estimators
+from spiralid.sysid.models.polynomials import format_pole_radius
 
 # The best Eb-SDA (w x 0.1) model of a default `spiralid reproduce` run: a
 # pole pair within 1e-15 of the unit circle. numpy.roots puts it at

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import signal, stats
 
-from spiralid.sysid.correlation import (
+from spiralid.sysid.validation.correlation import (
     correlation,
     independence_test,
     whiteness_test,

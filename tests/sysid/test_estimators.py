@@ -9,18 +9,15 @@ from scipy import optimize, signal
 
 from spiralid.cli import build_parser
 from spiralid.datasets import robot_arm
-from spiralid.sysid import (
-    ARX,
-    IOData,
-    PaperCost,
-    estimators,
-    identify,
-    outputerror,
-    parametrizations,
-    step_up,
+from spiralid.sysid import ARX, IOData, PaperCost, identify, step_up
+from spiralid.sysid.estimation import estimators, outputerror, parametrizations
+from spiralid.sysid.estimation.estimators import (
+    METHODS,
+    STATUS,
+    EstimatorResult,
+    search_options,
 )
-from spiralid.sysid.estimators import METHODS, STATUS, EstimatorResult, search_options
-from spiralid.sysid.parametrizations import PARAMETRIZATIONS, stabilise
+from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS, stabilise
 
 SEARCHES = [name for name, m in METHODS.items() if m.search]
 

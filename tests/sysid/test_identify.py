@@ -8,7 +8,7 @@ from scipy import signal
 
 from spiralid.datasets import robot_arm
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, step_up
-from spiralid.sysid.identify import (
+from spiralid.sysid.estimation.identify import (
     default_bounds,
     feasible_initial_points,
     steiglitz_mcbride,
@@ -193,8 +193,8 @@ def test_steiglitz_mcbride_removes_the_output_noise_bias():
 
 @pytest.mark.parametrize("initial", ["rest", "measured"])
 def test_oe_keeps_the_start_with_the_lower_cost(initial):
-    from spiralid.sysid.cost import PaperCost
-    from spiralid.sysid.outputerror import local_polish
+    from spiralid.sysid.estimation.cost import PaperCost
+    from spiralid.sysid.estimation.outputerror import local_polish
 
     rng = np.random.default_rng(4)
     u = rng.standard_normal(400)
@@ -281,7 +281,7 @@ def test_user_bounds_are_the_search_box(known):
 
 
 def test_unstable_start_is_reflected_inside():
-    from spiralid.sysid.parametrizations import stabilise
+    from spiralid.sysid.estimation.parametrizations import stabilise
 
     arx = ARX(3, 1, 0)
     roots = np.array([1.25, 0.5 + 0.6j, 0.5 - 0.6j])  # |0.5 +- 0.6j| = 0.78
@@ -299,7 +299,7 @@ def test_oe_from_rest_is_a_prediction_error_method():
     # sensitivities filtered from rest) equals central finite differences of
     # the residual written out here with scipy.signal.lfilter from rest over
     # all N samples, and the gradient J' r of the criterion vanishes.
-    from spiralid.sysid.parametrizations import KMAX
+    from spiralid.sysid.estimation.parametrizations import KMAX
 
     rng = np.random.default_rng(21)
     u = rng.standard_normal(500)
@@ -339,7 +339,7 @@ def test_rig_rest_criterion_validates_better_than_measured():
     # the benchmarks. Validation: free run from rest over the whole record.
     from spiralid.report import default_data
     from spiralid.sysid import validate
-    from spiralid.sysid.outputerror import local_polish
+    from spiralid.sysid.estimation.outputerror import local_polish
 
     est, val = default_data().split()
     arx = ARX(8, 8, 0)

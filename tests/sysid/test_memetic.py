@@ -5,9 +5,9 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IOData
-from spiralid.sysid.memetic import frequency_seeds, projected_spiral
-from spiralid.sysid.modal import ModalParametrization
-from spiralid.sysid.varpro import ProjectedCost
+from spiralid.sysid.estimation.memetic import frequency_seeds, projected_spiral
+from spiralid.sysid.estimation.modal import ModalParametrization
+from spiralid.sysid.estimation.varpro import ProjectedCost
 
 
 def _two_modes(n=3000, ts=0.002, noise=0.0, seed=0):

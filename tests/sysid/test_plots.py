@@ -8,9 +8,9 @@ from matplotlib.figure import Figure
 from scipy import signal
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, plots
-from spiralid.sysid.correlation import independence_test, whiteness_test
 from spiralid.sysid.spectra import find_resonances, modes_from_poles, psd
-from spiralid.sysid.validate import validate
+from spiralid.sysid.validation.correlation import independence_test, whiteness_test
+from spiralid.sysid.validation.validate import validate
 
 matplotlib.use("Agg")
 
@@ -234,7 +234,7 @@ def test_figures_carry_units_continue_time_and_label_residuals():
 
 
 def test_log_cost_axis_keeps_several_labelled_ticks():
-    from spiralid.sysid.plots import plot_convergence
+    from spiralid.sysid.validation.plots import plot_convergence
 
     # Costs within less than a decade: plain log ticks would label one value.
     h = [np.linspace(90.0, 60.0, 40), np.linspace(95.0, 70.0, 40)]

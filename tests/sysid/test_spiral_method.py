@@ -5,9 +5,9 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
-from spiralid.sysid.estimators import DEFAULT_METHOD
-from spiralid.sysid.modal import ModalParametrization
-from spiralid.sysid.parametrizations import make_parametrization
+from spiralid.sysid.estimation.estimators import DEFAULT_METHOD
+from spiralid.sysid.estimation.modal import ModalParametrization
+from spiralid.sysid.estimation.parametrizations import make_parametrization
 
 ARX4 = ARX(4, 3, 1)
 

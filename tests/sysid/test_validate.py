@@ -7,8 +7,8 @@ import pytest
 from scipy import signal
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost
-from spiralid.sysid.correlation import independence_test, whiteness_test
-from spiralid.sysid.validate import (
+from spiralid.sysid.validation.correlation import independence_test, whiteness_test
+from spiralid.sysid.validation.validate import (
     fit_percent,
     realization_tests,
     rmse,

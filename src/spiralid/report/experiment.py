@@ -21,9 +21,9 @@ from scipy import stats
 from spiralid.study.runner import execute
 from spiralid.study.tasks import Task
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
-from spiralid.sysid.estimators import search_options
-from spiralid.sysid.parametrizations import DEFAULT_PARAMETRIZATION
-from spiralid.sysid.validate import Validation, validate
+from spiralid.sysid.estimation.estimators import search_options
+from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
+from spiralid.sysid.validation.validate import Validation, validate
 
 __all__ = [
     "CONFIGURATIONS",
@@ -41,7 +41,7 @@ class Configuration:
     """One arm of the comparison: an optimiser, what it searches, the gain.
 
     ``safe_start`` None takes the method's default (off for the paper's
-    methods, see :mod:`spiralid.sysid.estimators`).
+    methods, see :mod:`spiralid.sysid.estimation.estimators`).
     """
 
     label: str
@@ -291,7 +291,7 @@ def reproduce(
     max_nfev : int, default 20000
         Budget of cost evaluations of every search run, the same for all so
         that the algorithms compare at equal cost; no iteration cap stops a
-        run first (:func:`spiralid.sysid.estimators.search_options`).
+        run first (:func:`spiralid.sysid.estimation.estimators.search_options`).
     n_points : int, default 50
         Search points ``m``.
     arx : ARX, default ARX(8, 8, 0)

@@ -2,7 +2,7 @@
 
 Each function takes a :class:`~spiralid.report.experiment.Reproduction` and
 returns a matplotlib ``Figure``; the plotting itself is
-:mod:`spiralid.sysid.plots`.
+:mod:`spiralid.sysid.validation.plots`.
 """
 
 from __future__ import annotations

@@ -19,7 +19,7 @@ import numpy as np
 
 from spiralid.report.atomic import OutputFolder
 from spiralid.report.experiment import Reproduction
-from spiralid.sysid.polynomials import format_pole_radius
+from spiralid.sysid.models.polynomials import format_pole_radius
 
 __all__ = [
     "OUTPUT_FILES",

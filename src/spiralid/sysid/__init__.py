@@ -1,46 +1,49 @@
-"""Parametric system identification: data, ARX structures, the paper's cost,
-estimation and validation."""
+"""Parametric system identification, in the order the work flows: records
+(`data`, `spectra`) -> model structures (`models`) -> estimation
+(`estimation`: the paper's cost, parametrisations, estimators, `identify`)
+-> validation (`validation`). Each subpackage imports only from those
+before it."""
 
 # --- core (data, arx, cost, identify) ---
-from .arx import ARX as ARX
-from .arx import arx_least_squares as arx_least_squares
-from .cost import PaperCost as PaperCost
 from .data import IOData as IOData
-from .estimators import METHODS as METHODS
-from .estimators import EstimatorResult as EstimatorResult
-from .identify import identify as identify
-from .model import IdentifiedModel as IdentifiedModel
-from .outputerror import steiglitz_mcbride as steiglitz_mcbride
-from .parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
-from .parametrizations import default_bounds as default_bounds
-from .polynomials import fold_reflection as fold_reflection
-from .polynomials import format_pole_radius as format_pole_radius
-from .polynomials import is_stable_polynomial as is_stable_polynomial
-from .polynomials import max_pole_radius as max_pole_radius
-from .polynomials import random_stable_polynomial as random_stable_polynomial
-from .polynomials import step_down as step_down
-from .polynomials import step_up as step_up
+from .estimation.cost import PaperCost as PaperCost
+from .estimation.estimators import METHODS as METHODS
+from .estimation.estimators import EstimatorResult as EstimatorResult
+from .estimation.identify import identify as identify
+from .estimation.outputerror import steiglitz_mcbride as steiglitz_mcbride
+from .estimation.parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
+from .estimation.parametrizations import default_bounds as default_bounds
+from .models.arx import ARX as ARX
+from .models.arx import arx_least_squares as arx_least_squares
+from .models.identified import IdentifiedModel as IdentifiedModel
+from .models.polynomials import fold_reflection as fold_reflection
+from .models.polynomials import format_pole_radius as format_pole_radius
+from .models.polynomials import is_stable_polynomial as is_stable_polynomial
+from .models.polynomials import max_pole_radius as max_pole_radius
+from .models.polynomials import random_stable_polynomial as random_stable_polynomial
+from .models.polynomials import step_down as step_down
+from .models.polynomials import step_up as step_up
 
 # --- validation (validate, plots) ---
 # isort: split
-from .correlation import CorrelationTest as CorrelationTest
-from .correlation import independence_test as independence_test
-from .correlation import whiteness_test as whiteness_test
 from .spectra import find_resonances as find_resonances
 from .spectra import modes_from_poles as modes_from_poles
 from .spectra import psd as psd
-from .validate import Realization as Realization
-from .validate import Validation as Validation
-from .validate import fit_percent as fit_percent
-from .validate import realization_tests as realization_tests
-from .validate import validate as validate
+from .validation.correlation import CorrelationTest as CorrelationTest
+from .validation.correlation import independence_test as independence_test
+from .validation.correlation import whiteness_test as whiteness_test
+from .validation.validate import Realization as Realization
+from .validation.validate import Validation as Validation
+from .validation.validate import fit_percent as fit_percent
+from .validation.validate import realization_tests as realization_tests
+from .validation.validate import validate as validate
 
 # The modal search's building blocks, loaded on first use (identify loads
 # them itself when a method needs them).
 _LAZY = {
-    "ModalParametrization": ".modal",
-    "ProjectedCost": ".varpro",
-    "projected_spiral": ".memetic",
+    "ModalParametrization": ".estimation.modal",
+    "ProjectedCost": ".estimation.varpro",
+    "projected_spiral": ".estimation.memetic",
 }
 
 
@@ -50,7 +53,7 @@ def __getattr__(name: str):
     # `plots` needs matplotlib, which is slow to import and not needed to
     # identify or validate a model: load it on first use only.
     if name == "plots":
-        return importlib.import_module(".plots", __name__)
+        return importlib.import_module(".validation.plots", __name__)
     if name in _LAZY:
         return getattr(importlib.import_module(_LAZY[name], __name__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

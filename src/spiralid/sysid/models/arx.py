@@ -30,10 +30,14 @@ import numba
 import numpy as np
 from scipy import signal
 
-from .data import IOData, check_signal
+from ..data import IOData, check_signal
 from .polynomials import is_stable_polynomial
 
-__all__ = ["ARX", "arx_least_squares"]
+__all__ = ["ARX", "INITIAL_CONDITIONS", "arx_least_squares"]
+
+# How a free run starts: from rest (zero past samples) or from the record's
+# first measured samples.
+INITIAL_CONDITIONS = ("rest", "measured")
 
 
 def _order(value, name: str, minimum: int) -> int:

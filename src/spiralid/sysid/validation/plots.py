@@ -13,8 +13,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..spectra import PSD, Modes, Peaks
 from .correlation import CorrelationTest
-from .spectra import PSD, Modes, Peaks
 
 __all__ = [
     "plot_convergence",
@@ -114,8 +114,8 @@ def plot_time_response(
 def plot_residual_tests(*tests: CorrelationTest) -> Figure:
     """Residual correlations with their confidence bands, one axes per test.
 
-    Each test (from :func:`~spiralid.sysid.correlation.whiteness_test` or
-    :func:`~spiralid.sysid.correlation.independence_test`) is drawn as stems
+    Each test (from :func:`~spiralid.sysid.validation.correlation.whiteness_test` or
+    :func:`~spiralid.sysid.validation.correlation.independence_test`) is drawn as stems
     with dashed ``+-z/sqrt(N)`` bands for each of its levels, and its verdict
     in the title, as MATLAB's ``resid`` lays them out. When the test's
     ``band_scale`` differs from 1 (coloured input and residual), the
@@ -129,7 +129,7 @@ def plot_residual_tests(*tests: CorrelationTest) -> Figure:
     Examples
     --------
     >>> import numpy as np
-    >>> from spiralid.sysid.correlation import independence_test, whiteness_test
+    >>> from spiralid.sysid import independence_test, whiteness_test
     >>> rng = np.random.default_rng(0)
     >>> u, e = rng.standard_normal(500), rng.standard_normal(500)
     >>> fig = plot_residual_tests(whiteness_test(e), independence_test(u, e))

@@ -8,7 +8,7 @@ identified model and reports, in one :class:`Validation`:
   the free-run simulation (the paper's validation, Figure-3) and, labelled
   separately, the one-step prediction;
 * residual analysis: whiteness of the residual and its independence from the
-  input, with 95 % and 99 % bands (:mod:`spiralid.sysid.correlation`);
+  input, with 95 % and 99 % bands (:mod:`spiralid.sysid.validation.correlation`);
 * frequency domain: Welch spectra of measured and modelled output and their
   resonance peaks, and the model's own modes from its poles
   (:mod:`spiralid.sysid.spectra`; the paper's Figure-7c);
@@ -24,15 +24,19 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+from ..data import check_pair
+from ..models.polynomials import (
+    format_pole_radius,
+    is_stable_polynomial,
+    max_pole_radius,
+)
+from ..spectra import PSD, Modes, Peaks, find_resonances, modes_from_poles, psd
 from .correlation import (
     CorrelationTest,
     check_lags,
     independence_test,
     whiteness_test,
 )
-from .data import check_pair
-from .polynomials import format_pole_radius, is_stable_polynomial, max_pole_radius
-from .spectra import PSD, Modes, Peaks, find_resonances, modes_from_poles, psd
 
 __all__ = [
     "Realization",
@@ -282,11 +286,11 @@ class Validation:
         Lightly damped modes of the model, from its poles.
     stable : bool
         All poles strictly inside the unit circle: spiralid's one stability
-        verdict (:func:`~spiralid.sysid.polynomials.is_stable_polynomial`,
+        verdict (:func:`~spiralid.sysid.models.polynomials.is_stable_polynomial`,
         the same as ``model.is_stable`` and the cost's penalty).
     max_pole_radius : float
         Largest ``|p|``, on the verdict's side of the unit circle
-        (:func:`~spiralid.sysid.polynomials.max_pole_radius`).
+        (:func:`~spiralid.sysid.models.polynomials.max_pole_radius`).
     realization : Realization
         Controllability / observability of the state-space realisation.
     poles, zeros : ndarray of complex
@@ -613,86 +617,19 @@ def validate(
     hardly decays. Pass ``warmup`` to validate such a model from the state
     it has reached.
     """
-    if not all(hasattr(model, k) for k in ("simulate", "predict", "arx", "theta")):
-        raise ValueError(
-            "`model` must be an IdentifiedModel (from identify() or "
-            f"IdentifiedModel.from_dict); got {type(model).__name__}"
-        )
-    u, y, ts = _signals_of(data)
+    u, y, ts, lags, predictor = _valid_inputs(model, data, lags, residuals)
     n = y.size
-    # Checked here too (the correlation tests would) so a bad `lags` fails
-    # before the simulation and spectra are computed.
-    lags = check_lags(lags, n)
-    if residuals not in _RESIDUALS:
-        raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
-    model_ts = getattr(model, "ts", None)
-    if model_ts is not None and not np.isclose(float(model_ts), ts, rtol=1e-9):
-        raise ValueError(
-            f"`data` sample time must match the model's ts = {float(model_ts)!r}; "
-            f"got ts = {ts!r}"
-        )
-
-    predictor = getattr(model, "predictor", None) or "simulation"
-    if predictor not in _RESIDUALS:
-        raise ValueError(
-            f"`model.predictor` must be one of {_RESIDUALS}; got {predictor!r}"
-        )
-    if isinstance(gain, str) and gain == "auto":
-        rms_y = float(np.sqrt(np.mean(y**2)))
-        if rms_y == 0.0:
-            raise ValueError(
-                "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
-                "100 sqrt(K) / rms(y))"
-            )
-        w = 100.0 * np.sqrt(n) / rms_y
-    elif isinstance(gain, str) and gain == "model":
-        w = float(getattr(model, "gain", np.nan))
-        if not (np.isfinite(w) and w > 0):
-            raise ValueError(
-                f"`gain` 'model' needs a model with a finite positive gain; got {w!r}"
-            )
-    elif isinstance(gain, str):
-        raise ValueError(
-            f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
-        )
-    else:
-        try:
-            w = float(gain)
-        except (TypeError, ValueError):
-            w = float("nan")
-        if not (np.isfinite(w) and w > 0):
-            raise ValueError(
-                f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
-            )
+    w = _gain(gain, model, y)
     penalty = float(getattr(model, "penalty", 1e6))
     poles = np.asarray(_attr(model, "poles"), dtype=complex)
     zeros = np.asarray(_attr(model, "zeros"), dtype=complex)
     # The one stability verdict (Schur-Cohn on the coefficients, see
-    # spiralid.sysid.polynomials), not |np.roots| < 1, which misjudges
+    # spiralid.sysid.models.polynomials), not |np.roots| < 1, which misjudges
     # clustered poles near the circle.
     denominator = np.asarray(model.theta, dtype=float)[: model.arx.na]
     stable = bool(is_stable_polynomial(denominator))
     max_radius = float(max_pole_radius(denominator))
-
-    if warmup is None:
-        y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
-        y_pred = np.asarray(model.predict(data), dtype=float).ravel()
-    else:
-        wu, wy, wts = _signals_of(warmup, "warmup")
-        if not np.isclose(wts, ts, rtol=1e-9):
-            raise ValueError(
-                f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
-            )
-        whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
-        y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[wu.size :]
-        y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[wu.size :]
-    if y_sim.size == n and not np.all(np.isfinite(y_sim)):
-        raise ValueError(
-            f"`model` is unstable (max |pole| = {format_pole_radius(max_radius)}) "
-            "and its free-run "
-            f"output overflows on this record of N = {n} samples; a free-run "
-            "validation of it is meaningless"
-        )
+    y_sim, y_pred, start = _responses(model, data, warmup, max_radius)
     y, y_sim = check_pair(y, y_sim, "data.y", "model.simulate(data.u)")
     y, y_pred = check_pair(y, y_pred, "data.y", "model.predict(data)")
     e_sim, e_pred = y - y_sim, y - y_pred
@@ -703,13 +640,9 @@ def validate(
     cost = w * np.sqrt(np.sum(e_cost**2)) / n + (0.0 if stable else penalty)
 
     e_test = e_pred if residuals == "one-step" else e_sim
-    white = whiteness_test(e_test, lags, levels)
-    indep = independence_test(u, e_test, lags, levels)
-
     fs = 1.0 / ts
     spec_y = psd(y, fs, nperseg=nperseg)
     spec_m = psd(y_sim, fs, nperseg=nperseg)
-
     num, den = model.arx.polynomials(model.theta)
     label = label if label is not None else str(getattr(model, "method", "") or "")
 
@@ -726,8 +659,8 @@ def validate(
         error_range=(float(e_sim.min()), float(e_sim.max())),
         error_range_one_step=(float(e_pred.min()), float(e_pred.max())),
         residuals=residuals,
-        whiteness=white,
-        independence=indep,
+        whiteness=whiteness_test(e_test, lags, levels),
+        independence=independence_test(u, e_test, lags, levels),
         psd_measured=spec_y,
         psd_model=spec_m,
         peaks_measured=find_resonances(spec_y, n_peaks),
@@ -738,7 +671,7 @@ def validate(
         realization=realization_tests(num, den),
         poles=poles,
         zeros=zeros,
-        t=(np.arange(n) + (0 if warmup is None else wu.size)) * ts,
+        t=(np.arange(n) + start) * ts,
         u=u,
         y=y,
         y_sim=y_sim,
@@ -746,3 +679,88 @@ def validate(
         output_name=str(getattr(data, "output_name", "output")),
         output_unit=str(getattr(data, "output_unit", "")),
     )
+
+
+def _valid_inputs(model, data, lags, residuals):
+    """`validate`'s argument checks: the signals, ``lags`` and the predictor,
+    before any simulation or spectrum is computed."""
+    if not all(hasattr(model, k) for k in ("simulate", "predict", "arx", "theta")):
+        raise ValueError(
+            "`model` must be an IdentifiedModel (from identify() or "
+            f"IdentifiedModel.from_dict); got {type(model).__name__}"
+        )
+    u, y, ts = _signals_of(data)
+    # Checked here too (the correlation tests would) so a bad `lags` fails
+    # before the simulation and spectra are computed.
+    lags = check_lags(lags, y.size)
+    if residuals not in _RESIDUALS:
+        raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
+    model_ts = getattr(model, "ts", None)
+    if model_ts is not None and not np.isclose(float(model_ts), ts, rtol=1e-9):
+        raise ValueError(
+            f"`data` sample time must match the model's ts = {float(model_ts)!r}; "
+            f"got ts = {ts!r}"
+        )
+    predictor = getattr(model, "predictor", None) or "simulation"
+    if predictor not in _RESIDUALS:
+        raise ValueError(
+            f"`model.predictor` must be one of {_RESIDUALS}; got {predictor!r}"
+        )
+    return u, y, ts, lags, predictor
+
+
+def _gain(gain, model, y: np.ndarray) -> float:
+    """The gain ``w`` of eq. (2) on the validation record (see `validate`)."""
+    if isinstance(gain, str) and gain == "auto":
+        rms_y = float(np.sqrt(np.mean(y**2)))
+        if rms_y == 0.0:
+            raise ValueError(
+                "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
+                "100 sqrt(K) / rms(y))"
+            )
+        return 100.0 * np.sqrt(y.size) / rms_y
+    if isinstance(gain, str) and gain == "model":
+        w = float(getattr(model, "gain", np.nan))
+        if not (np.isfinite(w) and w > 0):
+            raise ValueError(
+                f"`gain` 'model' needs a model with a finite positive gain; got {w!r}"
+            )
+        return w
+    try:
+        w = float(gain) if not isinstance(gain, str) else float("nan")
+    except (TypeError, ValueError):
+        w = float("nan")
+    if not (np.isfinite(w) and w > 0):
+        raise ValueError(
+            f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
+        )
+    return w
+
+
+def _responses(model, data, warmup, max_radius: float):
+    """The model's free run and one-step prediction over ``data`` (after
+    ``warmup`` when given), and the index of ``data``'s first sample in the
+    run."""
+    u, y, ts = _signals_of(data)
+    if warmup is None:
+        y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
+        y_pred = np.asarray(model.predict(data), dtype=float).ravel()
+        start = 0
+    else:
+        wu, wy, wts = _signals_of(warmup, "warmup")
+        if not np.isclose(wts, ts, rtol=1e-9):
+            raise ValueError(
+                f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
+            )
+        whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
+        start = wu.size
+        y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[start:]
+        y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[start:]
+    if y_sim.size == u.size and not np.all(np.isfinite(y_sim)):
+        raise ValueError(
+            f"`model` is unstable (max |pole| = {format_pole_radius(max_radius)}) "
+            "and its free-run "
+            f"output overflows on this record of N = {u.size} samples; a free-run "
+            "validation of it is meaningless"
+        )
+    return y_sim, y_pred, start

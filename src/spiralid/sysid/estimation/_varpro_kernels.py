@@ -1,8 +1,8 @@
 """Compiled kernel of the variable-projection cost (private).
 
-Loaded by :mod:`spiralid.sysid.varpro` on first use only, so that
+Loaded by :mod:`spiralid.sysid.estimation.varpro` on first use only, so that
 ``import spiralid`` does not pay for Numba. Candidates lie along the fast
-axis (as in :mod:`spiralid.sysid.cost`): the filter recursion is a serial
+axis (as in :mod:`spiralid.sysid.estimation.cost`): the filter recursion is a serial
 chain in time, so the work vectorises across candidates.
 """
 

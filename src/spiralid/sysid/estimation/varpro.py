@@ -32,10 +32,10 @@ from __future__ import annotations
 import numpy as np
 from scipy import optimize
 
-from .arx import ARX
+from ..data import IOData
+from ..models.arx import ARX
+from ..models.polynomials import is_stable_polynomial
 from .cost import PaperCost
-from .data import IOData
-from .polynomials import is_stable_polynomial
 
 __all__ = ["ProjectedCost", "gauss_newton_polish"]
 
@@ -235,7 +235,7 @@ def gauss_newton_polish(
     cost : ProjectedCost
     parametrization
         Has ``bounds`` (na, 2), ``to_denominator(x)`` and ``jacobian(x)``
-        (``d a / d x``), e.g. :class:`~spiralid.sysid.modal.ModalParametrization`.
+        (``d a / d x``), e.g. :class:`~spiralid.sysid.ModalParametrization`.
     x0 : array_like, shape (na,)
         Start, inside the box (a stable denominator).
     max_nfev : int

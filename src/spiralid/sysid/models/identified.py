@@ -8,9 +8,8 @@ from typing import Any
 import numpy as np
 from scipy import signal
 
-from .arx import ARX
-from .cost import INITIAL_CONDITIONS
-from .data import IOData
+from ..data import IOData
+from .arx import ARX, INITIAL_CONDITIONS
 from .polynomials import max_pole_radius
 
 __all__ = ["IdentifiedModel"]
@@ -42,7 +41,7 @@ class IdentifiedModel:
         The paper's cost, eq. (2)-(3), of ``theta`` on the estimation data.
     result : EstimatorResult or None
         What the estimator returned
-        (:class:`~spiralid.sysid.estimators.EstimatorResult`, an
+        (:class:`~spiralid.sysid.estimation.estimators.EstimatorResult`, an
         ``OptimizeResult`` whose ``x`` is ``theta``; ``status`` says whether
         it stopped at an evaluation cap, ``start`` which start ``"oe"`` kept);
         ``None`` after :meth:`from_dict`.
@@ -118,13 +117,13 @@ class IdentifiedModel:
     @property
     def is_stable(self) -> bool:
         """Every pole strictly inside the unit circle: spiralid's one
-        stability verdict (see :mod:`spiralid.sysid.polynomials`)."""
+        stability verdict (see :mod:`spiralid.sysid.models.polynomials`)."""
         return bool(self.arx.is_stable(self.theta))
 
     @property
     def max_pole_radius(self) -> float:
         """Largest ``|pole|``, on the verdict's side of the unit circle
-        (:func:`~spiralid.sysid.polynomials.max_pole_radius`)."""
+        (:func:`~spiralid.sysid.models.polynomials.max_pole_radius`)."""
         return float(max_pole_radius(self.theta[: self.arx.na]))
 
     def tf_string(self, digits: int = 4) -> str:

@@ -7,7 +7,7 @@ with the denominator searched as reflection coefficients
 ``k = KMAX tanh(z)``, ``KMAX = 1 - 1e-6``, so every step is stable
 (unstable poles of a start are first reflected into the unit circle,
 ``z -> 1 / conj(z)``). :func:`steiglitz_mcbride` gives the classical
-output-error start. The estimators (:mod:`spiralid.sysid.estimators`) run
+output-error start. The estimators (:mod:`spiralid.sysid.estimation.estimators`) run
 the polish from several starts and keep the lowest cost.
 """
 
@@ -16,10 +16,10 @@ from __future__ import annotations
 import numpy as np
 from scipy import optimize, signal
 
-from .arx import ARX, arx_least_squares
-from .data import IOData
+from ..data import IOData
+from ..models.arx import ARX, arx_least_squares
+from ..models.polynomials import step_up
 from .parametrizations import KMAX, stabilise
-from .polynomials import step_up
 
 __all__ = ["local_polish", "steiglitz_mcbride"]
 

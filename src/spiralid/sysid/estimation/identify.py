@@ -3,15 +3,15 @@
 The entry point only checks its arguments and dispatches; the pieces live
 in modules named for what they hold, each depending only on those above it:
 
-- :mod:`~spiralid.sysid.parametrizations`: what a search moves
+- :mod:`~spiralid.sysid.estimation.parametrizations`: what a search moves
   (``"coefficients"``, ``"reflection"``), its box, initial points and map to
   the ARX theta; the table ``PARAMETRIZATIONS``.
-- :mod:`~spiralid.sysid.outputerror`: the Levenberg-Marquardt polish and
+- :mod:`~spiralid.sysid.estimation.outputerror`: the Levenberg-Marquardt polish and
   Steiglitz-McBride.
-- :mod:`~spiralid.sysid.estimators`: one function per method, the table
+- :mod:`~spiralid.sysid.estimation.estimators`: one function per method, the table
   ``METHODS``, the result type ``EstimatorResult``, the budget rule and the
   safe start.
-- :mod:`~spiralid.sysid.model`: :class:`IdentifiedModel`.
+- :mod:`~spiralid.sysid.models.identified`: :class:`IdentifiedModel`.
 
 Initial condition of the simulation (``initial``)
 -------------------------------------------------
@@ -39,11 +39,11 @@ import numpy as np
 
 from spiralid._checks import generator
 
-from .arx import ARX
+from ..data import IOData
+from ..models.arx import ARX
+from ..models.identified import IdentifiedModel
 from .cost import PaperCost
-from .data import IOData
 from .estimators import DEFAULT_METHOD, METHODS, Problem
-from .model import IdentifiedModel
 from .outputerror import steiglitz_mcbride
 from .parametrizations import (
     default_bounds,
@@ -115,14 +115,14 @@ def identify(
     arx : ARX
         Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6).
     method : str, default "spiral"
-        A key of :data:`spiralid.sysid.estimators.METHODS`: ``"spiral"``
+        A key of :data:`spiralid.sysid.estimation.estimators.METHODS`: ``"spiral"``
         (the recommended spiral identification: Eb-SDA over the modes with
         the numerator projected out, a memetic Levenberg-Marquardt polish,
         restarts and safe starts; it reaches the output-error optimum, see
         the README), ``"ebsda"``, ``"sda"``, ``"lasda"`` (the paper's spiral
         searches), ``"de"`` (SciPy's differential evolution over the same
         cost, box and initial points, a baseline), ``"ls"`` or ``"oe"`` (see
-        :mod:`spiralid.sysid.estimators`). ``"ls"`` minimises the one-step
+        :mod:`spiralid.sysid.estimation.estimators`). ``"ls"`` minimises the one-step
         error and ``"oe"`` the simulation error whatever `predictor` says;
         `predictor` then only selects the reported cost.
     predictor : {"simulation", "one-step"}
@@ -130,7 +130,7 @@ def identify(
         error or the one-step prediction error.
     parametrization : str, optional
         What a search moves, a key of
-        :data:`spiralid.sysid.parametrizations.PARAMETRIZATIONS`:
+        :data:`spiralid.sysid.estimation.parametrizations.PARAMETRIZATIONS`:
         ``"coefficients"`` (the paper's), ``"reflection"`` (stable by
         construction) or ``"modal"`` (the denominator's modes, numerator
         projected out; simulation error from rest only). Default: the
@@ -156,7 +156,7 @@ def identify(
         Seed a search's first population with the stabilised least-squares
         estimate and the zero model, and let ``refine`` start from least
         squares and Steiglitz-McBride too, so the result is never worse than
-        either (see :mod:`spiralid.sysid.estimators`). Default: the method's
+        either (see :mod:`spiralid.sysid.estimation.estimators`). Default: the method's
         (off for the paper's ``"sda"``, ``"ebsda"`` and for ``"lasda"``,
         ``"de"``). Ignored by ``"ls"`` and ``"oe"``.
     **optimiser_options
@@ -164,13 +164,13 @@ def identify(
         ``max_nfev``, ``target``, ``callback``, ``bounds_policy``, ``x0``...);
         for ``"de"`` only ``n_points``, ``max_iter``, ``max_nfev``, ``x0`` and
         ``callback``. A budget ``max_nfev`` without ``max_iter`` is the stop
-        (:func:`~spiralid.sysid.estimators.search_options`).
+        (:func:`~spiralid.sysid.estimation.estimators.search_options`).
 
     Returns
     -------
     IdentifiedModel
         Its ``result`` is the estimator's
-        :class:`~spiralid.sysid.estimators.EstimatorResult`.
+        :class:`~spiralid.sysid.estimation.estimators.EstimatorResult`.
 
     Examples
     --------

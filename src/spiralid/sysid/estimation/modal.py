@@ -35,8 +35,8 @@ from itertools import combinations
 
 import numpy as np
 
-from .arx import _order
-from .data import _check_ts
+from ..data import _check_ts
+from ..models.arx import _order
 
 __all__ = ["ModalParametrization"]
 

@@ -31,7 +31,7 @@ How we read it (DESIGN.md items 2-3):
 
 - ``predictor="one-step"``: ``e`` is the equation (one-step prediction)
   error ``y - Phi theta`` over the ``K = N - t0`` samples ``t >= t0``,
-  whose regressors are all measured (see :mod:`spiralid.sysid.arx`);
+  whose regressors are all measured (see :mod:`spiralid.sysid.models.arx`);
   least squares is its exact minimiser. ``initial`` does not affect it.
 - ``gain="auto"`` sets ``w = 100 sqrt(K) / rms(y)`` (rms over the same
   ``K`` samples), so ``f`` is the RMS error as a percentage of the RMS of
@@ -52,14 +52,13 @@ import numba
 import numpy as np
 from scipy.signal import lfilter, lfiltic
 
-from .arx import ARX
-from .data import IOData
-from .polynomials import is_stable_polynomial
+from ..data import IOData
+from ..models.arx import ARX, INITIAL_CONDITIONS
+from ..models.polynomials import is_stable_polynomial
 
 __all__ = ["INITIAL_CONDITIONS", "PaperCost"]
 
 _PREDICTORS = ("simulation", "one-step")
-INITIAL_CONDITIONS = ("rest", "measured")
 
 
 class PaperCost:

@@ -12,14 +12,14 @@ Methods
 :data:`spiralid.optim.RULES`)
     The spiral optimisers of :func:`spiralid.optim.minimize` over the
     paper's cost :class:`~spiralid.sysid.PaperCost` (eq. (2)-(3)), in a
-    parametrisation of :mod:`spiralid.sysid.parametrizations`.
+    parametrisation of :mod:`spiralid.sysid.estimation.parametrizations`.
 ``"de"``
     SciPy's differential evolution over the same cost, box and initial
     points (:func:`spiralid.optim.differential_evolution`), a baseline.
 ``"ls"``
     Least squares, the exact minimiser of the one-step error.
 ``"oe"``
-    Output error (:mod:`spiralid.sysid.outputerror`): Levenberg-Marquardt on
+    Output error (:mod:`spiralid.sysid.estimation.outputerror`): Levenberg-Marquardt on
     the simulation error from the least-squares and the Steiglitz-McBride
     starts, keeping the lower estimation cost.
 
@@ -85,9 +85,9 @@ from scipy import optimize
 from spiralid._checks import integer
 from spiralid.optim import RULES, differential_evolution, minimize
 
-from .arx import ARX, arx_least_squares
+from ..data import IOData
+from ..models.arx import ARX, arx_least_squares
 from .cost import PaperCost
-from .data import IOData
 from .outputerror import local_polish, steiglitz_mcbride
 from .parametrizations import DEFAULT_PARAMETRIZATION, Parametrization
 
@@ -419,9 +419,9 @@ def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
     only approximate poles it cannot represent). Then `n_peaks` points at
     the frequency response's peaks, then the caller's `x0`.
     """
+    from ..models.polynomials import step_up
     from .memetic import frequency_seeds
     from .parametrizations import stabilise
-    from .polynomials import step_up
 
     par, arx = problem.parametrization, problem.arx
     rows, safe = [], None
@@ -459,11 +459,11 @@ def _estimate_recommended(
 
     A spiral search (`rule`, default Eb-SDA) over the modal coordinates of
     the denominator with the numerator projected out
-    (:class:`~spiralid.sysid.parametrizations.Modal`), its centre polished
+    (:class:`~spiralid.sysid.estimation.parametrizations.Modal`), its centre polished
     every `polish_every` iterations by `polish_nfev` evaluations of
     Levenberg-Marquardt on the projected problem, a fresh population after
     `restart_after` iterations without progress
-    (:func:`~spiralid.sysid.memetic.projected_spiral`), `frequency_seeds`
+    (:func:`~spiralid.sysid.estimation.memetic.projected_spiral`), `frequency_seeds`
     initial points at the frequency response's peaks, and with the safe
     start the stabilised least-squares, Steiglitz-McBride and zero models in
     the first population (the result is never worse than their projected

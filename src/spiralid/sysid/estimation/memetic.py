@@ -3,14 +3,14 @@ memetic local step, and starts from the measured frequency response.
 
 :func:`projected_spiral` runs a spiral optimiser
 (:class:`spiralid.optim.SpiralSearch`) over the coordinates of a
-denominator parametrisation (e.g. :class:`~spiralid.sysid.modal.
+denominator parametrisation (e.g. :class:`~spiralid.sysid.estimation.modal.
 ModalParametrization`), scoring each candidate with
-:class:`~spiralid.sysid.varpro.ProjectedCost` (the paper's cost at the
+:class:`~spiralid.sysid.estimation.varpro.ProjectedCost` (the paper's cost at the
 least-squares numerator). Two optional ingredients:
 
 - ``polish_every=k``: every ``k`` iterations (and once at the end) the
   centre is polished by a few Levenberg-Marquardt steps of the projected
-  problem (:func:`~spiralid.sysid.varpro.gauss_newton_polish`) and moved to
+  problem (:func:`~spiralid.sysid.estimation.varpro.gauss_newton_polish`) and moved to
   the polished point if that is better: a memetic algorithm (a population
   search with individual learning; Moscato 1989). The spiral moves then
   rotate about the polished centre.
@@ -33,8 +33,8 @@ from scipy import optimize, signal
 from spiralid._checks import integer
 from spiralid.optim import SpiralSearch
 
-from .data import IOData
-from .spectra import PSD, default_nperseg, find_resonances
+from ..data import IOData
+from ..spectra import PSD, default_nperseg, find_resonances
 from .varpro import ProjectedCost, gauss_newton_polish
 
 __all__ = ["frequency_seeds", "projected_spiral"]

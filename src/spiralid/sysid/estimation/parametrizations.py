@@ -4,7 +4,7 @@ A parametrisation maps the searched coordinates ``x`` to the ARX parameter
 vector ``theta = [a_1..a_na, b_0..b_(nb-1)]`` that the cost, the model and
 every result hold. Each one knows its default search box, its stable initial
 points, its map to theta and back (the back map seeds a search with a known
-model, see the safe start in :mod:`spiralid.sysid.estimators`).
+model, see the safe start in :mod:`spiralid.sysid.estimation.estimators`).
 
 ``"coefficients"`` (paper-faithful; the default)
     ``x = theta``: the optimiser moves the raw coefficients and unstable
@@ -13,17 +13,17 @@ model, see the safe start in :mod:`spiralid.sysid.estimators`).
     recursion, so every initial point is stable ("feasible").
 ``"modal"`` (numerator projected out)
     ``x`` = the denominator's modes, ``[f_1..f_S, log10 zeta_1..log10
-    zeta_S, p_1..p_R]`` (:class:`~spiralid.sysid.modal.ModalParametrization`:
+    zeta_S, p_1..p_R]`` (:class:`~spiralid.sysid.estimation.modal.ModalParametrization`:
     second-order sections in natural frequency (Hz) and log damping ratio,
     stable by construction), and no numerator: for every candidate
     denominator the numerator is the least-squares solution of the
-    simulation error from rest (:class:`~spiralid.sysid.varpro.ProjectedCost`),
+    simulation error from rest (:class:`~spiralid.sysid.ProjectedCost`),
     so a search moves ``na`` coordinates, not ``na + nb``. Only for the
     simulation error from rest (the cost's ``predictor="simulation"``,
     ``initial="rest"``).
 ``"reflection"`` (beyond the paper)
     ``x = [k_1..k_na, b]``; each ``k`` is folded into ``(-1, 1)``
-    (:func:`~spiralid.sysid.polynomials.fold_reflection`, clipped to
+    (:func:`~spiralid.sysid.models.polynomials.fold_reflection`, clipped to
     ``KMAX = 1 - 1e-6``) and mapped by step-up, so every candidate is stable
     and the penalty never fires. The initial points are uniform in the box.
 
@@ -57,9 +57,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from .arx import ARX, arx_least_squares
-from .data import IOData
-from .polynomials import fold_reflection, step_down, step_up
+from ..data import IOData
+from ..models.arx import ARX, arx_least_squares
+from ..models.polynomials import fold_reflection, step_down, step_up
 
 __all__ = [
     "DEFAULT_PARAMETRIZATION",
@@ -230,7 +230,7 @@ class Modal(Parametrization):
         return self.arx.na
 
     def projected(self, cost=None):
-        """The :class:`~spiralid.sysid.varpro.ProjectedCost` of this record,
+        """The :class:`~spiralid.sysid.estimation.varpro.ProjectedCost` of this record,
         with `cost`'s gain and penalty (default: the paper's defaults)."""
         from .varpro import ProjectedCost
 

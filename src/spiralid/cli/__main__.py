@@ -1,0 +1,7 @@
+"""``python -m spiralid.cli``."""
+
+import sys
+
+from . import main
+
+sys.exit(main())

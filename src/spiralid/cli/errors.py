@@ -1,0 +1,73 @@
+"""How the command reports: one-line errors, warnings and interrupts."""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+import warnings
+
+
+class UsageError(Exception):
+    """A problem with what the user asked for: exit 2 with one line."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports a bad argument in one line, not usage + error."""
+
+    def error(self, message: str):  # type: ignore[override]
+        raise UsageError(message)
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that partial output is cleaned up."""
+
+
+def _on_sigterm(signum, frame):
+    raise _Terminated
+
+
+# Library messages name arguments as the code does (in backticks); the
+# command line says them as the user typed them.
+_USER_WORDS = {
+    "data": "the data",
+    "path": "DATA",
+    "u": "the input",
+    "y": "the output",
+    "ts": "--ts",
+    "input": "--input",
+    "output": "--output",
+    "fraction": "--fraction",
+    "na": "--na",
+    "nb": "--nb",
+    "nk": "--nk",
+    "n_points": "--points",
+    "max_iter": "--iterations",
+    "max_nfev": "--budget",
+    "rng": "--seed",
+    "lags": "the number of residual-test lags (25)",
+}
+
+
+def _user_message(exc: BaseException) -> str:
+    """One line in the command line's words, without NumPy scalar reprs."""
+    text = " ".join(str(exc).split())
+    text = re.sub(r"np\.(?:float|int|uint|bool_?)\d*\(([^()]*)\)", r"\1", text)
+    text = re.sub(r"`([^`]+)`", lambda m: _USER_WORDS.get(m[1], m[1]), text)
+    # Bare keyword names, as in "must be >= 2 * n_points".
+    return re.sub(
+        r"\b(n_points|max_iter|max_nfev)\b", lambda m: _USER_WORDS[m[1]], text
+    )
+
+
+def _show_warnings(prefix: str, quiet: bool) -> None:
+    """Warnings as one line each, once; none at all with --quiet."""
+    if quiet:
+        warnings.simplefilter("ignore")
+        return
+    warnings.simplefilter("once")
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"{prefix}: warning: {_user_message(message)}", file=sys.stderr)
+
+    warnings.showwarning = show

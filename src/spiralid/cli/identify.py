@@ -1,0 +1,158 @@
+"""``spiralid identify``: estimate a model on a record and validate it."""
+
+from __future__ import annotations
+
+import json
+
+from .errors import UsageError
+from .options import (
+    _add_data_options,
+    _add_detrend_option,
+    _add_initial_option,
+    _detrended,
+    _fraction,
+    _HelpFormatter,
+    _listing,
+    _load_data,
+    _nonneg_int,
+    _open_folder,
+    _positive_int,
+    _save_figures,
+)
+
+
+def _structure(args):
+    from spiralid.sysid import ARX
+
+    return ARX(args.na, args.nb, args.nk)
+
+
+def run(args, argv: list[str]) -> int:
+    from spiralid.sysid import METHODS, identify, validate
+    from spiralid.sysid.validation.plots import plot_convergence
+
+    data = _load_data(args)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
+    arx = _structure(args)
+    est, val = data.split(args.fraction)
+    arx.check_length(est, "estimation part of DATA")
+    options = {}
+    if METHODS[args.method].search:
+        # The budget rule is identify()'s (estimators.search_options).
+        options = {"n_points": args.points, "max_nfev": args.budget}
+        if args.iterations is not None:
+            options["max_iter"] = args.iterations
+    elif args.refine:
+        searches = ", ".join(name for name, m in METHODS.items() if m.search)
+        raise UsageError(f"--refine applies to the search methods {searches}")
+    with _open_folder(args.out, args.force) as folder:
+        model = identify(
+            est,
+            arx,
+            method=args.method,
+            predictor=args.predictor,
+            initial=args.initial,
+            parametrization=args.parametrization,
+            refine=args.refine,
+            rng=args.seed,
+            **options,
+        )
+        v_est = validate(model, est, label=f"{args.method} (estimation)")
+        v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
+        staged = folder.path
+        (staged / "model.json").write_text(json.dumps(model.to_dict(), indent=2))
+        (staged / "validation.json").write_text(
+            json.dumps(
+                {"estimation": v_est.to_dict(), "validation": v_val.to_dict()},
+                indent=2,
+            )
+        )
+        summary = "\n\n".join(
+            [
+                f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}",
+                f"estimation cost (eq. 2): {model.cost:.6g}",
+                v_est.summary(),
+                v_val.summary(),
+            ]
+        )
+        (staged / "summary.txt").write_text(summary + "\n")
+        _save_figures(v_val.plot(), staged, "validation_")
+        _save_figures(v_est.plot(), staged, "estimation_")
+        if model.history is not None:
+            plot_convergence(
+                {args.method: model.history},
+                cost_label="best cost, eq. (2) (% of rms(y))",
+            ).savefig(staged / "convergence.png", dpi=110)
+        written = folder.commit(last="model.json")
+    if not args.quiet:
+        print(summary)
+        print(f"\nwrote {_listing(written, args.out)}")
+    return 0
+
+
+def add_parser(sub) -> None:
+    from spiralid.sysid.estimation.estimators import DEFAULT_METHOD, METHODS
+    from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS
+
+    p = sub.add_parser(
+        "identify",
+        formatter_class=_HelpFormatter,
+        help="identify an ARX model from a data file",
+        description="Estimate an ARX model on the first --fraction of DATA and "
+        "validate it on the rest; write model.json, validation.json, "
+        "summary.txt and figures into --out.",
+    )
+    p.add_argument(
+        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+    )
+    _add_data_options(p)
+    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
+    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
+    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
+    p.add_argument(
+        "--method",
+        choices=list(METHODS),
+        default=DEFAULT_METHOD,
+        help="estimator: a search over the paper's cost, least squares or output error",
+    )
+    p.add_argument(
+        "--predictor",
+        choices=["simulation", "one-step"],
+        default="simulation",
+        help="error of the cost: free-run simulation or one-step prediction",
+    )
+    p.add_argument(
+        "--parametrization",
+        choices=list(PARAMETRIZATIONS),
+        default=None,
+        help="what a search moves: the ARX coefficients (the paper), the "
+        "denominator's reflection coefficients or modal frequencies and dampings "
+        "(every candidate stable); default the method's own (modal for spiral)",
+    )
+    _add_initial_option(p)
+    _add_detrend_option(p)
+    p.add_argument(
+        "--refine", action="store_true", help="polish a spiral result locally"
+    )
+    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+    p.add_argument(
+        "--iterations",
+        type=_positive_int,
+        default=None,
+        help="max iterations (default 500, or no cap below --budget)",
+    )
+    p.add_argument(
+        "--budget", type=_positive_int, default=None, help="max cost evaluations"
+    )
+    p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
+    p.add_argument(
+        "--fraction",
+        type=_fraction,
+        default="2/3",
+        help="share of the record that estimates; the rest validates",
+    )
+    p.add_argument("--out", default="spiralid-identify", help="output directory")
+    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
+    p.add_argument("--quiet", action="store_true", help="print nothing")
+    p.set_defaults(run=run)

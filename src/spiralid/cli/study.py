@@ -1,0 +1,182 @@
+"""``spiralid study`` and ``spiralid study-report``: studies on Dask."""
+
+from __future__ import annotations
+
+import shlex
+from pathlib import Path
+
+from .errors import UsageError
+from .options import (
+    _positive_int,
+    _progress,
+)
+
+
+def _dask_missing() -> bool:
+    from importlib.util import find_spec
+
+    return find_spec("distributed") is None
+
+
+def _cmd_study(args, argv: list[str]) -> int:
+    from spiralid.study import DEFAULT_SPEC, load_spec, run_study
+
+    if args.show_default:
+        print(DEFAULT_SPEC.read_text(encoding="utf-8"), end="")
+        return 0
+    spec = load_spec(args.spec)
+    out = Path(args.out)
+    store = Path(args.store) if args.store is not None else out / STUDY_STORE
+    _check_study_dir(out, store, args.force)
+    if args.engine == "dask" and _dask_missing():
+        raise UsageError(
+            "the study command runs on Dask: pip install 'spiralid[study]' "
+            "(or pass --engine processes)"
+        )
+    if args.scheduler is not None and args.engine != "dask":
+        raise UsageError("--scheduler needs --engine dask")
+    bar = _progress(args, 1, "study")
+    try:
+        run = run_study(
+            spec,
+            store,
+            engine=args.engine,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            progress=bar,
+        )
+    finally:
+        bar.close()
+    if not args.quiet:
+        print(
+            f"{run.total} runs: {run.reused} already in {store}, "
+            f"{run.computed} computed now, {len(run.failures)} failed"
+        )
+    if not args.no_report:
+        _study_report(store, out, args, argv)
+    if run.failures:
+        task, message = run.failures[0]
+        raise UsageError(
+            f"{len(run.failures)} runs failed and were not stored (rerun to retry); "
+            f"first: {task.label} on {task.data}, {task.predictor}, seed "
+            f"{task.seed}: {message}"
+        )
+    return 0
+
+
+def _study_report(store: Path, out: Path, args, argv: list[str]) -> None:
+    from spiralid.report.study_output import study_summary, write_study_report
+    from spiralid.study import ResultStore, analyse, parse_spec
+
+    with ResultStore.open(store, readonly=True) as db:
+        rows, spec_text = db.rows(), db.meta().get("spec", "")
+    res = analyse(rows, parse_spec(spec_text, where=f"the specification in {store}"))
+    written = write_study_report(
+        res,
+        out,
+        spec_text=spec_text,
+        force=True,
+        command="spiralid " + shlex.join(argv),
+    )
+    if not args.quiet:
+        print(study_summary(res))
+        print(f"\nwrote {', '.join(p.name for p in written)} in {out}")
+
+
+def _cmd_study_report(args, argv: list[str]) -> int:
+    store = Path(args.store)
+    if not store.is_file():
+        raise UsageError(f"store {args.store!r} does not exist")
+    out = Path(args.out) if args.out is not None else store.parent
+    _check_study_dir(out, store, args.force)
+    _study_report(store, out, args, argv)
+    return 0
+
+
+STUDY_STORE = "study.sqlite"
+
+
+def _check_study_dir(out: Path, store: Path, force: bool) -> None:
+    """Refuse an output folder holding anything but this study's own files.
+
+    A rerun of a study (to resume it) finds its store and its earlier report
+    there: those it may replace; anything else needs --force.
+    """
+    from spiralid.report.study_output import STUDY_FILES
+
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {str(out)!r} is a file, not a directory")
+    if not out.is_dir() or force:
+        return
+    own = {*STUDY_FILES, store.name, store.name + ".lock"}
+    foreign = sorted(p.name for p in out.iterdir() if p.name not in own)
+    if foreign:
+        raise UsageError(
+            f"--out {str(out)!r} holds files that are not this study's "
+            f"({', '.join(foreign[:3])}); choose another or pass --force"
+        )
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "study",
+        help="a study over every reading of the paper's cost, on Dask, resumable",
+        description="Run every optimiser of SPEC (a TOML file; default the "
+        "paper's grid) on every reading (record x predictor x parametrisation) "
+        "and seed, on a Dask cluster; each finished run is committed to a SQLite "
+        "store, so rerunning the same command after an interruption computes "
+        "only what is missing. Then write the 'where the claim holds' report.",
+    )
+    p.add_argument("spec", nargs="?", default=None, help="study specification (TOML)")
+    p.add_argument(
+        "--show-default",
+        action="store_true",
+        help="print the default specification (the paper's grid) and exit",
+    )
+    p.add_argument("--out", default="spiralid-study", help="output directory")
+    p.add_argument(
+        "--store",
+        default=None,
+        help=f"SQLite result store (default OUT/{STUDY_STORE})",
+    )
+    p.add_argument(
+        "--engine",
+        choices=["dask", "processes", "local"],
+        default="dask",
+        help="where runs execute: a Dask cluster (default), a process pool, or "
+        "this process",
+    )
+    p.add_argument(
+        "--scheduler",
+        default=None,
+        help="address of a running Dask scheduler (default: start a LocalCluster)",
+    )
+    p.add_argument(
+        "--workers",
+        type=_positive_int,
+        default=None,
+        help="worker processes of the local cluster (default: CPU count)",
+    )
+    p.add_argument("--no-report", action="store_true", help="only run and store")
+    p.add_argument(
+        "--force", action="store_true", help="write into an --out with other files"
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    p.set_defaults(run=_cmd_study)
+
+    p = sub.add_parser(
+        "study-report",
+        help="the report of a study's store",
+        description="Analyse a study's SQLite store: per reading, Eb-SDA "
+        "against SDA (rank-sum test, A12, Holm correction), convergence bands, "
+        "results.json and report.html.",
+    )
+    p.add_argument("store", help="SQLite store written by `spiralid study`")
+    p.add_argument(
+        "--out", default=None, help="output directory (default: the store's folder)"
+    )
+    p.add_argument(
+        "--force", action="store_true", help="write into an --out with other files"
+    )
+    p.add_argument("--quiet", action="store_true", help="print nothing")
+    p.set_defaults(run=_cmd_study_report)

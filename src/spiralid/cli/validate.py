@@ -1,0 +1,87 @@
+"""``spiralid validate``: validate a saved model on a record."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from .errors import UsageError
+from .options import (
+    _add_data_options,
+    _add_detrend_option,
+    _detrended,
+    _fraction,
+    _HelpFormatter,
+    _listing,
+    _load_data,
+    _open_folder,
+    _save_figures,
+)
+
+
+def run(args, argv: list[str]) -> int:
+    from spiralid.sysid import IdentifiedModel, validate
+
+    path = Path(args.model)
+    if not path.is_file():
+        raise UsageError(f"model file {args.model!r} does not exist")
+    try:
+        model = IdentifiedModel.from_dict(json.loads(path.read_text()))
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        message = " ".join(str(exc).split())
+        raise UsageError(
+            f"{args.model!r} is not a valid spiralid model file ({message})"
+        ) from None
+    # The data's own sample time wins; validate() refuses one that differs
+    # from the model's. Only a file without one borrows the model's.
+    data = _load_data(args, default_ts=model.ts)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
+    if args.fraction is not None:
+        warm, data = data.split(args.fraction)
+    else:
+        warm = None
+    if args.out is None:
+        v = validate(model, data, warmup=warm, label=model.method)
+        if not args.quiet:
+            print(v.summary())
+        return 0
+    with _open_folder(args.out, args.force) as folder:
+        v = validate(model, data, warmup=warm, label=model.method)
+        (folder.path / "validation.json").write_text(json.dumps(v.to_dict(), indent=2))
+        (folder.path / "summary.txt").write_text(v.summary() + "\n")
+        _save_figures(v.plot(), folder.path)
+        written = folder.commit(last="validation.json")
+    if not args.quiet:
+        print(v.summary())
+        print(f"\nwrote {_listing(written, args.out)}")
+    return 0
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "validate",
+        formatter_class=_HelpFormatter,
+        help="validate a saved model on a data file",
+        description="Fit %, error range, residual tests, spectra, modes, "
+        "stability and realisation tests of MODEL on DATA.",
+    )
+    p.add_argument("model", help="model.json written by `spiralid identify`")
+    p.add_argument(
+        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+    )
+    _add_data_options(p)
+    p.add_argument(
+        "--fraction",
+        type=_fraction,
+        default=None,
+        help="run the model over the whole record but score only the part after "
+        "this share (e.g. 2/3 for the validation third); default: score all",
+    )
+    _add_detrend_option(p)
+    p.add_argument(
+        "--out", default=None, help="directory for validation.json and figures"
+    )
+    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
+    p.add_argument("--quiet", action="store_true", help="print nothing")
+    p.set_defaults(run=run)
