@@ -180,6 +180,22 @@ def test_identify_least_squares_on_the_real_arm(tmp_path):
     assert abs(val["fit_percent"] - 95.0) <= 1.0
 
 
+def test_identify_an_fir_model_with_the_default_method(tmp_path):
+    # `--na 0` has no denominator for the modal search: the default method
+    # solves the FIR model exactly, as output error does.
+    proc = run("identify", "robot_arm", "--na", "0", "--out", "fir", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    model = IdentifiedModel.from_dict(
+        json.loads((tmp_path / "fir" / "model.json").read_text())
+    )
+    assert (model.arx.na, model.method) == (0, "spiral")
+    oe = run("identify", "robot_arm", "--na", "0", "--method", "oe", "--out", "oe",
+             cwd=tmp_path)  # fmt: skip
+    assert oe.returncode == 0, oe.stderr
+    oe_model = json.loads((tmp_path / "oe" / "model.json").read_text())
+    assert model.cost == pytest.approx(oe_model["cost"], rel=1e-9)
+
+
 def _reproduce_ok(tmp_path, *extra):
     out = tmp_path / "rep"
     proc = run(

@@ -46,6 +46,7 @@ from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS, Problem
 from .outputerror import steiglitz_mcbride
 from .parametrizations import (
+    DEFAULT_PARAMETRIZATION,
     default_bounds,
     feasible_initial_points,
     make_parametrization,
@@ -191,6 +192,10 @@ def identify(
         raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
     if parametrization is None:
         parametrization = METHODS[method].parametrization
+        if arx.na == 0 and parametrization == "modal":
+            # An FIR model has no modes; the recommended method solves it
+            # exactly over the coefficients (see `_estimate_fir`).
+            parametrization = DEFAULT_PARAMETRIZATION
     par = make_parametrization(parametrization, data, arx)
     _check_options(method, optimiser_options)
     if safe_start is not None and not isinstance(safe_start, bool | np.bool_):
