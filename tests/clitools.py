@@ -1,6 +1,7 @@
 """Running the `spiralid` console script as a user would (a subprocess)."""
 
 import os
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -24,8 +25,18 @@ def run(*args, cwd, env=None, timeout=600):
     )
 
 
-def start(*args, cwd, env=None) -> subprocess.Popen:
-    """Start ``spiralid ARGS`` in `cwd` without waiting."""
+def _as_from_a_terminal() -> None:
+    # A shell starts background jobs with SIGINT ignored, and the command
+    # keeps an ignored SIGINT (as every Unix program should): reset it, so
+    # that these tests see what a user at a terminal sees however pytest
+    # itself was started.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def start(*args, cwd, env=None, new_group=False) -> subprocess.Popen:
+    """Start ``spiralid ARGS`` in `cwd` without waiting; with `new_group`,
+    in a process group of its own (as a shell's job: Ctrl-C signals the
+    whole group, workers included)."""
     return subprocess.Popen(
         [str(SCRIPT), *map(str, args)],
         cwd=cwd,
@@ -33,4 +44,6 @@ def start(*args, cwd, env=None) -> subprocess.Popen:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=_as_from_a_terminal,
+        process_group=0 if new_group else None,
     )

@@ -32,7 +32,7 @@ def _wait_for(predicate, proc: subprocess.Popen, timeout: float = 120.0):
 
 
 def _staged_png(parent: Path) -> bool:
-    return any(parent.glob(".spiralid-staging-rep-*/*.png"))
+    return any(parent.glob(".spiralid-staging-*-rep-*/*.png"))
 
 
 def _nothing_left(parent: Path) -> bool:

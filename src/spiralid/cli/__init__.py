@@ -18,11 +18,11 @@ import argparse
 import signal
 import sys
 import warnings
+from contextlib import contextmanager
 
 from . import identify, reproduce, simulate, study, validate
 from .errors import (
     UsageError,
-    _on_sigterm,
     _Parser,
     _show_warnings,
     _Terminated,
@@ -56,23 +56,54 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the ``spiralid`` command; return its exit status."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser = build_parser()
     command = argv[0] if argv and not argv[0].startswith("-") else None
     prefix = f"spiralid {command}" if command else "spiralid"
-    try:
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
-    except ValueError:  # not the main thread: leave SIGTERM alone
-        previous = None
-    try:
+    with _interrupts() as interrupted:
         with warnings.catch_warnings():
-            return _run(parser, argv, prefix)
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+            status = _run(argv, prefix)
+        if interrupted() and status not in (130, 143):
+            # Ctrl-C after the work was done (or swallowed on its way up):
+            # still one line and the status a shell expects.
+            print(f"{prefix}: interrupted", file=sys.stderr)
+            status = 130
+    return status
 
 
-def _run(parser, argv: list[str], prefix: str) -> int:
+@contextmanager
+def _interrupts():
+    """SIGINT raises KeyboardInterrupt, SIGTERM `_Terminated`, and both are
+    remembered, so that one arriving at any moment ends in one line and exit
+    status 130 (143); the previous handlers come back on leaving."""
+    received: list[int] = []
+
+    def on_signal(signum, frame):
+        received.append(signum)
+        if signum == signal.SIGTERM:
+            raise _Terminated
+        raise KeyboardInterrupt
+
+    previous = {}
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        try:
+            if signal.getsignal(signum) == signal.SIG_IGN:
+                # Ignored by whoever started us (a background job of a
+                # script, nohup): keep it so, as Python itself does.
+                continue
+            previous[signum] = signal.signal(signum, on_signal)
+        except ValueError:  # not the main thread: leave the signals alone
+            pass
     try:
+        yield lambda: bool(received)
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _run(argv: list[str], prefix: str) -> int:
+    try:
+        # Inside the try: building the parser imports the library, and a
+        # Ctrl-C during that import is one line like any other.
+        parser = build_parser()
         args = parser.parse_args(argv)
         _show_warnings(prefix, getattr(args, "quiet", False))
         if args.command is None:

@@ -23,10 +23,6 @@ class _Terminated(KeyboardInterrupt):
     """SIGTERM, raised like Ctrl-C so that partial output is cleaned up."""
 
 
-def _on_sigterm(signum, frame):
-    raise _Terminated
-
-
 # Library messages name arguments as the code does (in backticks); the
 # command line says them as the user typed them.
 _USER_WORDS = {

@@ -4,10 +4,9 @@ the record the options describe."""
 from __future__ import annotations
 
 import argparse
+import math
 from dataclasses import replace
 from pathlib import Path
-
-import numpy as np
 
 from .errors import UsageError
 
@@ -48,7 +47,7 @@ def _number(kind: type, allowed: str, ok):
                 else "a number"
             )
             raise argparse.ArgumentTypeError(f"must be {what}; got {text!r}") from None
-        if not (np.isfinite(value) and ok(value)):
+        if not (math.isfinite(value) and ok(value)):
             raise argparse.ArgumentTypeError(f"must be {allowed}; got {text!r}")
         return value
 
@@ -184,7 +183,11 @@ def _load(path: str, input, output, ts, default_ts: float | None = None):
         if output is None:
             output = "end_acceleration_m_s2" if written_by_us else "y"
         ts_file = _csv_sample_time(file, header) if "time_s" in header else None
-        if ts is not None and ts_file is not None and not np.isclose(ts, ts_file):
+        if (
+            ts is not None
+            and ts_file is not None
+            and not math.isclose(ts, ts_file, rel_tol=1e-5, abs_tol=1e-8)
+        ):
             raise UsageError(
                 f"--ts {ts:g} contradicts the time_s column of {path!r} (steps of "
                 f"{ts_file:g} s); leave --ts out or correct the file"
@@ -234,6 +237,8 @@ _UNITS = {
 
 def _csv_sample_time(file: Path, header: list[str]) -> float:
     """The step of an evenly spaced ``time_s`` column."""
+    import numpy as np
+
     t = np.loadtxt(
         file,
         delimiter=",",

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from .errors import UsageError
 from .options import (
     _HelpFormatter,
@@ -74,6 +72,8 @@ def _simulate_record(args):
 
 
 def _write_record(rec, path: Path, suffix: str) -> None:
+    import numpy as np
+
     columns = {
         "time_s": rec.t,
         "torque_Nm": rec.u,

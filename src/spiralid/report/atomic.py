@@ -47,6 +47,88 @@ def _why(exc: OSError) -> str:
     return exc.strerror or str(exc)
 
 
+def _umask() -> int:
+    """The process's umask, read without changing it where Linux allows."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _publish_mode(path: Path, directory: bool) -> None:
+    """Give a staged file or folder the mode a plain ``open``/``mkdir`` would
+    have given it under the user's umask (staging uses private 0600/0700
+    temporaries, which would otherwise make the output unreadable to
+    others)."""
+    base = 0o777 if directory else 0o666
+    os.chmod(path, base & ~_umask())
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # alive, another user's
+        return True
+    return True
+
+
+def _staging_prefix() -> str:
+    # The process id in the name tells a later run whether its writer is
+    # still alive (see _remove_stale).
+    return f"{_STAGING}{os.getpid()}-"
+
+
+def _remove_stale(folder: Path) -> list[str]:
+    """Remove what killed runs left in `folder`: lock files nobody holds and
+    staging files or folders whose process is gone. Returns their names."""
+    removed = []
+    for lock in folder.glob(f"{_LOCK}*"):
+        try:
+            fd = os.open(lock, os.O_RDWR)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)  # held: a live run
+            continue
+        with contextlib.suppress(OSError):
+            os.unlink(lock)
+            removed.append(lock.name)
+        os.close(fd)
+    for staged in folder.glob(f"{_STAGING}*"):
+        pid = staged.name[len(_STAGING) :].split("-", 1)[0]
+        if pid.isdigit() and _pid_alive(int(pid)):
+            continue
+        if staged.is_dir():
+            shutil.rmtree(staged, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                staged.unlink()
+        removed.append(staged.name)
+    return removed
+
+
+def _note_stale(folder: Path) -> None:
+    removed = _remove_stale(folder)
+    if removed:
+        import warnings
+
+        warnings.warn(
+            f"removed {len(removed)} file(s) left in {str(folder)!r} by a spiralid "
+            f"run that was killed ({', '.join(sorted(removed)[:3])})",
+            stacklevel=3,
+        )
+
+
 @contextlib.contextmanager
 def _signals_deferred():
     """Hold SIGINT/SIGTERM while the staged files move into place."""
@@ -215,12 +297,14 @@ class OutputFolder(_Staged):
             # Checked again under the lock: a run that finished meanwhile
             # has filled the target.
             self._check_target()
-            self._remove_stale_staging()
+            _note_stale(t.parent)
             if t.is_dir():
                 self._probe(t)
             try:
                 self.path = Path(
-                    tempfile.mkdtemp(prefix=f"{_STAGING}{t.name}-", dir=t.parent)
+                    tempfile.mkdtemp(
+                        prefix=f"{_staging_prefix()}{t.name}-", dir=t.parent
+                    )
                 )
             except OSError as exc:
                 raise OutputError(
@@ -233,19 +317,13 @@ class OutputFolder(_Staged):
 
     def _probe(self, folder: Path) -> None:
         try:
-            fd, name = tempfile.mkstemp(prefix=_STAGING, dir=folder)
+            fd, name = tempfile.mkstemp(prefix=_staging_prefix(), dir=folder)
         except OSError as exc:
             raise OutputError(
                 f"output folder {str(folder)!r} is not writable: {_why(exc)}"
             ) from None
         os.close(fd)
         os.unlink(name)
-
-    def _remove_stale_staging(self) -> None:
-        # Only the lock holder stages for this target, so any staging folder
-        # of it is from a run that was killed (SIGKILL, power loss).
-        for p in self.target.parent.glob(f"{_STAGING}{self.target.name}-*"):
-            shutil.rmtree(p, ignore_errors=True)
 
     # -- committing ---------------------------------------------------------------
 
@@ -262,6 +340,10 @@ class OutputFolder(_Staged):
         if last in names:
             names.remove(last)
             names.append(last)
+        for name in names:
+            if (self.path / name).is_dir():
+                _publish_mode(self.path / name, directory=True)
+        _publish_mode(self.path, directory=True)
         with _signals_deferred():
             try:
                 if not t.exists():
@@ -318,8 +400,12 @@ class OutputFile(_Staged):
         if t.exists() and not self.force:
             self._refuse_existing()
         self._created = _make_parents(t.parent)
+        if not self._created:
+            _note_stale(t.parent)
         try:
-            fd, tmp = tempfile.mkstemp(prefix=_STAGING, suffix=t.suffix, dir=t.parent)
+            fd, tmp = tempfile.mkstemp(
+                prefix=_staging_prefix(), suffix=t.suffix, dir=t.parent
+            )
         except OSError as exc:
             self.close()
             raise OutputError(f"cannot write {str(t)!r}: {_why(exc)}") from None
@@ -331,6 +417,7 @@ class OutputFile(_Staged):
         """Move the written temporary file into place; return the target."""
         if self.path is None:
             raise RuntimeError("commit() needs an open OutputFile")
+        _publish_mode(self.path, directory=False)
         with _signals_deferred():
             try:
                 if self.force:

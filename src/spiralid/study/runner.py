@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 import multiprocessing
 import os
+import signal
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
@@ -56,12 +57,85 @@ class StudyRun:
     failures: list[tuple[Task, str]] = field(default_factory=list)
 
 
+@contextmanager
+def _children_without_sigint():
+    """Processes started inside the block never see SIGINT.
+
+    Ctrl-C sends SIGINT to the whole process group: workers that received it
+    would each print a KeyboardInterrupt traceback. The signal is blocked
+    while they are spawned (a blocked mask survives fork and exec, so they
+    start with it blocked and never act on it); the parent stops them
+    itself. A Ctrl-C that arrives meanwhile stays pending and reaches this
+    process when the block ends.
+    """
+    try:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    except (AttributeError, ValueError):  # no pthreads / not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _die_with_parent(parent: int) -> None:
+    """Have the kernel kill this worker when `parent`, the process that
+    started it, dies (Linux's PR_SET_PDEATHSIG), so that `kill -9` of a run
+    leaves no idle workers behind; elsewhere a watchdog thread polls the
+    parent. A parent that died while this worker was still starting is
+    noticed too (the worker has been handed to another process by then)."""
+    if os.getppid() != parent:
+        os._exit(1)
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        pr_set_pdeathsig = 1
+        if libc.prctl(pr_set_pdeathsig, signal.SIGKILL) == 0:
+            if os.getppid() != parent:  # the parent died before the call
+                os._exit(1)
+            return
+    except (OSError, AttributeError):
+        pass
+    import threading
+    import time
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def _start_worker(parent: int, initializer: Callable | None, initargs: tuple) -> None:
+    """Every pool worker's first act: ignore Ctrl-C (the parent stops the
+    workers; the block of `_children_without_sigint` covers their start-up)
+    and die with the parent, then the caller's initializer (e.g. compiling
+    the kernels)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent(parent)
+    if initializer is not None:
+        initializer(*initargs)
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Stop a pool's workers now, without waiting for their running tasks."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    for process in processes:
+        process.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.join(timeout=5)
+
+
 def _dask_client(scheduler: str | None, workers: int | None):
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
         return Client(scheduler), None
-    with _single_threaded_blas():
+    with _single_threaded_blas(), _children_without_sigint():
         cluster = LocalCluster(
             n_workers=workers or os.cpu_count() or 1,
             threads_per_worker=1,
@@ -132,18 +206,23 @@ def _single_threaded_blas():
 
 
 def _execute_processes(tasks, records, workers, detail, initializer, initargs):
-    with (
-        _single_threaded_blas(),
-        ProcessPoolExecutor(
+    with _single_threaded_blas(), _children_without_sigint():
+        pool = ProcessPoolExecutor(
             max_workers=workers or os.cpu_count() or 1,
             mp_context=multiprocessing.get_context("spawn"),
-            initializer=initializer,
-            initargs=initargs,
-        ) as pool,
-    ):
+            initializer=_start_worker,
+            initargs=(os.getpid(), initializer, initargs),
+        )
         futures = {pool.submit(run_task, t, records[t.data], detail): t for t in tasks}
+    try:
         for fut in as_completed(futures):
             yield futures[fut], _outcome(fut)
+    except BaseException:
+        # Ctrl-C, SIGTERM, a closed generator: the workers ignore SIGINT, so
+        # the parent stops them.
+        _stop_workers(pool)
+        raise
+    pool.shutdown(wait=True)
 
 
 def execute(
