@@ -5,13 +5,14 @@ nothing behind; a second run into the same folder is refused while the first
 writes; an unwritable folder is refused before any computation.
 """
 
+import os
 import signal
 import subprocess
 import time
 from pathlib import Path
 
 import pytest
-from clitools import run, start
+from clitools import SCRIPT, cli_env, run, start
 
 from spiralid import cli
 
@@ -123,3 +124,111 @@ def test_unwritable_folder_refused_before_computing(
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "not writable" in err[0]
     assert list(immutable_folder.iterdir()) == []
+
+
+# -- Ctrl-C to the whole job, worker processes, stale files, file modes ------
+
+POOLED = ("reproduce", "--seeds", "2", "--budget", "3000", "--points", "20")
+POOLED += ("--workers", "2", "--quiet")
+
+
+def _group_alive(pgid: int) -> list[int]:
+    found = subprocess.run(["pgrep", "-g", str(pgid)], capture_output=True, text=True)
+    return [int(p) for p in found.stdout.split()]
+
+
+def _gone(pgid: int, timeout: float = 10.0) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if not _group_alive(pgid):
+            return True
+        time.sleep(0.1)
+    return False
+
+
+@pytest.mark.parametrize("moment", ["start-up", "workers starting", "computing"])
+def test_ctrl_c_to_the_job_is_one_line_and_stops_every_worker(tmp_path, moment):
+    # What a terminal's Ctrl-C does: SIGINT to every process of the job.
+    proc = start(*POOLED, "--out", "rep", cwd=tmp_path, new_group=True)
+    if moment == "start-up":
+        time.sleep(0.05)
+    elif moment == "workers starting":
+        _wait_for(lambda: len(_group_alive(proc.pid)) > 1, proc)
+    else:
+        _wait_for(lambda: _staged_png(tmp_path) or _group_alive(proc.pid), proc)
+        time.sleep(2.0)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130
+    assert err.splitlines() == ["spiralid reproduce: interrupted"]
+    assert _gone(proc.pid)
+    assert _nothing_left(tmp_path)
+
+
+def test_ctrl_c_after_the_work_is_done_is_still_one_line(monkeypatch, capsys):
+    # A signal can arrive after the commit, or be swallowed by a library on
+    # its way up: the command still ends with one line and status 130.
+    def run(args, argv):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.1)
+        except KeyboardInterrupt:
+            pass
+        return 0
+
+    monkeypatch.setattr("spiralid.cli.simulate.run", run)
+    assert cli.main(["simulate"]) == 130
+    assert capsys.readouterr().err.splitlines() == ["spiralid simulate: interrupted"]
+
+
+def test_kill_9_leaves_no_worker_and_the_next_run_tidies_up(tmp_path):
+    proc = start(*POOLED, "--out", "rep", cwd=tmp_path, new_group=True)
+    _wait_for(lambda: len(_group_alive(proc.pid)) >= 3, proc)  # tracker + 2
+    proc.kill()
+    proc.wait()
+    assert _gone(proc.pid)
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left and all(name.startswith(".spiralid-") for name in left)
+    # Any later run writing beside them removes them, and says so in a line.
+    later = run("simulate", "--out", "rig.csv", cwd=tmp_path)
+    assert later.returncode == 0, later.stderr
+    assert len(later.stderr.splitlines()) == 1
+    assert "removed 2 file(s)" in later.stderr and "killed" in later.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rig.csv"]
+
+
+def test_study_on_dask_ctrl_c_is_one_line(tmp_path):
+    pytest.importorskip("distributed")
+    spec = run("study", "--show-default", cwd=tmp_path).stdout
+    spec = spec.replace("seeds = 20", "seeds = 2 #")
+    spec = spec.replace("budget = 20000", "budget = 2000 #")
+    (tmp_path / "s.toml").write_text(spec)
+    proc = start("study", "s.toml", "--out", "st", "--workers", "2", "--quiet",
+                 cwd=tmp_path, new_group=True)  # fmt: skip
+    _wait_for(lambda: (tmp_path / "st" / "study.sqlite").exists(), proc)
+    time.sleep(1.0)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130
+    assert err.splitlines() == ["spiralid study: interrupted"]
+    assert _gone(proc.pid)
+
+
+MODES = [(0o022, 0o644, 0o755), (0o077, 0o600, 0o700)]
+
+
+@pytest.mark.parametrize("mask, file_mode, dir_mode", MODES)
+def test_outputs_follow_the_umask(tmp_path, mask, file_mode, dir_mode):
+    def with_mask(*args):
+        return subprocess.run(
+            [str(SCRIPT), *args], cwd=tmp_path, env=cli_env(), umask=mask,
+            capture_output=True, text=True,
+        )  # fmt: skip
+
+    assert with_mask("simulate", "--out", "rig.csv", "--quiet").returncode == 0
+    made = with_mask("identify", "rig.csv", "--method", "ls", "--out", "m", "--quiet")
+    assert made.returncode == 0, made.stderr
+    assert (tmp_path / "rig.csv").stat().st_mode & 0o777 == file_mode
+    assert (tmp_path / "m").stat().st_mode & 0o777 == dir_mode
+    for p in (tmp_path / "m").iterdir():
+        assert p.stat().st_mode & 0o777 == file_mode, p.name

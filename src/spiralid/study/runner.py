@@ -58,25 +58,30 @@ class StudyRun:
 
 
 @contextmanager
-def _children_without_sigint():
-    """Processes started inside the block never see SIGINT.
+def _children_ignore_sigint():
+    """Processes spawned inside the block start with SIGINT ignored, and a
+    Ctrl-C meanwhile still reaches this process when the block ends.
 
     Ctrl-C sends SIGINT to the whole process group: workers that received it
-    would each print a KeyboardInterrupt traceback. The signal is blocked
-    while they are spawned (a blocked mask survives fork and exec, so they
-    start with it blocked and never act on it); the parent stops them
-    itself. A Ctrl-C that arrives meanwhile stays pending and reaches this
-    process when the block ends.
+    would each print a KeyboardInterrupt traceback, and the parent stops them
+    anyway. An ignored disposition is the signal state that survives spawn's
+    fork and exec (a blocked mask does not), so it is set while the workers
+    are spawned; the signal is blocked too, because Linux keeps a blocked
+    signal pending even when it is ignored, so that it is delivered to the
+    restored handler when the block ends. The workers keep ignoring it
+    (`_start_worker`).
     """
     try:
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     except (AttributeError, ValueError):  # no pthreads / not the main thread
         yield
         return
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def _die_with_parent(parent: int) -> None:
@@ -111,8 +116,7 @@ def _die_with_parent(parent: int) -> None:
 
 def _start_worker(parent: int, initializer: Callable | None, initargs: tuple) -> None:
     """Every pool worker's first act: ignore Ctrl-C (the parent stops the
-    workers; the block of `_children_without_sigint` covers their start-up)
-    and die with the parent, then the caller's initializer (e.g. compiling
+    workers) and die with the parent, then the caller's initializer (e.g. compiling
     the kernels)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _die_with_parent(parent)
@@ -135,13 +139,21 @@ def _dask_client(scheduler: str | None, workers: int | None):
 
     if scheduler is not None:
         return Client(scheduler), None
-    with _single_threaded_blas(), _children_without_sigint():
+    # A Ctrl-C interrupts the cluster's coroutines in this process, whose
+    # unretrieved exceptions asyncio would log as tracebacks when they are
+    # collected (this process runs no other asyncio code).
+    logging.getLogger("asyncio").setLevel(logging.CRITICAL)
+    with _single_threaded_blas():
         cluster = LocalCluster(
             n_workers=workers or os.cpu_count() or 1,
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
-            silence_logs=logging.ERROR,
+            # Errors reach us through the futures; the cluster's own log lines
+            # would only add tracebacks to a Ctrl-C.
+            silence_logs=logging.CRITICAL,
+            # Each worker ignores Ctrl-C; the client closes the cluster.
+            preload=["spiralid.study._dask_worker"],
         )
     return Client(cluster), cluster
 
@@ -206,7 +218,7 @@ def _single_threaded_blas():
 
 
 def _execute_processes(tasks, records, workers, detail, initializer, initargs):
-    with _single_threaded_blas(), _children_without_sigint():
+    with _single_threaded_blas(), _children_ignore_sigint():
         pool = ProcessPoolExecutor(
             max_workers=workers or os.cpu_count() or 1,
             mp_context=multiprocessing.get_context("spawn"),
