@@ -69,7 +69,9 @@ def _children_ignore_sigint():
     are spawned; the signal is blocked too, because Linux keeps a blocked
     signal pending even when it is ignored, so that it is delivered to the
     restored handler when the block ends. The workers keep ignoring it
-    (`_start_worker`).
+    (`_start_worker`). Known gap: threads started before the block (BLAS's)
+    do not block it, and the kernel may hand them a Ctrl-C of those few
+    milliseconds, which is then discarded; pressing Ctrl-C again works.
     """
     try:
         mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
