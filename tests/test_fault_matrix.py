@@ -250,3 +250,116 @@ def test_console_script_one_line_for_a_hostile_record(files):
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "rescaled" in proc.stderr
     assert not (files / "spiralid-identify").exists()
+
+
+# -- second fault round: limits, model files, messages ------------------------
+
+
+@pytest.fixture
+def more_files(files):
+    model = json.loads((files / "model.json").read_text())
+    for name, change in {
+        "nk_huge.json": {"nk": 10_000_000},
+        "nk_large.json": {"nk": 30_000},
+        "na_text.json": {"na": "x"},
+        "theta_huge.json": {"theta": [1e308, 0, 0, 0]},
+    }.items():
+        (files / name).write_text(json.dumps({**model, **change}))
+    (files / "latin1.json").write_bytes(b"\xff\xfe{}")
+    (files / "amodel").mkdir()
+    (files / "garbage.npz").write_bytes(b"hello world" * 10)
+    (files / "spec.toml").write_bytes(b"\xff\xfe seeds = 2")
+    cell = {"u": [1.0] * 600, "y": ["n_points", *[0.5] * 599]}
+    _csv(files / "cell.csv", cell)
+    return files
+
+
+SECOND_ROUND = [
+    ("validate nk_huge.json ok.csv --ts 0.01", "reaches 10000001 samples"),
+    ("validate nk_large.json ok.csv --ts 0.01", "more than the data's N = 600"),
+    ("validate na_text.json ok.csv --ts 0.01", "field 'na' must be an integer"),
+    ("validate theta_huge.json ok.csv --ts 0.01", "'theta' overflows"),
+    ("validate latin1.json ok.csv --ts 0.01", "is not UTF-8 text"),
+    ("validate amodel ok.csv --ts 0.01", "is a folder, not a model.json"),
+    ("identify garbage.npz", "is not a .npz archive"),
+    ("simulate --duration 1e9", "at most 10,000,000"),
+    ("simulate --fs 1e12", "shorten --duration or lower --fs"),
+    ("study spec.toml --engine local", "is not UTF-8 text"),
+    ("identify cell.csv --ts 0.01", "got 'n_points'"),
+]
+
+
+@pytest.mark.parametrize("line, words", SECOND_ROUND, ids=[c[0] for c in SECOND_ROUND])
+def test_second_round_faults_end_in_one_line(more_files, capsys, line, words):
+    argv = line.split()
+    if argv[0] in ("identify", "validate") and "--out" not in argv:
+        argv += ["--out", "out"]
+    if argv[0] == "study":
+        argv += ["--out", "st"]
+    before = _state(more_files)
+    assert cli.main(argv) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], err
+    assert "warning" not in err and "Traceback" not in err and out == ""
+    assert _state(more_files) == before
+
+
+def test_a_model_remembers_its_detrending(files, capsys):
+    data = IOData.from_csv(files / "ok.csv", ts=0.01)
+    _csv(files / "offset.csv", {"u": list(data.u + 3.0), "y": list(data.y - 40.0)})
+    common = ["--ts", "0.01", "--method", "ls", "--na", "2", "--nb", "2", "--nk", "1"]
+    made = ["identify", "offset.csv", *common, "--detrend", "--quiet"]
+    assert cli.main([*made, "--out", "a"]) == 0
+    model = json.loads((files / "a" / "model.json").read_text())
+    est = data.split(2 / 3)[0]
+    assert model["u_offset"] == pytest.approx(est.u.mean() + 3.0, rel=1e-12)
+    assert model["y_offset"] == pytest.approx(est.y.mean() - 40.0, rel=1e-12)
+    assert model["fraction"] == pytest.approx(2 / 3)
+    # Validated without --detrend, the recorded offsets are applied: the fit
+    # is the model's, not -1749 %.
+    check = ["validate", "a/model.json", "offset.csv", "--ts", "0.01", "--fraction"]
+    assert cli.main([*check, "2/3", "--out", "v"]) == 0
+    fit = json.loads((files / "v" / "validation.json").read_text())["fit_percent"]
+    assert fit > 95
+    # A model estimated without --detrend refuses it, with the reason.
+    assert cli.main(["identify", "offset.csv", *common, "--quiet", "--out", "b"]) == 0
+    capsys.readouterr()
+    assert cli.main(["validate", "b/model.json", "offset.csv", "--ts", "0.01",
+                     "--detrend"]) == 2  # fmt: skip
+    assert "estimated without it" in capsys.readouterr().err
+
+
+def test_model_file_is_byte_reproducible_and_timings_apart(files):
+    args = ["identify", "ok.csv", "--ts", "0.01", "--na", "2", "--nb", "2"]
+    args += ["--budget", "400", "--points", "10", "--quiet"]
+    assert cli.main([*args, "--out", "r1"]) == 0
+    assert cli.main([*args, "--out", "r2"]) == 0
+    one, two = (files / "r1" / "model.json"), (files / "r2" / "model.json")
+    assert one.read_bytes() == two.read_bytes()
+    assert "timings" not in json.loads(one.read_text())
+    assert set(json.loads((files / "r1" / "timings.json").read_text())) >= {"total"}
+
+
+def test_degenerate_models_get_order_advice():
+    from spiralid.sysid import IdentifiedModel, validate
+
+    rng = np.random.default_rng(1)
+    u = rng.standard_normal(600)
+    y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    data = IOData(u, y, ts=0.01)
+    # A common factor (1 - 0.5 z^-1) in numerator and denominator: ARX(3, 3, 1)
+    # holding an ARX(2, 2, 1) system, an exact cancellation.
+    a = np.convolve([1.0, -1.5, 0.7], [1.0, -0.5])
+    b = np.convolve([1.0, 0.5], [1.0, -0.5])
+    cancelled = IdentifiedModel(np.r_[a[1:], b], arx=ARX(3, 3, 1), ts=0.01,
+                                method="ls")  # fmt: skip
+    advice = validate(cancelled, data).order_advice
+    assert "cancel" in advice and "lower" in advice
+    # A vanishing last denominator coefficient: a pole at the origin.
+    vanishing = IdentifiedModel([-1.5, 0.7, 1e-18, 1.0, 0.5, 0.0], arx=ARX(3, 3, 1),
+                                ts=0.01, method="ls")  # fmt: skip
+    assert "origin" in validate(vanishing, data).summary()
+    plain = IdentifiedModel([-1.5, 0.7, 1.0, 0.5], arx=ARX(2, 2, 1), ts=0.01,
+                            method="ls")  # fmt: skip
+    assert validate(plain, data).order_advice is None

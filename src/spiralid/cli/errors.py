@@ -41,13 +41,25 @@ _USER_WORDS = {
     "max_iter": "--iterations",
     "max_nfev": "--budget",
     "rng": "--seed",
+    "duration": "--duration",
+    "fs": "--fs",
     "lags": "the number of residual-test lags (25)",
 }
 
 
 def _user_message(exc: BaseException) -> str:
-    """One line in the command line's words, without NumPy scalar reprs."""
+    """One line in the command line's words, without NumPy scalar reprs.
+
+    Only the message's own words are rewritten, never what it quotes from
+    the user (a CSV cell, a file name)."""
     text = " ".join(str(exc).split())
+    parts = re.split(r"""('[^']*'|"[^"]*")""", text)
+    return "".join(
+        part if i % 2 else _in_user_words(part) for i, part in enumerate(parts)
+    )
+
+
+def _in_user_words(text: str) -> str:
     text = re.sub(r"np\.(?:float|int|uint|bool_?)\d*\(([^()]*)\)", r"\1", text)
     text = re.sub(r"`([^`]+)`", lambda m: _USER_WORDS.get(m[1], m[1]), text)
     # Bare keyword names, as in "must be >= 2 * n_points".

@@ -61,7 +61,13 @@ def run(args, argv: list[str]) -> int:
         v_est = validate(model, est, label=f"{args.method} (estimation)")
         v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
         staged = folder.path
-        (staged / "model.json").write_text(json.dumps(model.to_dict(), indent=2))
+        model.fraction = args.fraction
+        # model.json holds what the seed decides, byte for byte the same on
+        # a rerun; the wall times go beside it.
+        (staged / "model.json").write_text(
+            json.dumps(model.to_dict(timings=False), indent=2)
+        )
+        (staged / "timings.json").write_text(json.dumps(model.timings, indent=2))
         (staged / "validation.json").write_text(
             json.dumps(
                 {"estimation": v_est.to_dict(), "validation": v_val.to_dict()},

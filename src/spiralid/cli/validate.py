@@ -19,24 +19,65 @@ from .options import (
 )
 
 
-def run(args, argv: list[str]) -> int:
-    from spiralid.sysid import IdentifiedModel, validate
+def _read_model(name: str):
+    """The model file, and whether it records its preprocessing (files
+    written before it did only know --detrend from the user)."""
+    from spiralid.sysid import IdentifiedModel
 
-    path = Path(args.model)
+    path = Path(name)
+    if path.is_dir():
+        raise UsageError(f"model file {name!r} is a folder, not a model.json")
     if not path.is_file():
-        raise UsageError(f"model file {args.model!r} does not exist")
+        raise UsageError(f"model file {name!r} does not exist")
     try:
-        model = IdentifiedModel.from_dict(json.loads(path.read_text()))
-    except (ValueError, KeyError, TypeError, AttributeError) as exc:
-        message = " ".join(str(exc).split())
+        fields = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise UsageError(f"model file {name!r} is not UTF-8 text") from None
+    except ValueError as exc:
         raise UsageError(
-            f"{args.model!r} is not a valid spiralid model file ({message})"
+            f"{name!r} is not a valid spiralid model file (not JSON: {exc})"
         ) from None
+    try:
+        model = IdentifiedModel.from_dict(fields)
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        message = " ".join(str(exc).split()).replace("`", "'")
+        raise UsageError(
+            f"{name!r} is not a valid spiralid model file ({message})"
+        ) from None
+    return model, "u_offset" in fields
+
+
+def _prepared_as_the_model(data, model, recorded: bool, args):
+    """`data` shifted by the offsets the model was estimated with, as its
+    file records them (with or without `--detrend`); for files that record
+    nothing, `--detrend` removes the means of the part before `--fraction`."""
+    if not recorded:
+        return _detrended(data, args.fraction) if args.detrend else data
+    if (model.u_offset, model.y_offset) == (0.0, 0.0):
+        if args.detrend:
+            raise UsageError(
+                "--detrend does not apply: the model was estimated without it"
+            )
+        return data
+    from dataclasses import replace
+
+    return replace(
+        data,
+        u=data.u - model.u_offset,
+        y=data.y - model.y_offset,
+        u_offset=data.u_offset + model.u_offset,
+        y_offset=data.y_offset + model.y_offset,
+    )
+
+
+def run(args, argv: list[str]) -> int:
+    from spiralid.sysid import validate
+
+    model, recorded = _read_model(args.model)
     # The data's own sample time wins; validate() refuses one that differs
     # from the model's. Only a file without one borrows the model's.
     data = _load_data(args, default_ts=model.ts)
-    if args.detrend:
-        data = _detrended(data, args.fraction)
+    data = _prepared_as_the_model(data, model, recorded, args)
     if args.fraction is not None:
         warm, data = data.split(args.fraction)
     else:

@@ -16,7 +16,7 @@ import numpy as np
 from spiralid._checks import is_integer, positive
 from spiralid.fms.rig import FlexibleManipulator, Recording
 from spiralid.fms.sensors import Sensors
-from spiralid.fms.signals import bang_bang
+from spiralid.fms.signals import _nsamples, bang_bang
 
 __all__ = ["Experiment", "paper_experiment"]
 
@@ -82,7 +82,7 @@ class Experiment:
         >>> u.size, float(u.max()), int(np.count_nonzero(u))
         (3000, 0.3, 240)
         """
-        u = np.zeros(round(self.duration * self.fs))
+        u = np.zeros(_nsamples(self.duration, self.fs))
         for j in range(self.n_pulses):
             u += (-1) ** j * bang_bang(
                 self.amplitude,

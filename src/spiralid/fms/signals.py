@@ -13,10 +13,21 @@ from spiralid._checks import is_integer, positive, real
 __all__ = ["bang_bang", "chirp", "prbs"]
 
 
+# A record holds the torque, three outputs and the time: five float64
+# signals of this many samples is 400 MB, as much as a record should need.
+MAX_SAMPLES = 10_000_000
+
+
 def _nsamples(duration: float, fs: float) -> int:
     duration = positive(duration, "duration")
     fs = positive(fs, "fs")
     n = round(duration * fs)
+    if n > MAX_SAMPLES:
+        raise ValueError(
+            f"`duration` x `fs` asks for {n:.3g} samples ({duration:g} s at "
+            f"{fs:g} Hz); at most {MAX_SAMPLES:,} (memory): shorten `duration` "
+            "or lower `fs`"
+        )
     if n < 1:
         raise ValueError(
             f"`duration` must span at least one sample at fs={fs}; got {duration!r}"

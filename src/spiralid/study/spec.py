@@ -165,7 +165,11 @@ def load_spec(path: str | Path | None = None) -> StudySpec:
         text = file.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise ValueError(f"study specification {str(file)!r} does not exist") from None
-    except (IsADirectoryError, UnicodeDecodeError, PermissionError) as exc:
+    except UnicodeDecodeError:
+        raise ValueError(
+            f"study specification {str(file)!r} is not UTF-8 text (TOML files are)"
+        ) from None
+    except OSError as exc:
         raise ValueError(
             f"study specification {str(file)!r} cannot be read: {exc.strerror or exc}"
         ) from None

@@ -394,6 +394,19 @@ class IOData:
         ``ts=None`` reads the sample time from a scalar array named ``ts``.
         """
         try:
+            with open(path, "rb") as fh:
+                magic = fh.read(4)
+        except OSError as exc:
+            raise ValueError(
+                f"{str(path)!r} is not a readable .npz file ({exc.strerror})"
+            ) from None
+        if magic != b"PK\x03\x04":
+            # np.load would take anything else for a pickle.
+            raise ValueError(
+                f"{str(path)!r} is not a .npz archive (a zip of .npy arrays, as "
+                "numpy.savez writes)"
+            )
+        try:
             with np.load(path, allow_pickle=False) as z:
                 mapping = dict(z.items())
         except ValueError as exc:

@@ -14,6 +14,8 @@ from .polynomials import max_pole_radius
 
 __all__ = ["IdentifiedModel"]
 
+_MAX_COEFFICIENT = 1e150
+
 
 @dataclass(eq=False)
 class IdentifiedModel:
@@ -73,6 +75,14 @@ class IdentifiedModel:
     output_name: str = "y"
     # Last, so positional construction keeps its meaning.
     initial: str = "rest"
+    # How the estimation record was prepared (IOData's units and the offsets
+    # a detrend removed), and which share of the record estimated: what
+    # `spiralid validate` needs to treat new data as the model's was.
+    input_unit: str = ""
+    output_unit: str = ""
+    u_offset: float = 0.0
+    y_offset: float = 0.0
+    fraction: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
@@ -89,6 +99,14 @@ class IdentifiedModel:
             bad = int(np.flatnonzero(~np.isfinite(self.theta))[0])
             raise ValueError(
                 f"`theta` must be finite; got {self.theta[bad]!r} at index {bad}"
+            )
+        biggest = float(np.max(np.abs(self.theta), initial=0.0))
+        if biggest > _MAX_COEFFICIENT:
+            # Two such coefficients multiplied pass float64's range (1.8e308):
+            # poles, zeros and every simulation would overflow.
+            raise ValueError(
+                f"`theta` overflows: a coefficient of magnitude {biggest:.3g} is "
+                f"beyond {_MAX_COEFFICIENT:g}"
             )
 
     # -- model behaviour ---------------------------------------------------------
@@ -156,12 +174,16 @@ class IdentifiedModel:
 
     # -- serialisation -----------------------------------------------------------
 
-    def to_dict(self) -> dict:
-        """A JSON-safe summary (the optimiser result is reduced to its history)."""
+    def to_dict(self, *, timings: bool = True) -> dict:
+        """A JSON-safe summary (the optimiser result is reduced to its history).
+
+        ``timings=False`` leaves out the wall times, the only part that
+        differs between two runs with the same seed (``spiralid identify``
+        writes them to ``timings.json`` beside ``model.json``)."""
         summary = _summary(self.result)
         if summary is not None and self.refine_result is not None:
             summary["refine"] = _summary(self.refine_result)
-        return {
+        out = {
             "theta": [float(v) for v in self.theta],
             "na": self.arx.na,
             "nb": self.arx.nb,
@@ -181,13 +203,29 @@ class IdentifiedModel:
             "bounds": None if self.bounds is None else np.asarray(self.bounds).tolist(),
             "input_name": self.input_name,
             "output_name": self.output_name,
+            "input_unit": self.input_unit,
+            "output_unit": self.output_unit,
+            "u_offset": float(self.u_offset),
+            "y_offset": float(self.y_offset),
+            "fraction": None if self.fraction is None else float(self.fraction),
             "result": summary,
         }
+        if not timings:
+            del out["timings"]
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> IdentifiedModel:
         """Rebuild from :meth:`to_dict` output (``result`` is not restored)."""
+        if not isinstance(d, dict):
+            raise ValueError(f"a model must be a JSON object; got {type(d).__name__}")
         try:
+            for name in ("na", "nb", "nk"):
+                # Named as the file names them, not as the command's options.
+                if isinstance(d[name], bool) or not isinstance(d[name], int):
+                    raise ValueError(
+                        f"field {name!r} must be an integer; got {d[name]!r}"
+                    )
             arx = ARX(d["na"], d["nb"], d["nk"])
             return cls(
                 theta=np.asarray(d["theta"], dtype=float),
@@ -207,9 +245,14 @@ class IdentifiedModel:
                 bounds=None if d.get("bounds") is None else np.asarray(d["bounds"]),
                 input_name=d.get("input_name", "u"),
                 output_name=d.get("output_name", "y"),
+                input_unit=str(d.get("input_unit", "")),
+                output_unit=str(d.get("output_unit", "")),
+                u_offset=float(d.get("u_offset", 0.0)),
+                y_offset=float(d.get("y_offset", 0.0)),
+                fraction=None if d.get("fraction") is None else float(d["fraction"]),
             )
         except KeyError as exc:
-            raise ValueError(f"`d` must contain the key {exc.args[0]!r}") from None
+            raise ValueError(f"the field {exc.args[0]!r} is missing") from None
 
     def __repr__(self) -> str:
         return (

@@ -50,6 +50,11 @@ __all__ = [
 _RESIDUALS = ("one-step", "simulation")
 
 
+# Closer than this, a pole and a zero (or a pole and the origin) are taken
+# as one: relative to the unit circle, far below any resonance's width.
+_CANCELLATION = 1e-6
+
+
 def fit_percent(y, yhat) -> float:
     """Normalised fit in percent, as MATLAB's ``compare`` reports it.
 
@@ -350,6 +355,29 @@ class Validation:
         """One-step prediction error ``y - y_pred``."""
         return self.y - self.y_pred
 
+    @property
+    def order_advice(self) -> str | None:
+        """Why the model's order looks higher than the data support, with
+        advice, or None: an exact or near pole-zero cancellation
+        (``|p - z| < 1e-6``, or a realisation that is not minimal), or poles
+        at the origin (the denominator's last coefficients vanish)."""
+        reasons = []
+        d = self.realization.min_pole_zero_distance
+        if not self.realization.minimal or d < _CANCELLATION:
+            reasons.append(f"a pole and a zero {d:.2g} apart cancel")
+        at_origin = int(np.sum(np.abs(self.poles) < _CANCELLATION))
+        if at_origin:
+            reasons.append(
+                f"{at_origin} pole(s) at the origin (vanishing denominator "
+                "coefficients)"
+            )
+        if not reasons:
+            return None
+        return (
+            f"{' and '.join(reasons)}: the order is higher than the data "
+            "support; try a lower one"
+        )
+
     def summary(self) -> str:
         """A plain-text table of the results."""
 
@@ -406,6 +434,9 @@ class Validation:
             ),
             ("min |pole - zero|", f"{rz.min_pole_zero_distance:.3g}"),
         ]
+        advice = self.order_advice
+        if advice is not None:
+            rows.append(("order", advice))
         width = max(len(k) for k, _ in rows)
         title = f"Validation of {self.label}" if self.label else "Validation"
         lines = [title, "-" * max(len(title), width + 30)]
@@ -427,6 +458,7 @@ class Validation:
             "ts": float(self.ts),
             "fit_percent": float(self.fit_percent),
             "fit_percent_one_step": float(self.fit_percent_one_step),
+            "order_advice": self.order_advice,
             "rmse": float(self.rmse),
             "rmse_one_step": float(self.rmse_one_step),
             "cost": float(self.cost),
@@ -693,6 +725,14 @@ def _valid_inputs(model, data, lags, residuals):
     # Checked here too (the correlation tests would) so a bad `lags` fails
     # before the simulation and spectra are computed.
     lags = check_lags(lags, y.size)
+    arx = model.arx
+    if arx.max_lag >= y.size:
+        # Before any signal of that length is built (a tampered file's nk
+        # could ask for terabytes).
+        raise ValueError(
+            f"`model` reaches {arx.max_lag} samples into the past ({arx}), more "
+            f"than `data`'s N = {y.size} samples hold"
+        )
     if residuals not in _RESIDUALS:
         raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
     model_ts = getattr(model, "ts", None)
