@@ -53,7 +53,33 @@ def _versions() -> dict:
         "numba": numba.__version__,
         "matplotlib": matplotlib.__version__,
         "platform": platform.platform(),
+        # The numbers depend on it: each OpenBLAS kernel rounds its own way.
+        "blas_kernel": blas_kernel(),
     }
+
+
+def blas_kernel() -> str:
+    """The OpenBLAS kernel NumPy runs on (e.g. ``"Haswell"``), ``"unknown"``
+    where it cannot be asked (another BLAS, no ``/proc``)."""
+    import ctypes
+
+    try:
+        with open("/proc/self/maps", encoding="utf-8") as fh:
+            path = next(line.split()[-1] for line in fh if "openblas" in line)
+        lib = ctypes.CDLL(path)
+    except (OSError, StopIteration, IndexError):
+        return "unknown"
+    for name in (
+        "scipy_openblas_get_corename64_",
+        "scipy_openblas_get_corename",
+        "openblas_get_corename64_",
+        "openblas_get_corename",
+    ):
+        getter = getattr(lib, name, None)
+        if getter is not None:
+            getter.restype = ctypes.c_char_p
+            return getter().decode("ascii", "replace")
+    return "unknown"
 
 
 def verdict(rep: Reproduction, a: str = "Eb-SDA", b: str = "SDA") -> str:
