@@ -119,12 +119,13 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _add_detrend_option(p: argparse.ArgumentParser) -> None:
+def _add_detrend_option(p: argparse.ArgumentParser, help_extra: str = "") -> None:
     p.add_argument(
         "--detrend",
         action="store_true",
         help="remove the means of input and output (those of the estimation "
-        "part, or of the part before --fraction, from the whole record) first",
+        "part, or of the part before --fraction, from the whole record) first"
+        + help_extra,
     )
 
 

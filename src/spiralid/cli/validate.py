@@ -119,7 +119,11 @@ def add_parser(sub) -> None:
         help="run the model over the whole record but score only the part after "
         "this share (e.g. 2/3 for the validation third); default: score all",
     )
-    _add_detrend_option(p)
+    _add_detrend_option(
+        p,
+        "; a model.json that records its offsets has them applied anyway, and "
+        "one estimated without --detrend refuses it",
+    )
     p.add_argument(
         "--out", default=None, help="directory for validation.json and figures"
     )
