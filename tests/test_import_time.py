@@ -40,4 +40,6 @@ def test_public_names_still_resolve():
 
     assert spiralid.IOData is spiralid.sysid.IOData
     assert spiralid.minimize is spiralid.optim.minimize
+    # Documented at the top level (README, "Which method to use").
+    assert spiralid.steiglitz_mcbride is spiralid.sysid.steiglitz_mcbride
     assert {"identify", "datasets", "fms"} <= set(dir(spiralid))

@@ -29,6 +29,7 @@ _NAMES = {
     "PaperCost": "sysid",
     "Validation": "sysid",
     "arx_least_squares": "sysid",
+    "steiglitz_mcbride": "sysid",
     "identify": "sysid",
     "validate": "sysid",
 }

@@ -121,3 +121,36 @@ def test_bad_coordinates_are_named():
         par.to_denominator([1.0, 2.0])
     with pytest.raises(ValueError, match="`a`"):
         par.from_denominator([np.nan, 0.0, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("na", [10, 16, 24, 32])
+def test_many_real_poles_are_paired_by_a_rule_not_by_enumeration(monkeypatch, na):
+    # (na - 1)!! pairings of na real poles (2 million at 16) were once all
+    # examined: now two pairings of na / 2 pairs each.
+    par = ModalParametrization(na, ts=0.002)
+    calls = []
+    original = par._mode_of_real_pair
+    monkeypatch.setattr(
+        par, "_mode_of_real_pair", lambda pair: calls.append(1) or original(pair)
+    )
+    x = par.from_denominator(np.zeros(na))
+    assert len(calls) <= na
+    # The zero model (all poles at z = 0) maps to the box's nearest
+    # representable point: every section a double pole at exp(-pi), the
+    # fastest critically damped mode, with its frequency at the box's edge.
+    s = par.n_sections
+    np.testing.assert_allclose(x[:s], par.bounds[0, 1])
+    np.testing.assert_allclose(x[s : 2 * s], 0.0, atol=1e-2)
+
+
+@pytest.mark.parametrize("na", [10, 16])
+def test_repeated_real_poles_round_trip(na):
+    # Overdamped sections built in the box, several of them equal: the
+    # denominator maps back to one with the same poles.
+    par = ModalParametrization(na, ts=0.002)
+    s = par.n_sections
+    freqs = np.r_[[20.0] * (s // 2), [60.0] * (s - s // 2)]
+    logz = np.r_[[0.3] * (s // 2), [0.1] * (s - s // 2)]
+    a = par.to_denominator(np.r_[freqs, logz])
+    back = par.to_denominator(par.from_denominator(a))
+    np.testing.assert_allclose(back, a, rtol=1e-6, atol=1e-9)

@@ -47,6 +47,8 @@ _LOG_ZETA = (-3.0, 1.0)
 # degenerates (a double pole at z = 1 or z = -rho).
 _EDGE = 1e-3
 _PMAX = 1.0 - 1e-6
+# Real poles up to which `from_denominator` tries every pairing (8 x 105).
+_ENUMERATE = 8
 
 
 class ModalParametrization:
@@ -251,11 +253,15 @@ class ModalParametrization:
     def _assign_real(self, real: np.ndarray, n_pairs: int):
         """Split real poles into first-order sections and overdamped pairs.
 
-        Tries every choice of first-order poles and every pairing of the rest
-        (at most 105 pairings for 8 poles) and keeps the one whose
-        coordinates leave the box least, so a denominator built from the box
-        maps back exactly.
+        Up to :data:`_ENUMERATE` real poles: every choice of first-order
+        poles and every pairing of the rest (at most 8 x 105), keeping the
+        one whose coordinates leave the box least, so a denominator built
+        from the box maps back exactly. Beyond, the count of pairings grows
+        as (n - 1)!! (2 million at 16 poles), so a rule pairs them instead
+        (`_assign_real_by_rule`), in O(n log n).
         """
+        if real.size > _ENUMERATE:
+            return self._assign_real_by_rule(real, n_pairs)
         lo, hi = self.bounds[:, 0], self.bounds[:, 1]
         s = self.n_sections
         width = np.r_[hi[0] - lo[0], hi[s] - lo[s]] if s else np.ones(2)
@@ -288,6 +294,38 @@ class ModalParametrization:
         # Pad if the polynomial had fewer real poles than first-order slots.
         firsts = np.r_[firsts, np.zeros(self.n_real - firsts.size)]
         return firsts, modes[:n_pairs]
+
+    def _assign_real_by_rule(self, real: np.ndarray, n_pairs: int):
+        """The real poles of largest magnitude fill the first-order sections;
+        the rest, sorted by value, pair either with their neighbours (a pair
+        of close poles is a section near critical damping) or from the
+        outside in (a slow pole with a fast one, as an overdamped section's
+        two poles are), whichever leaves the box less: two pairings, not
+        (n - 1)!!. Equal poles, as the zero model's, pair with each other."""
+        by_size = np.argsort(-np.abs(real), kind="stable")
+        chosen = np.sort(by_size[: self.n_real])
+        firsts = np.r_[real[chosen], np.zeros(self.n_real - chosen.size)]
+        rest = np.sort(np.delete(real, chosen))[::-1]
+        half = rest.size // 2
+        neighbours = [rest[i : i + 2] for i in range(0, 2 * half, 2)]
+        outside_in = [rest[[i, rest.size - 1 - i]] for i in range(half)]
+        candidates = [
+            [self._mode_of_real_pair(pair) for pair in pairing]
+            for pairing in (neighbours, outside_in)
+        ]
+        modes = min(candidates, key=self._box_miss)
+        return firsts, modes[:n_pairs]
+
+    def _box_miss(self, modes) -> float:
+        """How far sections' (frequency, log damping) leave the box, in
+        widths of the box."""
+        s = self.n_sections
+        if not s or not modes:
+            return 0.0
+        box = self.bounds[[0, s]]
+        v = np.asarray(modes, dtype=float)
+        out = np.maximum(box[:, 0] - v, 0) + np.maximum(v - box[:, 1], 0)
+        return float(np.sum(out / (box[:, 1] - box[:, 0])))
 
     def _mode_of_pole(self, z: complex) -> tuple[float, float]:
         s = np.log(max(abs(z), 1e-300)) + 1j * np.angle(z)
