@@ -7,13 +7,6 @@ manipulator system", and applies them to ARX modelling of a flexible
 manipulator.
 """
 
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("spiralid")
-except PackageNotFoundError:  # running from a source tree without install
-    __version__ = "0.0.0+unknown"
-
 # The public names load on first use (PEP 562): `import spiralid` stays as
 # cheap as the metadata lookup above, and SciPy, Numba and the compiled
 # kernels are imported only by the parts that need them.
@@ -33,12 +26,26 @@ _NAMES = {
     "identify": "sysid",
     "validate": "sysid",
 }
-__all__ = [*_SUBPACKAGES, *_NAMES]
+__all__ = ["__version__", *_SUBPACKAGES, *_NAMES]
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("spiralid")
+    except PackageNotFoundError:  # running from a source tree without install
+        return "0.0.0+unknown"
 
 
 def __getattr__(name: str):
     import importlib
 
+    if name == "__version__":
+        # Looked up on first use: the metadata scan costs more than the rest
+        # of `import spiralid`, which the command's Ctrl-C handling waits on.
+        globals()[name] = value = _version()
+        return value
     if name in _SUBPACKAGES:
         return importlib.import_module(f".{name}", __name__)
     if name in _NAMES:

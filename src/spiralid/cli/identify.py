@@ -53,6 +53,7 @@ def run(args, argv: list[str]) -> int:
             method=args.method,
             predictor=args.predictor,
             initial=args.initial,
+            integrator=args.integrator,
             parametrization=args.parametrization,
             refine=args.refine,
             rng=args.seed,
@@ -140,6 +141,12 @@ def add_parser(sub) -> None:
     _add_detrend_option(p)
     p.add_argument(
         "--refine", action="store_true", help="polish a spiral result locally"
+    )
+    p.add_argument(
+        "--integrator",
+        action="store_true",
+        help="the output integrates (a known pole at z = 1, e.g. the rig's hub "
+        "angle): --na counts it, the method estimates the other poles",
     )
     p.add_argument("--points", type=_positive_int, default=50, help="search points")
     p.add_argument(

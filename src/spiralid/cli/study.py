@@ -108,7 +108,10 @@ def _check_study_dir(out: Path, store: Path, force: bool) -> None:
         raise UsageError(f"--out {str(out)!r} is a file, not a directory")
     if not out.is_dir() or force:
         return
-    own = {*STUDY_FILES, store.name, store.name + ".lock"}
+    # SQLite's own companions of the store: a study killed inside a
+    # transaction leaves its rollback journal, which the rerun replays.
+    companions = ("-journal", "-wal", "-shm", ".lock")
+    own = {*STUDY_FILES, store.name, *(store.name + c for c in companions)}
     foreign = sorted(p.name for p in out.iterdir() if p.name not in own)
     if foreign:
         raise UsageError(

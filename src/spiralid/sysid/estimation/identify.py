@@ -34,6 +34,7 @@ predictor do not depend on it.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -42,6 +43,7 @@ from spiralid._checks import generator
 from ..data import IOData
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
+from ..models.polynomials import with_integrator
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS, Problem
 from .outputerror import steiglitz_mcbride
@@ -105,6 +107,7 @@ def identify(
     bounds=None,
     initial: str = "rest",
     safe_start: bool | None = None,
+    integrator: bool = False,
     **optimiser_options,
 ) -> IdentifiedModel:
     """Estimate an ARX model from input-output data.
@@ -160,6 +163,16 @@ def identify(
         either (see :mod:`spiralid.sysid.estimation.estimators`). Default: the method's
         (off for the paper's ``"sda"``, ``"ebsda"`` and for ``"lasda"``,
         ``"de"``). Ignored by ``"ls"`` and ``"oe"``.
+    integrator : bool
+        The output integrates (a pole at z = 1 known beforehand, as the
+        rig's hub angle integrates its velocity): ``arx.na`` counts it, the
+        estimation chooses the other ``na - 1`` poles. For the free run from
+        rest, ``B / (A' (1 - z^-1))`` applied to ``u`` is ``B / A'`` applied
+        to the running sum of ``u``, so any method estimates ``B / A'`` from
+        (running sum of ``u``, ``y``) with its cost unchanged, and the model
+        is composed back. Needs ``predictor="simulation"`` and
+        ``initial="rest"``. The model is marginally stable by design: its
+        stability verdict is on the other poles.
     **optimiser_options
         Passed to :func:`spiralid.optim.minimize` (``n_points``, ``max_iter``,
         ``max_nfev``, ``target``, ``callback``, ``bounds_policy``, ``x0``...);
@@ -188,6 +201,26 @@ def identify(
         raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
     if not isinstance(arx, ARX):
         raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+    if not isinstance(integrator, bool | np.bool_):
+        raise ValueError(f"`integrator` must be True or False; got {integrator!r}")
+    if integrator:
+        return _identify_integrating(
+            data,
+            arx,
+            dict(
+                method=method,
+                predictor=predictor,
+                parametrization=parametrization,
+                rng=rng,
+                refine=refine,
+                gain=gain,
+                penalty=penalty,
+                bounds=bounds,
+                initial=initial,
+                safe_start=safe_start,
+                **optimiser_options,
+            ),
+        )
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
     if parametrization is None:
@@ -251,4 +284,29 @@ def identify(
         output_unit=data.output_unit,
         u_offset=data.u_offset,
         y_offset=data.y_offset,
+    )
+
+
+def _identify_integrating(data: IOData, arx: ARX, options: dict) -> IdentifiedModel:
+    """`identify` with a known integrator: ``B / A'`` from the running sum
+    of the input, composed back into ``B / (A' (1 - z^-1))``."""
+    if arx.na < 1:
+        raise ValueError(f"`integrator` needs a denominator (na >= 1); got {arx}")
+    if options["predictor"] != "simulation" or options["initial"] != "rest":
+        raise ValueError(
+            "`integrator` needs predictor='simulation' and initial='rest' (the "
+            "running sum of the input stands for the integrator's state from "
+            f"rest); got predictor={options['predictor']!r}, "
+            f"initial={options['initial']!r}"
+        )
+    summed = replace(data, u=np.cumsum(data.u))
+    inner = identify(summed, ARX(arx.na - 1, arx.nb, arx.nk), **options)
+    theta = np.r_[with_integrator(inner.theta[: arx.na - 1]), inner.theta[arx.na - 1 :]]
+    return replace(
+        inner,
+        theta=theta,
+        arx=arx,
+        input_unit=data.input_unit,
+        u_offset=data.u_offset,
+        integrator=True,
     )

@@ -10,7 +10,7 @@ from scipy import signal
 
 from ..data import IOData
 from .arx import ARX, INITIAL_CONDITIONS
-from .polynomials import max_pole_radius
+from .polynomials import deflate_integrator, is_stable_polynomial, max_pole_radius
 
 __all__ = ["IdentifiedModel"]
 
@@ -83,6 +83,10 @@ class IdentifiedModel:
     u_offset: float = 0.0
     y_offset: float = 0.0
     fraction: float | None = None
+    # A known integrator (a pole at z = 1) factored out of the denominator
+    # before estimation (`identify(integrator=True)`): the model is then
+    # marginally stable by design, not unstable.
+    integrator: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
@@ -100,6 +104,13 @@ class IdentifiedModel:
             raise ValueError(
                 f"`theta` must be finite; got {self.theta[bad]!r} at index {bad}"
             )
+        if self.integrator:
+            a = np.r_[1.0, self.theta[: self.arx.na]]
+            if self.arx.na < 1 or abs(a.sum()) > 1e-9 * np.abs(a).sum():
+                raise ValueError(
+                    "`integrator` needs a denominator with a pole at z = 1 "
+                    f"(A(1) = 0); got A(1) = {a.sum():.3g}"
+                )
         biggest = float(np.max(np.abs(self.theta), initial=0.0))
         if biggest > _MAX_COEFFICIENT:
             # Two such coefficients multiplied pass float64's range (1.8e308):
@@ -133,16 +144,27 @@ class IdentifiedModel:
         return self.arx.zeros(self.theta)
 
     @property
+    def free_denominator(self) -> np.ndarray:
+        """The denominator's coefficients ``a_1..`` without the known
+        integrator: the poles the estimation chose (all of them when
+        ``integrator`` is False)."""
+        a = self.theta[: self.arx.na]
+        return deflate_integrator(a) if self.integrator else a
+
+    @property
     def is_stable(self) -> bool:
         """Every pole strictly inside the unit circle: spiralid's one
-        stability verdict (see :mod:`spiralid.sysid.models.polynomials`)."""
-        return bool(self.arx.is_stable(self.theta))
+        stability verdict (see :mod:`spiralid.sysid.models.polynomials`).
+        With a known integrator, the verdict is on the other poles (the
+        model is marginally stable by design)."""
+        return bool(is_stable_polynomial(self.free_denominator))
 
     @property
     def max_pole_radius(self) -> float:
         """Largest ``|pole|``, on the verdict's side of the unit circle
-        (:func:`~spiralid.sysid.models.polynomials.max_pole_radius`)."""
-        return float(max_pole_radius(self.theta[: self.arx.na]))
+        (:func:`~spiralid.sysid.models.polynomials.max_pole_radius`), over
+        the poles the estimation chose (the integrator's is 1)."""
+        return float(max_pole_radius(self.free_denominator))
 
     def tf_string(self, digits: int = 4) -> str:
         """Transfer function in z as eq. (9)-(10) print it."""
@@ -208,6 +230,7 @@ class IdentifiedModel:
             "u_offset": float(self.u_offset),
             "y_offset": float(self.y_offset),
             "fraction": None if self.fraction is None else float(self.fraction),
+            "integrator": bool(self.integrator),
             "result": summary,
         }
         if not timings:
@@ -250,6 +273,7 @@ class IdentifiedModel:
                 u_offset=float(d.get("u_offset", 0.0)),
                 y_offset=float(d.get("y_offset", 0.0)),
                 fraction=None if d.get("fraction") is None else float(d["fraction"]),
+                integrator=bool(d.get("integrator", False)),
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None

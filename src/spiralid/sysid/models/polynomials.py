@@ -43,6 +43,7 @@ import numba
 import numpy as np
 
 __all__ = [
+    "deflate_integrator",
     "fold_reflection",
     "format_pole_radius",
     "is_stable_polynomial",
@@ -50,6 +51,7 @@ __all__ = [
     "random_stable_polynomial",
     "step_down",
     "step_up",
+    "with_integrator",
 ]
 
 
@@ -343,3 +345,26 @@ def random_stable_polynomial(n: int, size: int | None = None, rng=None) -> np.nd
     k = rng.uniform(-1.0, 1.0, size=(m, int(n)))
     a = step_up(k)
     return a[0] if size is None else a
+
+
+def deflate_integrator(a) -> np.ndarray:
+    """``a'`` with ``1 + a_1 z^-1 + .. = (1 + a'_1 z^-1 + ..)(1 - z^-1)``:
+    the denominator without a known integrator (a root at z = 1).
+
+    Examples
+    --------
+    >>> deflate_integrator(np.convolve([1.0, -0.5], [1.0, -1.0])[1:]).tolist()
+    [-0.5]
+    """
+    a = np.r_[1.0, np.asarray(a, dtype=float)]
+    # Synthetic division by (1 - z^-1): the running sum of the coefficients.
+    return np.cumsum(a)[1:-1]
+
+
+def with_integrator(a) -> np.ndarray:
+    """The coefficients of ``(1 + a_1 z^-1 + ..)(1 - z^-1)`` after the 1.
+
+    >>> with_integrator([-0.5]).tolist()
+    [-1.5, 0.5]
+    """
+    return np.convolve(np.r_[1.0, np.asarray(a, dtype=float)], [1.0, -1.0])[1:]

@@ -338,6 +338,7 @@ class Validation:
     y_pred: np.ndarray
     output_name: str = "output"
     output_unit: str = ""
+    integrator: bool = False
 
     @property
     def error(self) -> np.ndarray:
@@ -426,7 +427,13 @@ class Validation:
             ("PSD resolution (Hz)", f"{self.psd_measured.resolution:.3g}"),
             (
                 "stable (max |pole|)",
-                f"{self.stable} ({format_pole_radius(self.max_pole_radius)})",
+                f"{self.stable} ({format_pole_radius(self.max_pole_radius)})"
+                + (
+                    "; and a known integrator (pole at z = 1): marginally "
+                    "stable by design"
+                    if self.integrator
+                    else ""
+                ),
             ),
             (
                 "controllable / observable",
@@ -474,6 +481,7 @@ class Validation:
             "peaks_model_hz": [float(v) for v in self.peaks_model.frequency],
             "modes": self.modes.to_dict(),
             "stable": bool(self.stable),
+            "integrator": bool(self.integrator),
             "max_pole_radius": float(self.max_pole_radius),
             "realization": self.realization.to_dict(),
             "poles": cplx(self.poles),
@@ -658,7 +666,11 @@ def validate(
     # The one stability verdict (Schur-Cohn on the coefficients, see
     # spiralid.sysid.models.polynomials), not |np.roots| < 1, which misjudges
     # clustered poles near the circle.
-    denominator = np.asarray(model.theta, dtype=float)[: model.arx.na]
+    # Without a known integrator's pole (z = 1), which the model has by
+    # design (`identify(integrator=True)`).
+    denominator = np.asarray(
+        getattr(model, "free_denominator", model.theta[: model.arx.na]), dtype=float
+    )
     stable = bool(is_stable_polynomial(denominator))
     max_radius = float(max_pole_radius(denominator))
     y_sim, y_pred, start = _responses(model, data, warmup, max_radius)
@@ -708,6 +720,7 @@ def validate(
         y=y,
         y_sim=y_sim,
         y_pred=y_pred,
+        integrator=bool(getattr(model, "integrator", False)),
         output_name=str(getattr(data, "output_name", "output")),
         output_unit=str(getattr(data, "output_unit", "")),
     )
