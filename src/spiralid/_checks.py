@@ -5,7 +5,8 @@ backticks, says what is allowed and shows what came in, so that bad input
 never surfaces as a NumPy or Numba traceback from deep inside a kernel.
 
 This module imports nothing of ours, so ``optim`` and ``fms`` can both use it
-and still depend on nothing else in the package (DESIGN.md).
+and still depend on nothing else in the package (docs/design-notes.md,
+"Layout and dependencies").
 
 The scalar checks have two readings, chosen by ``strict`` (default ``True``):
 

@@ -1,7 +1,7 @@
 """The single-link flexible manipulator rig: modes and sampled simulation.
 
 Default constants are those of the University of Sheffield rig used in the
-paper (its reference [13]) as given in issue 3 from the literature on that rig
+paper (its reference [13]), from the literature on that rig
 (A. K. M. Azad, PhD thesis, University of Sheffield, 1994; M. O. Tokhi and
 A. K. M. Azad (eds.), "Flexible Robot Manipulators", IET, 2008): an aluminium
 beam of 900 x 19.008 x 3.2004 mm, E = 71 GPa, rho = 2710 kg/m^3, hub inertia

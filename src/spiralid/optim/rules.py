@@ -154,7 +154,7 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
     Evaluated as ``lower + (upper - lower) * expit(ln c1 - c2 d)`` (compiled,
     with a sign-split logistic), which is the same function but finite and
     warning-free for any ``d >= 0``, ``inf`` included (penalised costs make
-    ``d`` huge; DESIGN.md item 4). It falls monotonically from
+    ``d`` huge). It falls monotonically from
     ``upper + (lower - upper) / (1 + c1)`` at ``d = 0`` to ``lower`` as
     ``d -> inf``.
 

@@ -127,7 +127,7 @@ class Reproduction:
     Attributes
     ----------
     data, estimation, validation : IOData
-        The record and its 2/3-1/3 parts (DESIGN.md item 11).
+        The record and its 2/3-1/3 parts (the paper's split).
     arx : ARX
     seeds : list of int
     options : dict
@@ -295,7 +295,7 @@ def reproduce(
     n_points : int, default 50
         Search points ``m``.
     arx : ARX, default ARX(8, 8, 0)
-        Eq. (6) (DESIGN.md item 1).
+        Eq. (6).
     fraction : float, default 2/3
         Estimation share of the record.
     initial : {"rest", "measured"}, default "rest"

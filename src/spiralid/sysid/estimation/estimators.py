@@ -564,11 +564,26 @@ def _estimate_fir(problem: Problem) -> EstimatorResult:
     return result
 
 
+def _rule_options() -> tuple[str, ...]:
+    """What a rule's method passes on to :func:`spiralid.optim.minimize`:
+    its keyword options, less those the estimator sets itself (the rule is
+    the method's own, so a method bound to one rule cannot be re-ruled)."""
+    import inspect
+
+    own = {"method", "rng", "vectorized"}
+    return tuple(
+        name
+        for name, par in inspect.signature(minimize).parameters.items()
+        if par.kind is inspect.Parameter.KEYWORD_ONLY and name not in own
+    )
+
+
 # One entry per method; its key is the name users pass.
 METHODS: dict[str, Method] = {
     **{
         name: Method(
             partial(_estimate_spiral, rule=name),
+            options=_rule_options(),
             summary=f"spiral search with the rule {name!r} of spiralid.optim.RULES",
         )
         for name in RULES

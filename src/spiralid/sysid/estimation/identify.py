@@ -79,7 +79,12 @@ def _check_bounds(bounds, p: int) -> np.ndarray:
     return box
 
 
-def _check_options(method: str, options: dict) -> None:
+def check_method_options(method: str, options: dict) -> None:
+    """The one check of a method's options against what it declares
+    (:data:`METHODS`), for `identify`, the command line and study files
+    alike: a one-line ValueError before any work."""
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
     spec = METHODS[method]
     if not spec.search and options:
         searches = tuple(name for name, m in METHODS.items() if m.search)
@@ -221,8 +226,7 @@ def identify(
                 **optimiser_options,
             ),
         )
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
+    check_method_options(method, optimiser_options)
     if parametrization is None:
         parametrization = METHODS[method].parametrization
         if arx.na == 0 and parametrization == "modal":
@@ -230,7 +234,6 @@ def identify(
             # exactly over the coefficients (see `_estimate_fir`).
             parametrization = DEFAULT_PARAMETRIZATION
     par = make_parametrization(parametrization, data, arx)
-    _check_options(method, optimiser_options)
     if safe_start is not None and not isinstance(safe_start, bool | np.bool_):
         raise ValueError(
             f"`safe_start` must be True, False or None; got {safe_start!r}"

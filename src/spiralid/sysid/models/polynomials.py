@@ -8,9 +8,9 @@ stable one); the step-down recursion maps back, and doubles as the
 Schur-Cohn (Jury) stability test: ``O(n^2)`` per polynomial, vectorised
 over a population, and much cheaper than ``numpy.roots``.
 
-This is how the initial points are put "in the feasible region" (DESIGN.md
-item 12) and how ``parametrization="reflection"`` keeps every candidate
-stable (item 13).
+This is how the initial points are put "in the feasible region" (the
+paper's wording) and how ``parametrization="reflection"`` keeps every
+candidate stable.
 
 The stability verdict
 ---------------------
@@ -330,7 +330,7 @@ def random_stable_polynomial(n: int, size: int | None = None, rng=None) -> np.nd
     Returns
     -------
     ndarray, shape (n,) or (size, n)
-        Coefficients ``a_1..a_n``, each polynomial stable (DESIGN.md item 12).
+        Coefficients ``a_1..a_n``, each polynomial stable.
 
     Examples
     --------

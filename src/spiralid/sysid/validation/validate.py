@@ -348,7 +348,7 @@ class Validation:
     @property
     def modes_hz(self) -> np.ndarray:
         """Natural frequencies in Hz of the model's lightly damped modes
-        (``modes.frequency``; DESIGN.md's ``rep.modes_hz``)."""
+        (``modes.frequency``)."""
         return self.modes.frequency
 
     @property
@@ -570,7 +570,7 @@ def validate(
         ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
         ``predict(data)``, ``poles``, ``zeros``).
     data : IOData
-        The validation record, usually the last third (DESIGN.md item 11).
+        The validation record, usually the last third (the paper's split).
         The model is run from zero initial conditions over it.
     lags : int, default 25
         Correlation lags: autocorrelation at ``1..lags``, cross-correlation at
