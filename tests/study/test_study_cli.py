@@ -34,7 +34,10 @@ def test_study_writes_store_and_report_then_resumes(small_spec, tmp_path):
     assert "20 runs: 20 already in" in again.stdout
     rep = run("study-report", out / "study.sqlite", "--out", "r2", cwd=tmp_path)
     assert rep.returncode == 0, rep.stderr
-    assert (tmp_path / "r2" / "report.html").read_text().count("<img") == 2
+    report = (tmp_path / "r2" / "report.html").read_text()
+    # Convergence bands, effect sizes and the anytime distributions.
+    assert report.count("<img") == 3
+    assert "The claim at every budget" in report
 
 
 def test_show_default_prints_the_shipped_grid(tmp_path):

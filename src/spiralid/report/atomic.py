@@ -131,17 +131,34 @@ def _note_stale(folder: Path) -> None:
 
 @contextlib.contextmanager
 def _signals_deferred():
-    """Hold SIGINT/SIGTERM while the staged files move into place."""
-    blocked = {signal.SIGINT, signal.SIGTERM}
+    """Hold SIGINT/SIGTERM while files are created or moved into place, and
+    deliver them when the block ends.
+
+    A Python-level handler that only records, not a blocked signal mask: the
+    mask is per thread, and a signal the kernel hands to another thread (a
+    BLAS worker) would still reach Python's handler at once.
+    """
+    held: list[int] = []
+
+    def hold(signum, frame):
+        held.append(signum)
+
+    previous = {}
     try:
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, blocked)
-    except (AttributeError, ValueError):  # not the main thread / no pthreads
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            previous[signum] = signal.signal(signum, hold)
+    except ValueError:  # not the main thread: nothing to hold
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
         yield
         return
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+        for signum in dict.fromkeys(held):
+            signal.raise_signal(signum)
 
 
 def _make_parents(folder: Path) -> list[Path]:
@@ -290,30 +307,34 @@ class OutputFolder(_Staged):
     def open(self) -> OutputFolder:
         t = self.target
         self._check_target()
-        self._created = _make_parents(t.parent)
         try:
-            self._lock = _Lock(t.parent / f"{_LOCK}{t.name}", t)
-            self._lock.acquire()
-            # Checked again under the lock: a run that finished meanwhile
-            # has filled the target.
-            self._check_target()
-            _note_stale(t.parent)
-            if t.is_dir():
-                self._probe(t)
-            try:
-                self.path = Path(
-                    tempfile.mkdtemp(
-                        prefix=f"{_staging_prefix()}{t.name}-", dir=t.parent
-                    )
-                )
-            except OSError as exc:
-                raise OutputError(
-                    f"cannot write beside {str(t)!r}: {_why(exc)}"
-                ) from None
+            # Ctrl-C waits until the lock, the folders and the staging folder
+            # are all made or all undone: one arriving between creating a
+            # file and recording it would leave it behind.
+            with _signals_deferred():
+                self._created = _make_parents(t.parent)
+                self._open_staging()
         except BaseException:
             self.close()
             raise
         return self
+
+    def _open_staging(self) -> None:
+        t = self.target
+        self._lock = _Lock(t.parent / f"{_LOCK}{t.name}", t)
+        self._lock.acquire()
+        # Checked again under the lock: a run that finished meanwhile
+        # has filled the target.
+        self._check_target()
+        _note_stale(t.parent)
+        if t.is_dir():
+            self._probe(t)
+        try:
+            self.path = Path(
+                tempfile.mkdtemp(prefix=f"{_staging_prefix()}{t.name}-", dir=t.parent)
+            )
+        except OSError as exc:
+            raise OutputError(f"cannot write beside {str(t)!r}: {_why(exc)}") from None
 
     def _probe(self, folder: Path) -> None:
         try:

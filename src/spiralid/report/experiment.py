@@ -16,7 +16,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import stats
 
 from spiralid.study.runner import execute
 from spiralid.study.tasks import Task
@@ -181,23 +180,19 @@ class Reproduction:
         }
 
     def ranksum(self, a: str, b: str) -> dict:
-        """Wilcoxon rank-sum test of the estimation costs of `a` against `b`.
+        """Wilcoxon rank-sum test of the estimation costs of `a` against `b`
+        (:func:`spiralid.study.statistics.rank_sum`, the one implementation
+        the study uses too): ``p_two_sided`` tests for any difference,
+        ``p_less`` for `a` lower."""
+        from spiralid.study.statistics import rank_sum
 
-        Computed as the equivalent Mann-Whitney U test, exact for the small,
-        tie-free samples of a few seeds (SciPy's ``method="auto"``), where
-        the normal approximation of ``scipy.stats.ranksums`` is poor.
-        ``p_two_sided`` tests for any difference; ``p_less`` for `a` lower.
-        """
-        ca = [r.cost for r in self.runs[a]]
-        cb = [r.cost for r in self.runs[b]]
-        two = stats.mannwhitneyu(ca, cb, alternative="two-sided")
-        less = stats.mannwhitneyu(ca, cb, alternative="less")
+        test = rank_sum([r.cost for r in self.runs[a]], [r.cost for r in self.runs[b]])
         return {
             "a": a,
             "b": b,
-            "u_statistic": float(two.statistic),
-            "p_two_sided": float(two.pvalue),
-            "p_less": float(less.pvalue),
+            "u_statistic": test["u"],
+            "p_two_sided": test["p_two_sided"],
+            "p_less": test["p_less"],
         }
 
     def table2(self) -> list[dict]:

@@ -106,6 +106,52 @@ def verdict(rep: Reproduction, a: str = "Eb-SDA", b: str = "SDA") -> str:
     )
 
 
+def budget_verdict(rep: Reproduction, a: str = "Eb-SDA", b: str = "SDA") -> dict:
+    """The claim at a ladder of budgets, from the runs' own histories
+    (:func:`spiralid.study.anytime.budget_verdicts`, Holm over the budgets),
+    with a sentence: the budget the verdict holds at and where it flips."""
+    from spiralid.study.anytime import budget_verdicts
+
+    if a not in rep.runs or b not in rep.runs:
+        return {"rows": [], "sentence": ""}
+    cells = {
+        (("reproduce",), label): {
+            "history": [r.model.history for r in rep.runs[label]],
+            "nfev": [r.model.result["nfev"] for r in rep.runs[label]],
+        }
+        for label in (a, b)
+    }
+    out = budget_verdicts(
+        cells,
+        [("reproduce",)],
+        (a, b),
+        rep.options["max_nfev"],
+        rep.options["n_points"],
+    )
+    rows = out["rows"]
+    full = rows[-1]
+    flips = out["crossovers"].get(("reproduce",), [])
+    sentence = f"At {full['budget']:,} evaluations: {full['verdict']}"
+    if flips:
+        verdict_at = {r["budget"]: r["verdict"] for r in rows}
+        ladder = [r["budget"] for r in rows]
+        steps = [
+            f"{verdict_at[ladder[ladder.index(f) - 1]]} up to "
+            f"{ladder[ladder.index(f) - 1]:,}, {verdict_at[f]} from {f:,}"
+            for f in flips
+        ]
+        sentence += "; along the way (Holm over the budgets): " + "; ".join(steps)
+    else:
+        sentence += f", the same at every budget from {rows[0]['budget']:,}"
+    return {
+        "budgets": out["budgets"],
+        "holm_family": out["family"],
+        "rows": [{k: v for k, v in r.items() if k != "reading"} for r in rows],
+        "crossovers": flips,
+        "sentence": sentence + ".",
+    }
+
+
 def results_dict(rep: Reproduction, command: str | None = None) -> dict:
     """Every number of the reproduction, JSON-safe."""
     data = rep.data
@@ -149,6 +195,7 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
         "statistics": {label: rep.statistics(label) for label in rep.runs},
         "ranksum": ranksums(rep),
         "verdict": verdict(rep),
+        "verdict_by_budget": budget_verdict(rep),
         "transfer_functions": {k: r.model.tf_string(digits=4) for k, r in best.items()},
         "validation": {
             k: {"estimation": e.to_dict(), "validation": v.to_dict()}
@@ -289,6 +336,7 @@ def summary_text(rep: Reproduction) -> str:
             _table(_STAT_HEAD, _stat_rows(rep)),
             "",
             verdict(rep),
+            budget_verdict(rep)["sentence"],
             f"Experiment wall time {rep.elapsed:.1f} s.",
         ]
     )
@@ -339,6 +387,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         f"points, seeds {rep.seeds}; the local polish of '+ refine' adds its own "
         f"evaluations. Experiment wall time {rep.elapsed:.1f} s.</p>",
         f"<h2>Verdict</h2><p><b>{e(verdict(rep))}</b></p>",
+        f"<p>{e(budget_verdict(rep)['sentence'])}</p>",
         "<h2>Table-2</h2><p>Best run of each method (lowest estimation cost). "
         "Error ranges are min and max of the free-run error y - y&#770; in "
         "output units.</p>",

@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 
 from spiralid.study import StudyResults
 
-__all__ = ["claim_effects", "convergence_bands", "study_figures"]
+__all__ = ["anytime_ecdf", "claim_effects", "convergence_bands", "study_figures"]
 
 
 def _band(histories: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -54,6 +54,50 @@ def convergence_bands(res: StudyResults) -> Figure:
     return fig
 
 
+def anytime_ecdf(res: StudyResults) -> Figure:
+    """Fraction of runs below a cost target against evaluations, per reading
+    (an empirical runtime distribution, as COCO draws them).
+
+    The target of a reading is the larger of the two configurations' median
+    final costs, so that at least half the runs of one of them reach it;
+    the budgets where the claim's verdict changes are marked.
+    """
+    from spiralid.study.anytime import evaluations
+
+    readings = [
+        rd for rd in res.readings if all((rd, c) in res.cells for c in res.claim)
+    ]
+    cols = min(3, max(len(readings), 1))
+    rows = -(-max(len(readings), 1) // cols)
+    fig = Figure(figsize=(4.2 * cols, 2.6 * rows), layout="constrained")
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    n_points = res.anytime.get("n_points", 50)
+    for ax, rd in zip(axes, readings, strict=False):
+        target = max(float(np.median(res.cells[rd, c]["cost"])) for c in res.claim)
+        for label, color in zip(res.claim, ("C1", "C0"), strict=True):
+            cell = res.cells[rd, label]
+            hit = []
+            for h, nfev in zip(cell["history"], cell["nfev"], strict=True):
+                counts = evaluations(n_points, int(nfev), len(h))
+                below = np.flatnonzero(np.asarray(h, dtype=float) <= target)
+                hit.append(counts[below[0]] if below.size else np.inf)
+            hit = np.sort(hit)
+            grid = np.unique(np.r_[hit[np.isfinite(hit)], max(cell["nfev"])])
+            frac = [np.mean(hit <= g) for g in grid]
+            ax.step(grid, frac, where="post", color=color, label=label)
+        for b in res.anytime.get("crossovers", {}).get(rd, []):
+            ax.axvline(b, color="0.3", linestyle=":", linewidth=1)
+        ax.set_xscale("log")
+        ax.set_ylim(0, 1.02)
+        ax.set_title(f"{', '.join(map(str, rd))}\ntarget {target:.4g}", fontsize=8)
+        ax.set_xlabel("evaluations")
+        ax.set_ylabel("fraction of runs below target")
+        ax.legend(fontsize=7, loc="lower right")
+    for ax in axes[len(readings) :]:
+        ax.set_visible(False)
+    return fig
+
+
 def claim_effects(res: StudyResults) -> Figure:
     """A12 of the claim per reading; filled where Holm-adjusted p < alpha."""
     claims = res.claims
@@ -82,4 +126,5 @@ def study_figures(res: StudyResults) -> dict[str, Figure]:
     return {
         "study_convergence": convergence_bands(res),
         "study_claim_a12": claim_effects(res),
+        **({"study_anytime": anytime_ecdf(res)} if res.anytime.get("rows") else {}),
     }

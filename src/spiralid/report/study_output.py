@@ -22,6 +22,7 @@ STUDY_FILES = (
     "report.html",
     "study_convergence.png",
     "study_claim_a12.png",
+    "study_anytime.png",
 )
 
 _CLAIM_HEAD = [
@@ -110,6 +111,70 @@ def _cell_rows(res: StudyResults, reading) -> list[list]:
     return rows
 
 
+_ANYTIME_HEAD = ["record", "predictor", "parametrization", "budget"]
+
+
+def _anytime_head(res: StudyResults) -> list[str]:
+    a, b = res.claim
+    return [*_ANYTIME_HEAD, a, b, "p", "p (Holm)", "A12", "verdict"]
+
+
+def _anytime_rows(res: StudyResults) -> list[list]:
+    return [
+        [
+            *r["reading"],
+            f"{r['budget']:,}",
+            _g(r["median_x"]),
+            _g(r["median_y"]),
+            _g(r["p_two_sided"]),
+            _g(r["p_holm"]),
+            f"{r['a12']:.2f}",
+            r["verdict"],
+        ]
+        for r in res.anytime.get("rows", [])
+    ]
+
+
+def _crossover_lines(res: StudyResults) -> list[str]:
+    """One sentence per reading whose verdict changes with the budget."""
+    out = []
+    for rd, budgets in res.anytime.get("crossovers", {}).items():
+        if not budgets:
+            continue
+        rows = {
+            r["budget"]: r["verdict"] for r in res.anytime["rows"] if r["reading"] == rd
+        }
+        ladder = sorted(rows)
+        steps = []
+        for b in budgets:
+            before = ladder[ladder.index(b) - 1]
+            steps.append(f"{rows[before]} at {before:,} -> {rows[b]} at {b:,}")
+        out.append(f"{', '.join(map(str, rd))}: " + "; ".join(steps))
+    return out
+
+
+def anytime_summary(res: StudyResults) -> str:
+    """The claim at every budget of the ladder, as text."""
+    if not res.anytime.get("rows"):
+        return ""
+    a, b = res.claim
+    lines = [
+        f"The claim at every budget ({a} against {b}, best cost after that many "
+        f"evaluations, from the stored histories; Holm over all "
+        f"{res.anytime['family']} tests: readings x budgets)",
+        "",
+        _table(_anytime_head(res), _anytime_rows(res)),
+        "",
+    ]
+    flips = _crossover_lines(res)
+    lines.append(
+        "Where the verdict changes with the budget: " + " | ".join(flips)
+        if flips
+        else "The verdict of every reading is the same at every budget."
+    )
+    return "\n".join(lines)
+
+
 def study_summary(res: StudyResults) -> str:
     """The "where the claim holds" table as text."""
     a, b = res.claim
@@ -126,6 +191,9 @@ def study_summary(res: StudyResults) -> str:
         f"{a} is significantly better than {b} on {len(wins)} of "
         f"{len(res.claims)} readings.",
     ]
+    anytime = anytime_summary(res)
+    if anytime:
+        lines += ["", anytime]
     return "\n".join(lines)
 
 
@@ -138,6 +206,28 @@ def study_results_dict(res: StudyResults, spec_text: str, command=None) -> dict:
         "claim": list(res.claim),
         "alpha": res.alpha,
         "claims": res.claims,
+        "anytime": {
+            "budgets": res.anytime.get("budgets", []),
+            "holm_family": res.anytime.get("family", 0),
+            "rows": [
+                {
+                    **{k: v for k, v in r.items() if k != "reading"},
+                    "data": r["reading"][0],
+                    "predictor": r["reading"][1],
+                    "parametrization": r["reading"][2],
+                }
+                for r in res.anytime.get("rows", [])
+            ],
+            "crossovers": [
+                {
+                    "data": rd[0],
+                    "predictor": rd[1],
+                    "parametrization": rd[2],
+                    "budgets": budgets,
+                }
+                for rd, budgets in res.anytime.get("crossovers", {}).items()
+            ],
+        },
         "cells": [
             {
                 "data": rd[0],
@@ -186,6 +276,22 @@ def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
         "<h2>Where the claim holds</h2>",
         _table(_claim_head(res), _claim_rows(res), "html"),
     ]
+    if res.anytime.get("rows"):
+        flips = _crossover_lines(res)
+        parts += [
+            "<h2>The claim at every budget</h2>",
+            "<p>The best cost of every run after that many evaluations, read "
+            "from its stored history (no run repeated); p-values Holm-adjusted "
+            f"over all {res.anytime['family']} tests (readings x budgets).</p>",
+            _table(_anytime_head(res), _anytime_rows(res), "html"),
+            "<p>"
+            + (
+                "Where the verdict changes: " + e(" | ".join(flips))
+                if flips
+                else "The verdict of every reading is the same at every budget."
+            )
+            + "</p>",
+        ]
     for stem, png in images.items():
         b64 = base64.b64encode(png).decode("ascii")
         parts.append(

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .anytime import budget_verdicts
 from .spec import StudySpec
 from .statistics import holm, rank_sum
 
@@ -41,6 +42,10 @@ class StudyResults:
     claims : list of dict
         Per reading where both labels of `claim` ran: the medians, ``n``,
         ``p_two_sided``, ``p_holm``, ``a12`` and ``verdict``.
+    anytime : dict
+        The claim at a ladder of budgets, from the stored histories
+        (:func:`~spiralid.study.anytime.budget_verdicts`); empty without the
+        specification.
     claim : (str, str)
     alpha : float
     """
@@ -52,6 +57,7 @@ class StudyResults:
     claims: list[dict] = field(default_factory=list)
     claim: tuple[str, str] = CLAIM
     alpha: float = 0.05
+    anytime: dict = field(default_factory=dict)
 
     def statistics(self, reading: Reading, label: str) -> dict:
         """Median, best, worst and quartiles of cost; median fit and time."""
@@ -134,6 +140,7 @@ def analyse(
             "fit_val": np.array([r["fit_val"] for r in group]),
             "seconds": np.array([r["seconds"] for r in group]),
             "history": [r["model"]["history"] for r in group],
+            "nfev": [r["nfev"] for r in group],
         }
         for key, group in grouped.items()
     }
@@ -166,5 +173,9 @@ def analyse(
                 "a12": t["a12"],
                 "verdict": _verdict(float(p_adj), t["a12"], claim, alpha),
             }
+        )
+    if spec is not None and tested:
+        res.anytime = budget_verdicts(
+            cells, tested, tuple(claim), spec.budget, spec.points, alpha=alpha
         )
     return res

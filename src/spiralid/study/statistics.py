@@ -65,8 +65,8 @@ def rank_sum(x, y) -> dict:
     """Two-sided rank-sum test of `x` against `y`, with medians and A12.
 
     Returns a dict with ``u`` (the Mann-Whitney statistic of `x`),
-    ``p_two_sided``, ``a12`` (of `x` over `y`, lower cost winning) and both
-    medians.
+    ``p_two_sided``, ``p_less`` (one-sided: `x` lower), ``a12`` (of `x`
+    over `y`, lower cost winning) and both medians.
     """
     from scipy import stats
 
@@ -74,13 +74,15 @@ def rank_sum(x, y) -> dict:
     if np.ptp(np.concatenate([x, y])) == 0:
         # Every run ended at the same cost: no evidence of any difference
         # (SciPy would divide by a zero variance).
-        u, p = x.size * y.size / 2.0, 1.0
+        u, p, p_less = x.size * y.size / 2.0, 1.0, 1.0
     else:
         res = stats.mannwhitneyu(x, y, alternative="two-sided")
         u, p = float(res.statistic), float(res.pvalue)
+        p_less = float(stats.mannwhitneyu(x, y, alternative="less").pvalue)
     return {
         "u": u,
         "p_two_sided": p,
+        "p_less": p_less,
         "a12": a12(x, y),
         "median_x": float(np.median(x)),
         "median_y": float(np.median(y)),
