@@ -125,3 +125,43 @@ def test_fir_structure_is_solved_exactly_by_the_default_method(nk):
     assert fit.method == "spiral"
     np.testing.assert_allclose(fit.theta, _fir_exact(data, 3, nk), rtol=1e-8)
     assert "FIR" in fit.result.message
+
+
+def test_output_error_goes_on_past_its_cap_and_reports_stationarity():
+    # On this record one round of LM (its cap 100 (p + 1) = 900 evaluations)
+    # used to stop early; now it goes on while the cost falls and says where
+    # it ended.
+    est = _lowpass_noise_record(2).split(2 / 3)[0]
+    fit = identify(est, ARX441, method="oe")
+    res = fit.result
+    assert res["rounds"] > 1 and res["nfev"] > 900
+    assert res["status"] == 0  # converged, not capped
+    # Stationary: the gradient is small and one more LM round from the end
+    # changes nothing that matters.
+    assert res["optimality"] < 1e-3
+    again = identify(est, ARX441, method="oe", rng=0)
+    assert again.cost == fit.cost
+    one_round, one_round_optimality = _single_round(est)
+    assert fit.cost <= one_round
+    # The single capped round had not reached a stationary point.
+    assert res["optimality"] < one_round_optimality
+
+
+def _single_round(est) -> tuple[float, float]:
+    """Output error as it was: one round of LM capped at 100 (p + 1); its
+    best start's cost and gradient."""
+    from spiralid.sysid.estimation import outputerror
+
+    starts = [
+        identify(est, ARX441, method="ls").theta,
+        steiglitz_mcbride(est, ARX441, identify(est, ARX441, method="ls").theta),
+    ]
+    cost = PaperCost(ARX441, est)
+    rounds = outputerror._ROUNDS
+    try:
+        outputerror._ROUNDS = 1
+        ends = [outputerror.local_polish(s, ARX441, est, "simulation") for s in starts]
+    finally:
+        outputerror._ROUNDS = rounds
+    best = min(ends, key=lambda end: float(cost(end[0])))
+    return float(cost(best[0])), float(best[1].optimality)
