@@ -39,10 +39,13 @@ def _step_up_jacobian(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return a, jac
 
 
-# One LM round's tolerances (step, cost, gradient), and the rounds a polish
-# may take when each runs into its evaluation cap.
+# One LM round's tolerances (step, cost, gradient); the rounds a polish may
+# take when each runs into its evaluation cap, and the relative fall of the
+# cost a capped round must bring for another to follow (less is the end of a
+# flat valley, not a step LM can still take).
 _TOL = 1e-12
 _ROUNDS = 10
+_GAIN = 1e-6
 
 
 def local_polish(
@@ -64,12 +67,13 @@ def local_polish(
 
     ``max_nfev`` caps the residual evaluations of one round of LM (default
     ``100 (p + 1)``, from the order); a round that reaches it is followed by
-    another from where it stopped, up to ten rounds, while the cost still
-    falls, so the polish ends where LM meets its tolerances (1e-12 relative
-    on step, cost and gradient) or stops improving. The result records
-    ``rounds``, the total ``nfev``, ``optimality`` (the gradient's largest
-    component at the end) and ``capped`` (the last round still ran into its
-    cap)."""
+    another from where it stopped, up to ten rounds, while a round still
+    lowers the cost by more than a millionth, so the polish ends where LM
+    meets its tolerances (1e-12 relative on step, cost and gradient) or
+    stops improving. The result records ``rounds``, the total ``nfev``,
+    ``optimality`` (the gradient's largest component at the end) and
+    ``capped`` (the last round reached its cap without the cost settling:
+    it still fell by more than a millionth, or LM took no step at all)."""
     na, t0 = arx.na, arx.max_lag
     if predictor == "simulation" and initial == "rest":
         # From rest is the measured-past problem on the record preceded by
@@ -144,14 +148,23 @@ def local_polish(
         # least_squares reports status 0 when it stopped at its cap: go on
         # from there while a round still lowers the cost, so the result is
         # a point where LM cannot improve, not where its count ran out.
-        improved = res.cost < 0.5 * np.sum(residual(x) ** 2) * (1 - _TOL)
+        before = 0.5 * float(np.sum(residual(x) ** 2))
+        gain = (before - res.cost) / before if before > 0 else 0.0
+        improved = gain > _GAIN
         x = res.x
         if res.status != 0 or not improved:
             break
     res.nfev, res.rounds, res.max_nfev = nfev, rounds, max_nfev
     # Stationarity at the end: the gradient's largest component (SciPy's
-    # first-order optimality) and whether every round ran into its cap.
-    res.capped = bool(res.status == 0)
+    # first-order optimality) and whether the cap, not the cost settling,
+    # ended it (a capped round that gained a little is the valley's end).
+    valley_end = 0.0 < gain <= _GAIN
+    res.capped = bool(res.status == 0 and not valley_end)
+    if res.status == 0 and valley_end:
+        res.message = (
+            f"A round of {max_nfev} evaluations lowered the cost by less than "
+            f"{_GAIN:g} of it: the end of a flat valley."
+        )
     a, _, b = parts(res.x)
     return np.r_[a, b], res
 
