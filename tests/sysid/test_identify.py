@@ -299,8 +299,6 @@ def test_oe_from_rest_is_a_prediction_error_method():
     # sensitivities filtered from rest) equals central finite differences of
     # the residual written out here with scipy.signal.lfilter from rest over
     # all N samples, and the gradient J' r of the criterion vanishes.
-    from spiralid.sysid.estimation.parametrizations import KMAX
-
     rng = np.random.default_rng(21)
     u = rng.standard_normal(500)
     clean = signal.lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
@@ -310,10 +308,9 @@ def test_oe_from_rest_is_a_prediction_error_method():
     assert oe.initial == "rest" and oe.result.success
 
     def residual(x):
-        a = step_up(KMAX * np.tanh(x[:2]))
-        return signal.lfilter([0.0, *x[2:]], np.r_[1.0, a], u) - data.y
+        return signal.lfilter([0.0, *x[2:]], np.r_[1.0, x[:2]], u) - data.y
 
-    raw = oe.result.raw  # least_squares' own result, in its coordinates
+    raw = oe.result.raw  # least_squares' own result (coordinates: theta)
     x = raw.x
     r = residual(x)
     np.testing.assert_allclose(r, raw.fun, rtol=1e-9, atol=1e-12)

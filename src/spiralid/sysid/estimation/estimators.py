@@ -140,11 +140,11 @@ class EstimatorResult(optimize.OptimizeResult):
         A search's box, in its searched coordinates.
     safe_start : bool, optional
         Whether a search's first population held the safe start.
-    optimality, rounds : float, int, optional
-        A polish's end: the gradient's largest component (SciPy's first-order
-        optimality) and the rounds of LM it took (a round that reaches its
-        evaluation cap is followed by another while the cost falls; status 1
-        when the last one still reached it).
+    optimality, at_bound : float, bool, optional
+        A polish's end: the gradient's largest component (first-order
+        optimality) and whether the end is on the stable region's edge
+        (where the gradient need not vanish); status 1 when the evaluation
+        cap, not a tolerance, ended it.
     start : str, optional
         Which start a polish kept (``"ls"``, ``"steiglitz-mcbride"``,
         ``"search"``); ``starts`` gives each start's cost.
@@ -280,14 +280,14 @@ def _polish(
         status=1 if capped else 0,
         success=bool(res.success),
         message=(
-            f"Stopped at the evaluation cap ({res.rounds} round(s) of max_nfev = "
-            f"{res.max_nfev}) before the tolerances were met."
+            f"Stopped at the evaluation cap (max_nfev = {res.max_nfev}) before "
+            "the tolerances were met."
             if capped
             else res.message
         ),
         nfev=int(res.nfev),
         optimality=float(res.optimality),
-        rounds=int(res.rounds),
+        at_bound=bool(res.at_bound),
         nit=None,
         history=None,
         elapsed=time.perf_counter() - t0,

@@ -1,14 +1,17 @@
 """Output error: Levenberg-Marquardt on the simulation error, kept stable.
 
 :func:`local_polish` is the local step of ``method="oe"`` and of
-``refine=True``: ``scipy.optimize.least_squares`` (Levenberg-Marquardt,
-analytic Jacobian) on the error :class:`~spiralid.sysid.PaperCost` defines,
-with the denominator searched as reflection coefficients
-``k = KMAX tanh(z)``, ``KMAX = 1 - 1e-6``, so every step is stable
-(unstable poles of a start are first reflected into the unit circle,
-``z -> 1 / conj(z)``). :func:`steiglitz_mcbride` gives the classical
-output-error start. The estimators (:mod:`spiralid.sysid.estimation.estimators`) run
-the polish from several starts and keep the lowest cost.
+``refine=True``: Levenberg-Marquardt
+(:func:`~spiralid.sysid.estimation.levenberg.levenberg_marquardt`, analytic
+Jacobian) on the error :class:`~spiralid.sysid.PaperCost` defines, over the
+ARX coefficients themselves, kept in the stable region :data:`KMAX` defines
+(every reflection coefficient ``|k_j| <= KMAX``, ``KMAX = 1 - 1e-6``): a
+trial step that leaves it has its unstable poles reflected into the unit
+circle, ``z -> 1 / conj(z)``, as a start's are. :func:`steiglitz_mcbride`
+gives the classical output-error start. The estimators
+(:mod:`spiralid.sysid.estimation.estimators`) run the polish from several
+starts and keep the lowest cost. docs/design-notes.md, "Where a local polish
+ends", says why the coefficients and why a projection.
 """
 
 from __future__ import annotations
@@ -18,34 +21,34 @@ from scipy import optimize, signal
 
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
-from ..models.polynomials import step_up
+from ..models.polynomials import step_down, step_up
+from .levenberg import levenberg_marquardt
 from .parametrizations import KMAX, stabilise
 
 __all__ = ["local_polish", "steiglitz_mcbride"]
 
-
-def _step_up_jacobian(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Step-up with its Jacobian ``D[i, j] = d a_i / d k_j`` (forward mode)."""
-    n = k.size
-    a = np.zeros(n)
-    jac = np.zeros((n, n))
-    for j in range(n):
-        prev, dprev = a[:j].copy(), jac[:j].copy()
-        a[:j] = prev + k[j] * prev[::-1]
-        jac[:j] = dprev + k[j] * dprev[::-1]
-        jac[:j, j] += prev[::-1]
-        a[j] = k[j]
-        jac[j, j] = 1.0
-    return a, jac
-
-
-# One LM round's tolerances (step, cost, gradient); the rounds a polish may
-# take when each runs into its evaluation cap, and the relative fall of the
-# cost a capped round must bring for another to follow (less is the end of a
-# flat valley, not a step LM can still take).
+# Tolerance of the polish (gradient, relative fall of the cost, step), and
+# where a crawl ends: a window of 10 (p + 1) evaluations that lowers the cost
+# by less than a millionth of it (along a valley that ends on the stability
+# boundary LM otherwise creeps for tens of thousands of evaluations, gaining
+# 1e-5 of the cost).
 _TOL = 1e-12
-_ROUNDS = 10
-_GAIN = 1e-6
+_STALL_WINDOW, _STALL_GAIN = 10, 1e-6
+
+
+def _within_bound(a: np.ndarray) -> bool:
+    """Every reflection coefficient of ``A`` at most :data:`KMAX` in size."""
+    return a.size == 0 or bool(np.all(np.abs(step_down(a)) <= KMAX))
+
+
+def _reflect_into_bound(theta: np.ndarray, na: int) -> np.ndarray | None:
+    """`theta` with its denominator's poles outside the region reflected in
+    (``None`` when rounding leaves it outside even so)."""
+    if _within_bound(theta[:na]):
+        return theta
+    k_b = stabilise(theta, ARX(na, theta.size - na, 0))
+    a = step_up(k_b[:na])
+    return np.r_[a, theta[na:]] if _within_bound(a) else None
 
 
 def local_polish(
@@ -57,23 +60,25 @@ def local_polish(
     max_nfev: int | None = None,
 ) -> tuple[np.ndarray, optimize.OptimizeResult]:
     """Levenberg-Marquardt polish of the `predictor`'s error as
-    :class:`PaperCost` defines it, kept stable: the denominator is searched
-    as ``k = kmax tanh(z)`` (reflection coefficients, so every step is
-    stable) with ``z`` unconstrained. Analytic Jacobian:
+    :class:`PaperCost` defines it, kept stable: the search is over ``theta``
+    itself, and a trial step whose denominator leaves the stable region
+    (some reflection coefficient ``|k_j| > KMAX``) has its outside poles
+    reflected in before it is judged. Analytic Jacobian:
     ``d yhat / d b_j = u(t-nk-j) / A`` and ``d yhat / d a_i = -yhat(t-i) / A``
     (simulation: sensitivities filtered from rest, with ``yhat`` zero before
     ``t = 0`` for ``initial="rest"`` and the measured initial state fixed
     for ``"measured"``), ``Phi`` (one-step).
 
-    ``max_nfev`` caps the residual evaluations of one round of LM (default
-    ``100 (p + 1)``, from the order); a round that reaches it is followed by
-    another from where it stopped, up to ten rounds, while a round still
-    lowers the cost by more than a millionth, so the polish ends where LM
-    meets its tolerances (1e-12 relative on step, cost and gradient) or
-    stops improving. The result records ``rounds``, the total ``nfev``,
-    ``optimality`` (the gradient's largest component at the end) and
-    ``capped`` (the last round reached its cap without the cost settling:
-    it still fell by more than a millionth, or LM took no step at all)."""
+    ``max_nfev`` caps the residual evaluations (default ``100 (p + 1)``, from
+    the order). The polish ends where LM meets its tolerance (1e-12 on the
+    gradient's cosine with the residual, the cost's relative fall and the
+    step), where no damped step lowers the cost, or where ``10 (p + 1)``
+    evaluations lowered the cost by less than a millionth of it. The result
+    (:func:`~spiralid.sysid.estimation.levenberg.levenberg_marquardt`'s)
+    records ``nfev``, ``optimality`` (the gradient's largest component at
+    the end), ``at_bound`` (the end is on the stable region's edge, where
+    the gradient need not vanish), ``max_nfev`` and ``capped`` (the cap, not
+    a tolerance, ended it)."""
     na, t0 = arx.na, arx.max_lag
     if predictor == "simulation" and initial == "rest":
         # From rest is the measured-past problem on the record preceded by
@@ -88,11 +93,6 @@ def local_polish(
     ulags = arx.input_lags(data.u)[:, t0:]
     past = y[t0 - na : t0][::-1]
 
-    def parts(x):
-        th = np.tanh(x[:na])
-        a, dadk = _step_up_jacobian(KMAX * th)
-        return a, dadk * (KMAX * (1.0 - th * th)), x[na:]
-
     if predictor == "simulation":
 
         def simulate(a, b):
@@ -104,69 +104,48 @@ def local_polish(
             return signal.lfilter([1.0], den, xs, zi=zi)[0]
 
         def residual(x):
-            a, _, b = parts(x)
-            return simulate(a, b) - yv
+            return simulate(x[:na], x[na:]) - yv
 
         def jacobian(x):
-            a, dadz, b = parts(x)
+            a, b = x[:na], x[na:]
             yext = np.r_[y[:t0], simulate(a, b)]
             lagged = [-yext[t0 - i : t0 - i + n_k] for i in range(1, na + 1)]
             rows = np.vstack([*lagged, ulags]) if na else ulags
-            sens = signal.lfilter([1.0], np.r_[1.0, a], rows, axis=1).T
-            return np.hstack([sens[:, :na] @ dadz, sens[:, na:]])
+            return signal.lfilter([1.0], np.r_[1.0, a], rows, axis=1).T
 
     else:
 
         def residual(x):
-            a, _, b = parts(x)
-            return phi @ np.r_[a, b] - yv
+            return phi @ x - yv
 
         def jacobian(x):
-            _, dadz, _ = parts(x)
-            return np.hstack([phi[:, :na] @ dadz, phi[:, na:]])
+            return phi
 
     if max_nfev is None:
         max_nfev = 100 * (arx.n_params + 1)
     start = stabilise(np.asarray(theta0, dtype=float), arx)
-    ratio = np.clip(start[:na] / KMAX, -1.0 + 1e-12, 1.0 - 1e-12)
-    x = np.r_[np.arctanh(ratio), start[na:]]
-    nfev = rounds = 0
-    while rounds < _ROUNDS:
-        rounds += 1
-        res = optimize.least_squares(
-            residual,
-            x,
-            jac=jacobian,
-            method="lm",
-            x_scale="jac",
-            xtol=_TOL,
-            ftol=_TOL,
-            gtol=_TOL,
-            max_nfev=max_nfev,
-        )
-        nfev += res.nfev
-        # least_squares reports status 0 when it stopped at its cap: go on
-        # from there while a round still lowers the cost, so the result is
-        # a point where LM cannot improve, not where its count ran out.
-        before = 0.5 * float(np.sum(residual(x) ** 2))
-        gain = (before - res.cost) / before if before > 0 else 0.0
-        improved = gain > _GAIN
-        x = res.x
-        if res.status != 0 or not improved:
-            break
-    res.nfev, res.rounds, res.max_nfev = nfev, rounds, max_nfev
-    # Stationarity at the end: the gradient's largest component (SciPy's
-    # first-order optimality) and whether the cap, not the cost settling,
-    # ended it (a capped round that gained a little is the valley's end).
-    valley_end = 0.0 < gain <= _GAIN
-    res.capped = bool(res.status == 0 and not valley_end)
-    if res.status == 0 and valley_end:
+    x0 = np.r_[step_up(start[:na]), start[na:]] if na else start
+    res = levenberg_marquardt(
+        residual,
+        jacobian,
+        x0,
+        project=lambda x: _reflect_into_bound(x, na),
+        max_nfev=max_nfev,
+        tol=_TOL,
+        stall=(_STALL_WINDOW * (arx.n_params + 1), _STALL_GAIN),
+    )
+    res.max_nfev = max_nfev
+    res.capped = res.status == 0
+    res.at_bound = na > 0 and bool(
+        np.max(np.abs(step_down(res.x[:na]))) > KMAX * (1.0 - 1e-9)
+    )
+    if res.at_bound and not res.capped:
         res.message = (
-            f"A round of {max_nfev} evaluations lowered the cost by less than "
-            f"{_GAIN:g} of it: the end of a flat valley."
+            "Ended on the edge of the stable region (a reflection coefficient "
+            f"at {KMAX}): the cost falls further only with a pole on or outside "
+            "the unit circle."
         )
-    a, _, b = parts(res.x)
-    return np.r_[a, b], res
+    return res.x.copy(), res
 
 
 def steiglitz_mcbride(
