@@ -10,6 +10,8 @@ Records (ARX(8, 8, 0), first 2/3 estimates, last 1/3 validates):
 - ``rig-payload``: a 0.1 kg payload at the tip.
 - ``rig-noisy``: accelerometer noise 5 m/s^2 instead of 1.
 - ``arm``: the real flexible arm (DaISy 96-009), ``ts = 0.01``, from rest.
+- ``rig-8000``: the rig's experiment four times as long (24 pulses, 12,000
+  samples: 8,000 estimate), for the scaling table.
 
 Methods, each at the same budget of cost evaluations (default 20,000; 50
 points):
@@ -46,6 +48,13 @@ seeds within 1 % of OE's cost (or below), median validation fit % (free run
 from rest over the whole record, scored on the last third), median wall
 time per identification, and the machine load.
 
+Scaling with the order (``--scaling``): ``spiral`` (default budget, seeds
+0..``--seeds``-1), OE and LS at ARX(n, n, 0) for n in ``--orders``
+(default 2, 4, 8, 12, 16, 24, 32) on ``rig`` and ``rig-8000``; median time,
+cost as a ratio to OE's, spiral's time as a ratio to OE's, and the growth
+exponent ``k`` of ``time ~ n^k`` fitted by least squares on log-log over
+n >= 4.
+
 Run: ``python benchmarks/identification.py [--seeds 20] [--budget 20000]
 [--records rig,arm] [--methods spiral,OE] [--workers 2] [--jsonl runs.jsonl]``;
 ``--summarise runs.jsonl`` prints the tables of a finished or partial run.
@@ -80,7 +89,8 @@ ARX_8 = ARX(8, 8, 0)
 ARM_CSV = (
     Path(__file__).resolve().parents[2] / "shared" / "data" / "daisy_robot_arm.csv"
 )
-RECORDS = ("rig", "rig-long", "rig-payload", "rig-noisy", "arm")
+RECORDS = ("rig", "rig-long", "rig-payload", "rig-noisy", "arm", "rig-8000")
+SCALING_ORDERS = (2, 4, 8, 12, 16, 24, 32)
 
 
 # -- records -------------------------------------------------------------------
@@ -106,6 +116,9 @@ def load_record(name: str, arm_csv: str | None = None) -> IOData:
             .run(FlexibleManipulator(payload_mass=0.1), rng=0)
             .iodata("end_acceleration")
         )
+    if name == "rig-8000":
+        exp = dataclasses.replace(paper_experiment(), duration=24.0, n_pulses=24)
+        return exp.run(rng=0).iodata("end_acceleration")
     if name == "rig-noisy":
         exp = dataclasses.replace(paper_experiment(), accel_noise=5.0)
         return exp.run(rng=0).iodata("end_acceleration")
@@ -328,6 +341,80 @@ def summarise(rows, records, methods):
     return "\n".join(lines)
 
 
+def scaling_one(task):
+    record, order, method, seed = task
+    est, _ = load_record(record).split(2 / 3)
+    arx = ARX(order, order, 0)
+    kw = {"rng": seed} if method == "spiral" else {}
+    t0 = time.perf_counter()
+    fit = identify(est, arx, method=method.lower(), **kw)
+    return dict(record=record, order=order, method=method, seed=seed,
+                cost=float(fit.cost), time=time.perf_counter() - t0)  # fmt: skip
+
+
+def growth_exponent(orders, times) -> float:
+    """``k`` of ``time ~ n^k``: least squares on log-log over n >= 4."""
+    keep = np.asarray(orders) >= 4
+    logs = np.log(np.asarray(orders, dtype=float)[keep])
+    return float(np.polyfit(logs, np.log(np.asarray(times)[keep]), 1)[0])
+
+
+def _key(row):
+    return row["record"], row["order"], row["method"]
+
+
+def summarise_scaling(rows, records, orders):
+    lines = []
+    for record in records:
+        lines.append(f"\n### {record}\n")
+        lines.append(
+            "| order | LS s | OE s | spiral s | spiral / OE time "
+            "| spiral cost / OE (median, worst) | LS cost / OE |"
+        )
+        lines.append("|---|---|---|---|---|---|---|")
+        med = {m: [] for m in ("LS", "OE", "spiral")}
+        for n in orders:
+            cell = {m: [r for r in rows if _key(r) == (record, n, m)] for m in med}
+            t = {m: float(np.median([r["time"] for r in cell[m]])) for m in med}
+            oe = cell["OE"][0]["cost"]
+            ratio = np.array([r["cost"] for r in cell["spiral"]]) / oe
+            for m in med:
+                med[m].append(t[m])
+            lines.append(
+                f"| {n} | {t['LS']:.3f} | {t['OE']:.2f} | {t['spiral']:.2f} | "
+                f"{t['spiral'] / t['OE']:.2f} | {np.median(ratio):.4f}, "
+                f"{ratio.max():.4f} | {cell['LS'][0]['cost'] / oe:.3f} |"
+            )
+        k = {m: growth_exponent(orders, med[m]) for m in med}
+        lines.append(
+            f"\ngrowth exponent k (time ~ n^k, n >= 4): LS {k['LS']:.2f}, "
+            f"OE {k['OE']:.2f}, spiral {k['spiral']:.2f}"
+        )
+    return "\n".join(lines)
+
+
+def scaling(args) -> None:
+    records = ("rig", "rig-8000")
+    orders = [int(n) for n in args.orders.split(",")]
+    tasks = [
+        (record, n, method, seed)
+        for record in records
+        for n in orders
+        for method, seeds in (("LS", 1), ("OE", 1), ("spiral", args.seeds))
+        for seed in range(seeds)
+    ]
+    scaling_one(("rig", 8, "spiral", 0))  # warm the compiled kernels
+    load0 = os.getloadavg()
+    t0 = time.perf_counter()
+    # One worker: the times are the point, and two would share the cores.
+    rows = [scaling_one(task) for task in tasks]
+    print(summarise_scaling(rows, records, orders))
+    print(
+        f"\n{len(tasks)} identifications in {time.perf_counter() - t0:.0f} s; "
+        f"load average at start {load0[0]:.2f}, at end {os.getloadavg()[0]:.2f}"
+    )
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=20)
@@ -345,7 +432,17 @@ def main(argv=None):
         metavar="JSONL",
         help="print the tables of a (possibly partial) --jsonl file and exit",
     )
+    ap.add_argument(
+        "--scaling",
+        action="store_true",
+        help="print the scaling table (time and cost against order)",
+    )
+    ap.add_argument("--orders", default=",".join(map(str, SCALING_ORDERS)),
+                    help="orders of the scaling table")  # fmt: skip
     args = ap.parse_args(argv)
+    if args.scaling:
+        scaling(args)
+        return
     records = args.records.split(",")
     methods = args.methods.split(",")
     for m in methods:
