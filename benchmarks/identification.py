@@ -178,7 +178,12 @@ def _projected(parametrization, method="ebsda", **kw):
     def run(est, seed, budget):
         cost = ProjectedCost(ARX_8, est)
         par = parametrization(est)
-        res = projected_spiral(cost, par, method, max_nfev=budget, rng=seed, **kw)
+        settings = dict(
+            n_points=50, polish_every=None, polish_nfev=10, restart_after=None
+        )
+        res = projected_spiral(
+            cost, par, method, max_nfev=budget, rng=seed, **(settings | kw)
+        )
         return res.x
 
     return run

@@ -12,6 +12,7 @@ manipulator.
 # kernels are imported only by the parts that need them.
 _SUBPACKAGES = ("datasets", "fms", "optim", "report", "sysid")
 _NAMES = {
+    "OptimiserResult": "optim",
     "SpiralResult": "optim",
     "minimize": "optim",
     "FlexibleManipulator": "fms",

@@ -293,9 +293,9 @@ def test_restarts_grow_the_population_within_the_budget(method):
         restarts=Restarts(stall=15),
         callback=lambda r: sizes.append(None),
     )
-    assert res.restarts >= 1
+    assert res.n_restarts >= 1
     assert res.nfev <= 6000
-    assert res.history.shape == (res.nit + res.restarts + 1,)
+    assert res.history.shape == (res.nit + res.n_restarts + 1,)
     assert np.all(np.diff(res.history) <= 0.0)
     assert res.fun == res.history[-1] == float(p.fun(res.x))
     assert len(sizes) == res.nit
@@ -309,7 +309,7 @@ def test_restarts_keep_the_best_of_all_runs_and_are_reproducible():
     np.testing.assert_array_equal(a.x, b.x)
     np.testing.assert_array_equal(a.history, b.history)
     # nfev adds each run's population: 8, then 16, 32, ... per restart.
-    sizes = [8 * 2**j for j in range(a.restarts + 1)]
+    sizes = [8 * 2**j for j in range(a.n_restarts + 1)]
     assert a.nfev >= sum(sizes)
 
 
@@ -318,5 +318,5 @@ def test_restarts_off_by_default():
     kw = dict(n_points=8, max_nfev=4000, vectorized=True, rng=7)
     a = minimize(p.fun, p.bounds(2), "sda", **kw)
     b = minimize(p.fun, p.bounds(2), "sda", restarts=False, **kw)
-    assert a.restarts == b.restarts == 0
+    assert a.n_restarts == b.n_restarts == 0
     np.testing.assert_array_equal(a.history, b.history)

@@ -31,8 +31,8 @@ def test_same_minimum_as_scipy_least_squares():
                                  xtol=1e-15, ftol=1e-15, gtol=1e-15)  # fmt: skip
     np.testing.assert_allclose(ours.x, ref.x, rtol=1e-8)
     np.testing.assert_allclose(ours.cost, ref.cost, rtol=1e-12)
-    assert ours.status in (1, 2, 3, 4) and ours.success
-    assert ours.message == STOPS[ours.status]
+    assert ours.stop in (1, 2, 3, 4) and ours.success and ours.status == 0
+    assert ours.message == STOPS[ours.stop]
     # The gradient J' r vanishes at the end.
     assert ours.optimality == pytest.approx(np.max(np.abs(ours.jac.T @ ours.fun)))
     assert ours.optimality < 1e-8
@@ -75,7 +75,9 @@ def test_cap_and_stall_are_reported():
     residual, jacobian = _exponential_fit()
     x0 = np.array([1.0, 0.5, 0.0])
     capped = levenberg_marquardt(residual, jacobian, x0, max_nfev=3)
-    assert capped.status == 0 and not capped.success and capped.nfev <= 3
+    assert capped.status == 1 and capped.stop == 0 and not capped.success
+    assert capped.nfev <= 3
     # A stall window whose required gain no step can bring.
     stalled = levenberg_marquardt(residual, jacobian, x0, stall=(2, 1.0))
-    assert stalled.status == 5 and "flat valley" in stalled.message
+    assert stalled.stop == 5 and stalled.status == 0
+    assert "flat valley" in stalled.message

@@ -9,6 +9,9 @@ from spiralid.sysid.estimation.memetic import frequency_seeds, projected_spiral
 from spiralid.sysid.estimation.modal import ModalParametrization
 from spiralid.sysid.estimation.varpro import ProjectedCost
 
+# A pure spiral search over the modes; tests set what they exercise.
+PLAIN = dict(n_points=50, polish_every=None, polish_nfev=10, restart_after=None)
+
 
 def _two_modes(n=3000, ts=0.002, noise=0.0, seed=0):
     """Two lightly damped modes at 12 and 40 Hz, sampled exactly."""
@@ -24,7 +27,8 @@ def test_memetic_search_recovers_a_two_mode_system():
     data, a_true = _two_modes()
     cost = ProjectedCost(ARX(4, 3, 1), data)
     par = ModalParametrization(4, data.ts)
-    res = projected_spiral(cost, par, "ebsda", max_nfev=3000, polish_every=5, rng=0)
+    kw = PLAIN | dict(max_nfev=3000, polish_every=5, rng=0)
+    res = projected_spiral(cost, par, "ebsda", **kw)
     assert res.fun < 1e-3  # percent RMS error: the true model costs 0
     assert res.x[:4] == pytest.approx(a_true, abs=1e-6)
     assert res.x[4:] == pytest.approx([0.5, 0.2, -0.1], abs=1e-6)
@@ -35,13 +39,14 @@ def test_same_seed_same_result_and_budget_respected():
     data, _ = _two_modes(noise=0.05)
     cost = ProjectedCost(ARX(4, 3, 1), data)
     par = ModalParametrization(4, data.ts)
-    kw = dict(max_nfev=1500, polish_every=5, restart_after=10, rng=7)
+    kw = PLAIN | dict(max_nfev=1500, polish_every=5, restart_after=10, rng=7)
     one = projected_spiral(cost, par, "sda", **kw)
     two = projected_spiral(cost, par, "sda", **kw)
     assert np.array_equal(one.x, two.x) and one.fun == two.fun
     assert one.nfev <= 1500
     assert np.all(np.diff(one.history) <= 0)
-    assert one.history.size == one.nit + 1
+    assert one.history.size == one.nit + one.n_restarts + 1
+    assert one.status == 1  # the budget ended it
 
 
 def test_an_initial_point_bounds_the_result():
@@ -49,7 +54,7 @@ def test_an_initial_point_bounds_the_result():
     cost = ProjectedCost(ARX(4, 3, 1), data)
     par = ModalParametrization(4, data.ts)
     start = np.array([[12.0, 40.0, np.log10(0.02), np.log10(0.03)]])
-    res = projected_spiral(cost, par, "sda", max_nfev=500, x0=start, rng=0)
+    res = projected_spiral(cost, par, "sda", max_nfev=500, x0=start, rng=0, **PLAIN)
     assert res.fun <= cost(par.to_denominator(start))[0]
 
 

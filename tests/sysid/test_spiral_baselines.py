@@ -146,5 +146,5 @@ def test_output_error_ends_where_no_local_step_improves():
     assert cost(again) >= fit.cost * (1 - 1e-6)
     ls = identify(est, ARX441, method="ls").theta
     _, from_ls = outputerror.local_polish(ls, ARX441, est, "simulation")
-    assert from_ls.status in (1, 2, 3, 4) and from_ls.optimality < 1e-4
+    assert from_ls.stop in (1, 2, 3, 4) and from_ls.optimality < 1e-4
     assert res["starts"]["ls"] >= fit.cost

@@ -8,6 +8,7 @@ Knows nothing of system identification. See :func:`minimize`;
 from spiralid.optim import testfunctions
 from spiralid.optim.evolution import differential_evolution
 from spiralid.optim.restarts import Restarts
+from spiralid.optim.result import STATUS, OptimiserResult
 from spiralid.optim.rotation import planes, rotate, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,
@@ -25,10 +26,12 @@ from spiralid.optim.spiral import RULES, SpiralResult, SpiralSearch, minimize
 
 __all__ = [
     "RULES",
+    "STATUS",
     "ConstantSpiral",
     "ConvergentSpiral",
     "ExponentialSpiral",
     "LinearSpiral",
+    "OptimiserResult",
     "PeriodicSpiral",
     "Restarts",
     "SpiralResult",

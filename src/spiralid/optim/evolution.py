@@ -18,6 +18,7 @@ import numpy as np
 from scipy import optimize
 
 from spiralid._checks import generator, integer
+from spiralid.optim.result import OptimiserResult
 
 __all__ = ["differential_evolution"]
 
@@ -32,7 +33,7 @@ def differential_evolution(
     rng=None,
     x0=None,
     callback: Callable | None = None,
-) -> optimize.OptimizeResult:
+) -> OptimiserResult:
     """Minimise a vectorised `fun` by SciPy's differential evolution.
 
     SciPy's defaults otherwise (``best1bin``, mutation (0.5, 1),
@@ -63,11 +64,14 @@ def differential_evolution(
 
     Returns
     -------
-    scipy.optimize.OptimizeResult
+    OptimiserResult
         ``x, fun, nit, success, message`` as SciPy gives them, ``nfev``
-        counting objective evaluations (SciPy counts vectorised calls), plus
-        ``history`` (best cost after each generation, index 0 the initial
-        population) and ``elapsed`` (seconds).
+        counting objective evaluations (SciPy counts vectorised calls),
+        ``status`` (a key of :data:`~spiralid.optim.result.STATUS`: 1 when
+        `max_nfev` left no room for another generation, 2 at `max_iter`, 0
+        when the callback stopped it), ``n_restarts`` (0), ``history`` (best
+        cost after each generation, index 0 the initial population) and
+        ``elapsed`` (seconds).
 
     Examples
     --------
@@ -89,10 +93,11 @@ def differential_evolution(
         raise ValueError(f"`bounds` must have low < high in every row; got {bounds!r}")
     n_points = integer(n_points, "n_points", 5)
     max_iter = integer(max_iter, "max_iter", 1)
+    generations = max_iter
     if max_nfev is not None:
         # The initial population and one generation at least.
         max_nfev = integer(max_nfev, "max_nfev", 2 * n_points)
-        max_iter = min(max_iter, max_nfev // n_points - 1)
+        generations = min(max_iter, max_nfev // n_points - 1)
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
@@ -127,17 +132,19 @@ def differential_evolution(
         return np.where(np.isfinite(costs), costs, np.inf)
 
     # SciPy passes the OptimizeResult only to a parameter of this exact name.
+    stopped = False
+
     def after_generation(intermediate_result: optimize.OptimizeResult) -> bool:
+        nonlocal stopped
         history.append(float(intermediate_result.fun))
-        if callback is None:
-            return False
-        return bool(callback(intermediate_result))
+        stopped = callback is not None and bool(callback(intermediate_result))
+        return stopped
 
     start = time.perf_counter()
     res = optimize.differential_evolution(
         batch,
         box,
-        maxiter=max_iter,
+        maxiter=generations,
         init=init,
         rng=gen,
         polish=False,
@@ -147,7 +154,20 @@ def differential_evolution(
         vectorized=True,
         callback=after_generation,
     )
-    res.nfev = nfev
-    res.history = np.minimum.accumulate(np.asarray(history, dtype=float))
-    res.elapsed = time.perf_counter() - start
-    return res
+    if stopped:
+        status = 0
+    else:
+        status = 2 if res.nit >= max_iter else 1
+    return OptimiserResult(
+        x=res.x,
+        fun=float(res.fun),
+        status=status,
+        success=bool(res.success),
+        message=str(res.message),
+        nit=int(res.nit),
+        nfev=nfev,
+        n_restarts=0,
+        history=np.minimum.accumulate(np.asarray(history, dtype=float)),
+        elapsed=time.perf_counter() - start,
+        population=res.population,
+    )

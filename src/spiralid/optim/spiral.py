@@ -20,7 +20,6 @@ until a finite cost turns up (every deviation is then ``inf``).
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import Bounds
@@ -28,6 +27,7 @@ from scipy.optimize import Bounds
 from spiralid._checks import generator, integer, real_array
 from spiralid.optim import _kernels
 from spiralid.optim.restarts import MIN_ITER, Restarts, parse_restarts
+from spiralid.optim.result import OptimiserResult
 from spiralid.optim.rotation import _sweep_order, rotation_matrix
 from spiralid.optim.rules import (
     ConstantSpiral,
@@ -76,54 +76,12 @@ RULES = _METHODS
 _POLICIES = ("none", "clip", "reflect")
 
 
-@dataclass
-class SpiralResult:
-    """Outcome of a spiral search.
+# minimize's result: the one optimiser result type, under the name the
+# spiral searches have always given it.
+SpiralResult = OptimiserResult
 
-    Attributes
-    ----------
-    x : ndarray, shape (n,)
-        Best point found (the final centre).
-    fun : float
-        Its cost as returned by the objective (non-finite only if no finite
-        cost was ever found).
-    nit : int
-        Iterations performed (over all runs, with restarts).
-    nfev : int
-        Objective evaluations, one per point: ``n_points`` for the initial
-        population, then ``n_points - 1`` per iteration (the centre does not
-        move and is not re-evaluated), i.e. ``n_points + nit (n_points - 1)``
-        without restarts; each restart adds its new population.
-    success : bool
-        True if the search ended on its iteration or evaluation budget or
-        on ``target``, with a finite cost (and ``target`` reached if given).
-    message : str
-        Why the search stopped.
-    history : ndarray, shape (nit + restarts + 1,)
-        Best cost so far after each iteration and each restart's initial
-        population; index 0 is the initial population. Non-finite costs
-        are recorded as ``inf``, so it never increases.
-    elapsed : float
-        Wall-clock seconds, objective evaluations included.
-    mean_radius, mean_angle : ndarray, shape (nit,)
-        Mean radius and angle (radians) over the moving points at each
-        iteration, for plots of the rule's behaviour. A
-        :class:`~spiralid.optim.StepRateRule` has no angle: NaN.
-    restarts : int
-        Number of restarts (0 unless ``restarts`` was set).
-    """
-
-    x: np.ndarray
-    fun: float
-    nit: int
-    nfev: int
-    success: bool
-    message: str
-    history: np.ndarray
-    elapsed: float
-    mean_radius: np.ndarray
-    mean_angle: np.ndarray
-    restarts: int = 0
+# The STATUS key of each way a search stops.
+_STATUS_CODE = {"max_iter": 2, "max_nfev": 1, "target": 0, "callback": 0, "running": 0}
 
 
 def _parse_bounds(bounds) -> tuple[np.ndarray, np.ndarray]:
@@ -466,12 +424,15 @@ class SpiralSearch:
             self.mean_radius.append(float(r.sum()) / k)
             self.mean_angle.append(float(theta.sum()) / k)
 
-    def move_centre(self, x, fun: float) -> bool:
+    def move_centre(self, x, fun: float, nfev: int = 0) -> bool:
         """Replace the centre by `x` of cost `fun` if that is lower.
 
         For a point found outside the spiral moves, e.g. a local polish of
         the centre in a memetic search; the rule's next moves rotate about
-        it. It must lie within the bounds. Returns whether it was taken.
+        it, and it counts as the centre moving (for restarts and step-rate
+        rules). It must lie within the bounds. `nfev`, the evaluations spent
+        finding it, is added to :attr:`nfev` whether or not it is taken.
+        Returns whether it was taken.
         """
         pt = np.asarray(x, dtype=np.float64)
         if pt.shape != self._lo.shape or not np.all(np.isfinite(pt)):
@@ -480,10 +441,12 @@ class SpiralSearch:
             )
         if np.any((pt < self._lo) | (pt > self._hi)):
             raise ValueError("`x` must lie within `bounds`")
+        self.nfev += integer(nfev, "nfev", 0)
         if not (math.isfinite(fun) and fun < self._f[0]):
             return False
         self._x[0] = pt
         self._f[0] = fun
+        self.last_move = self.nit
         self.history[-1] = self._best_cost()
         return True
 
@@ -504,6 +467,11 @@ class SpiralSearch:
     def fun(self) -> float:
         """The cost of :attr:`x`."""
         return min(float(self._f[0]), self._archive[1])
+
+    @property
+    def centre(self) -> np.ndarray:
+        """The current run's centre (row 0 of :attr:`population`)."""
+        return self._x[0].copy()
 
     @property
     def n_points(self) -> int:
@@ -528,7 +496,8 @@ class SpiralSearch:
         return self._f.copy()
 
     def result(self, status: str = "running", elapsed: float = 0.0, target=None):
-        """Package the current state as a :class:`SpiralResult`.
+        """Package the current state as an
+        :class:`~spiralid.optim.result.OptimiserResult` (see :func:`minimize`).
 
         ``status`` is a key of the stop-message table: "max_iter",
         "max_nfev", "target", "callback" or "running".
@@ -548,18 +517,19 @@ class SpiralSearch:
         if status != "running" and not reached and finite:
             notes.append(_NOTES["target_missed"])
         success = status in ("max_iter", "max_nfev", "target") and finite and reached
-        return SpiralResult(
+        return OptimiserResult(
             x=self.x,
             fun=fun,
-            nit=self.nit,
-            nfev=self.nfev,
+            status=_STATUS_CODE[status],
             success=success,
             message=" ".join(notes),
+            nit=self.nit,
+            nfev=self.nfev,
+            n_restarts=self.restarts,
             history=np.array(self.history),
             elapsed=elapsed,
             mean_radius=np.array(self.mean_radius),
             mean_angle=np.array(self.mean_angle),
-            restarts=self.restarts,
         )
 
 
@@ -593,7 +563,8 @@ def minimize(
     callback: Callable | None = None,
     bounds_policy: str = "none",
     restarts: bool | Restarts = False,
-) -> SpiralResult:
+    on_iteration: Callable | None = None,
+) -> OptimiserResult:
     """Minimise ``fun`` with a spiral dynamic algorithm (SDA, Eb-SDA, LASDA).
 
     Parameters
@@ -623,7 +594,7 @@ def minimize(
     max_nfev : int, optional
         Budget of objective evaluations (``>= n_points``). The search stops
         before an iteration that would exceed it, so ``nfev <= max_nfev``.
-        See :class:`SpiralResult` for how evaluations are counted.
+        See Returns for how evaluations are counted.
     target : float, optional
         Stop as soon as the best cost is at or below ``target``.
     rng : None, int or numpy.random.Generator
@@ -635,7 +606,7 @@ def minimize(
         ``bounds``); the rest are drawn uniformly.
     callback : callable, optional
         ``callback(intermediate_result)`` after every iteration (the last
-        one included) with a :class:`SpiralResult`; returning True stops the
+        one included) with the result so far; returning True stops the
         search. If ``target`` is reached in the same iteration, the stop is
         reported as reaching the target.
     bounds_policy : {"none", "clip", "reflect"}
@@ -648,10 +619,32 @@ def minimize(
         point of all runs is returned. Off by default (the paper's
         configurations). A restart happens only if its population can still
         make 10 iterations within the budget.
+    on_iteration : callable, optional
+        ``on_iteration(search)`` with the :class:`SpiralSearch` after every
+        iteration, before `callback`: a hook that may move the centre
+        (:meth:`SpiralSearch.move_centre`, e.g. a local polish of it, as the
+        memetic identification search does); the evaluations it reports
+        there count toward `max_nfev`.
 
     Returns
     -------
-    SpiralResult
+    OptimiserResult
+        ``x`` (the best point: the final centre, or an earlier run's best),
+        ``fun`` (its cost; non-finite only if no finite cost was ever
+        found), ``status`` (a key of :data:`~spiralid.optim.result.STATUS`:
+        1 at ``max_nfev``, 2 at ``max_iter``, 0 at ``target`` or the
+        callback), ``success`` (it ended on its budget or ``target`` with a
+        finite cost, and ``target`` reached if given), ``message``,
+        ``nit`` (over all runs), ``nfev`` (one per point: ``n_points`` for
+        the initial population, then ``n_points - 1`` per iteration, as the
+        centre does not move and is not re-evaluated; each restart adds its
+        new population), ``n_restarts``, ``history`` (best cost so far after
+        each iteration and each restart's initial population, index 0 the
+        initial population, non-finite as ``inf``, never increasing),
+        ``elapsed`` (seconds), and ``mean_radius``, ``mean_angle`` (mean
+        radius and angle in radians over the moving points at each
+        iteration, for plots of the rule's behaviour; a
+        :class:`~spiralid.optim.StepRateRule` has no angle: NaN).
 
     Examples
     --------
@@ -680,6 +673,10 @@ def minimize(
             raise ValueError(f"`target` must be a real number or None; got {target!r}")
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
+    if on_iteration is not None and not callable(on_iteration):
+        raise ValueError(
+            f"`on_iteration` must be callable or None; got {on_iteration!r}"
+        )
     restarts = parse_restarts(restarts)
 
     def iterations_left(m: int, nit: int, nfev: int) -> int:
@@ -721,6 +718,8 @@ def minimize(
                     status = "target"
                 continue
         search.step()
+        if on_iteration is not None:
+            on_iteration(search)
         # The callback sees every iteration, the last one included, so that
         # callers can time-stamp each entry of `history`.
         stop = callback is not None and callback(

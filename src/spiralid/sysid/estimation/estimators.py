@@ -80,10 +80,10 @@ from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
-from scipy import optimize
 
 from spiralid._checks import integer
 from spiralid.optim import RULES, differential_evolution, minimize
+from spiralid.optim.result import STATUS, OptimiserResult
 
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
@@ -101,18 +101,11 @@ __all__ = [
     "search_options",
 ]
 
-# The iteration cap of minimize() and differential_evolution() when none is given.
-_DEFAULT_MAX_ITER = 500
 
-STATUS = {
-    0: "Finished: exact, converged, or stopped by the target or the callback.",
-    1: "Stopped at the evaluation cap (max_nfev).",
-    2: "Stopped at the iteration cap (max_iter).",
-}
-
-
-class EstimatorResult(optimize.OptimizeResult):
-    """What every estimator returns; behaves like ``scipy.optimize.OptimizeResult``.
+class EstimatorResult(OptimiserResult):
+    """What every estimator returns: the optimisers' one result type
+    (:class:`~spiralid.optim.OptimiserResult`, which behaves like
+    ``scipy.optimize.OptimizeResult``) with the ARX theta as ``x``.
 
     Attributes
     ----------
@@ -248,6 +241,7 @@ def _estimate_ls(problem: Problem) -> EstimatorResult:
         message="Least-squares solution (exact minimiser of the one-step error).",
         nfev=0,
         nit=0,
+        n_restarts=0,
         history=None,
         elapsed=time.perf_counter() - t0,
         raw=None,
@@ -288,7 +282,8 @@ def _polish(
         nfev=int(res.nfev),
         optimality=float(res.optimality),
         at_bound=bool(res.at_bound),
-        nit=None,
+        nit=int(res.nit),
+        n_restarts=0,
         history=None,
         elapsed=time.perf_counter() - t0,
         start=name,
@@ -339,27 +334,15 @@ def _first_population(
     return np.concatenate(parts) if parts else None
 
 
-def _stop_status(nit: int, nfev: int, options: dict, per_iteration: int) -> int:
-    """The :data:`STATUS` key of a search that ran `nit` iterations."""
-    if nit >= options.get("max_iter", _DEFAULT_MAX_ITER):
-        return 2
-    budget = options.get("max_nfev")
-    if budget is not None and nfev + per_iteration > budget:
-        return 1
-    return 0
-
-
 def _search(
     problem: Problem,
     optimiser: Callable,
     options: dict,
-    per_iteration: Callable[[int], int],
 ) -> EstimatorResult:
     """A population search over the problem's parametrisation.
 
-    ``optimiser(fun, box, x0=..., **options)`` runs it;
-    ``per_iteration(n_points)`` is its evaluations per iteration (for the
-    status).
+    ``optimiser(fun, box, x0=..., **options)`` runs it and returns an
+    :class:`~spiralid.optim.OptimiserResult`, whose status is the estimator's.
     """
     t0 = time.perf_counter()
     par = problem.parametrization
@@ -373,11 +356,12 @@ def _search(
     result = EstimatorResult(
         x=theta,
         fun=float(problem.cost(theta)),
-        status=_stop_status(raw.nit, raw.nfev, options, per_iteration(m)),
+        status=int(raw.status),
         success=bool(raw.success),
         message=str(raw.message),
         nfev=int(raw.nfev),
         nit=int(raw.nit),
+        n_restarts=int(raw.n_restarts),
         history=None if history is None else np.asarray(history, dtype=float),
         elapsed=time.perf_counter() - t0,
         x_search=np.asarray(raw.x, dtype=float),
@@ -407,14 +391,14 @@ def _estimate_spiral(problem: Problem, *, rule: str, **options) -> EstimatorResu
     def run(fun, box, **opts):
         return minimize(fun, box, method=rule, rng=problem.rng, vectorized=True, **opts)
 
-    return _search(problem, run, options, per_iteration=lambda m: m - 1)
+    return _search(problem, run, options)
 
 
 def _estimate_de(problem: Problem, **options) -> EstimatorResult:
     def run(fun, box, **opts):
         return differential_evolution(fun, box, rng=problem.rng, **opts)
 
-    return _search(problem, run, options, per_iteration=lambda m: m)
+    return _search(problem, run, options)
 
 
 def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
@@ -577,7 +561,7 @@ def _rule_options() -> tuple[str, ...]:
     the method's own, so a method bound to one rule cannot be re-ruled)."""
     import inspect
 
-    own = {"method", "rng", "vectorized"}
+    own = {"method", "rng", "vectorized", "on_iteration"}
     return tuple(
         name
         for name, par in inspect.signature(minimize).parameters.items()

@@ -25,7 +25,9 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy import linalg, optimize
+from scipy import linalg
+
+from spiralid.optim.result import OptimiserResult
 
 __all__ = ["levenberg_marquardt"]
 
@@ -34,6 +36,8 @@ __all__ = ["levenberg_marquardt"]
 _LAMBDA0 = 1e-3
 _LAMBDA_MAX = 1e16
 
+# Why the polish stopped (``stop``); 0 is the evaluation cap, the only one
+# that is status 1 of :data:`~spiralid.optim.result.STATUS`.
 STOPS = {
     0: "The evaluation cap was reached before a tolerance was met.",
     1: "The gradient is below its tolerance: a stationary point.",
@@ -53,7 +57,7 @@ def levenberg_marquardt(
     max_nfev: int = 1000,
     tol: float = 1e-12,
     stall: tuple[int, float] | None = None,
-) -> optimize.OptimizeResult:
+) -> OptimiserResult:
     """Minimise ``0.5 |residual(x)|^2`` from `x0` by Levenberg-Marquardt.
 
     Parameters
@@ -82,11 +86,12 @@ def levenberg_marquardt(
 
     Returns
     -------
-    OptimizeResult
+    OptimiserResult
         ``x``, ``cost`` (``0.5 |r|^2``), ``fun`` (the residual at ``x``),
         ``jac`` (at ``x``), ``optimality`` (the gradient ``J' r``'s largest
-        component), ``nfev``, ``njev``, ``nit`` (accepted steps), ``status``
-        (a key of :data:`STOPS`; 0 means the cap ended it) and ``message``.
+        component), ``nfev``, ``njev``, ``nit`` (accepted steps), ``stop``
+        (a key of :data:`STOPS`), ``status`` (1 when the cap ended it,
+        otherwise 0), ``success`` and ``message``.
     """
     project = project or (lambda x: x)
     x = np.array(x0, dtype=float)
@@ -139,7 +144,7 @@ def levenberg_marquardt(
             checkpoint = (nfev, cost)
     jac = jacobian(x)
     njev += 1
-    return optimize.OptimizeResult(
+    return OptimiserResult(
         x=x,
         cost=0.5 * cost,
         fun=r,
@@ -148,7 +153,10 @@ def levenberg_marquardt(
         nfev=nfev,
         njev=njev,
         nit=nit,
-        status=status,
+        n_restarts=0,
+        history=None,
+        stop=status,
+        status=1 if status == 0 else 0,
         success=status != 0,
         message=STOPS[status],
     )

@@ -8,8 +8,8 @@ ModalParametrization`), scoring each candidate with
 :class:`~spiralid.sysid.estimation.varpro.ProjectedCost` (the paper's cost at the
 least-squares numerator). Two optional ingredients:
 
-- ``polish_every=k``: every ``k`` iterations (and once at the end) the
-  centre is polished by a few Levenberg-Marquardt steps of the projected
+- ``polish_every=k``: every ``k`` iterations (and once at the end, the
+  best point) the centre is polished by a few Levenberg-Marquardt steps of the projected
   problem (:func:`~spiralid.sysid.estimation.varpro.gauss_newton_polish`) and moved to
   the polished point if that is better: a memetic algorithm (a population
   search with individual learning; Moscato 1989). The spiral moves then
@@ -28,10 +28,10 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy import optimize, signal
+from scipy import signal
 
 from spiralid._checks import integer
-from spiralid.optim import SpiralSearch
+from spiralid.optim import OptimiserResult, Restarts, SpiralSearch, minimize
 
 from ..data import IOData
 from ..spectra import PSD, default_nperseg, find_resonances
@@ -88,20 +88,24 @@ def frequency_seeds(data: IOData, parametrization, m: int, rng=None) -> np.ndarr
 def projected_spiral(
     cost: ProjectedCost,
     parametrization,
-    method="sda",
+    method,
     *,
-    n_points: int = 50,
-    max_nfev: int = 20_000,
-    polish_every: int | None = None,
-    polish_nfev: int = 10,
+    n_points: int,
+    max_nfev: int,
+    polish_every: int | None,
+    polish_nfev: int,
+    restart_after: int | None,
     x0=None,
-    restart_after: int | None = None,
-    restart_points=None,
     max_iter: int | None = None,
     callback=None,
     rng=None,
-) -> optimize.OptimizeResult:
+) -> OptimiserResult:
     """Spiral search over denominator coordinates, numerator projected out.
+
+    :func:`spiralid.optim.minimize` drives the search (its budget, restarts
+    and callback); this adds the memetic polish as its per-iteration hook.
+    The settings have no defaults here: the recommended method's are
+    :func:`~spiralid.sysid.estimation.estimators._estimate_recommended`'s.
 
     Parameters
     ----------
@@ -116,37 +120,33 @@ def projected_spiral(
     max_nfev : int
         Budget of cost evaluations, polish included; no population step or
         polish is started that would exceed it.
-    polish_every : int, optional
-        Polish the centre every this many iterations and once at the end;
-        ``None``: a pure spiral search.
+    polish_every : int or None
+        Polish the centre every this many iterations and the best point
+        once at the end; ``None``: a pure spiral search.
     polish_nfev : int
         Evaluations per polish.
+    restart_after : int or None
+        Start a fresh population of the same size, uniform in the box, when
+        the centre has not moved for this many iterations (IPOP's restart
+        without growth, :class:`~spiralid.optim.Restarts`); the best point
+        over all populations is returned. ``None``: no restarts.
     x0 : array_like, shape (k, na), optional
         Initial points (the rest of the population is uniform in the box).
-    restart_after : int, optional
-        Start a fresh population (uniform in the box plus
-        `restart_points`) when the centre has not improved for this many
-        iterations; the best point over all populations is returned.
-        ``None``: no restarts.
-    restart_points : array_like, shape (k, na), optional
-        Initial points of every restarted population.
     max_iter : int, optional
         Cap on the iterations (all populations together).
     callback : callable, optional
-        ``callback(intermediate)`` after every iteration with an
-        ``OptimizeResult`` holding ``x`` (coordinates) and ``fun`` (best so
-        far); returning True stops the search.
+        As in :func:`spiralid.optim.minimize`: after every iteration with
+        the result so far (``x`` in the searched coordinates); returning
+        True stops the search.
     rng : int, Generator or None
 
     Returns
     -------
-    OptimizeResult
+    OptimiserResult
         ``x`` the ARX theta ``[a, b]``, ``fun`` its cost (eq. (2)-(3)),
-        ``z`` the searched coordinates, ``nfev``, ``nit``, ``n_polish``
-        (polishes that moved the centre), ``history`` (best cost after each
-        iteration), ``status`` (1: budget used, 2: `max_iter`, 0: the
-        callback), ``message``, ``success``,
-        ``elapsed``.
+        ``z`` the searched coordinates, ``status`` (1: budget used, 2:
+        `max_iter`, 0: the callback), ``n_polish`` (polishes that moved the
+        centre) and the rest of :func:`~spiralid.optim.minimize`'s result.
     """
     t_start = time.perf_counter()
     n_points = integer(n_points, "n_points", 2)
@@ -156,88 +156,52 @@ def projected_spiral(
         polish_every = integer(polish_every, "polish_every", 1)
     if restart_after is not None:
         restart_after = integer(restart_after, "restart_after", 1)
-    if max_iter is not None:
-        max_iter = integer(max_iter, "max_iter", 1)
-    gen = np.random.default_rng(rng)
+    max_iter = max_nfev if max_iter is None else integer(max_iter, "max_iter", 1)
+    n_polish = 0
 
     def fun(z):
         return cost(parametrization.to_denominator(z))
 
-    def new_search(start):
-        return SpiralSearch(
-            fun,
-            parametrization.bounds,
-            method,
-            n_points=n_points,
-            rng=gen,
-            vectorized=True,
-            x0=start,
-            bounds_policy="clip",
-        )
+    def polish(search: SpiralSearch) -> None:
+        nonlocal n_polish
+        if search.nit % polish_every or search.nfev + polish_nfev > max_nfev:
+            return
+        res = gauss_newton_polish(cost, parametrization, search.centre, polish_nfev)
+        n_polish += search.move_centre(res.x, res.fun, nfev=res.nfev)
 
-    search = new_search(x0)
-    per_step = n_points - 1
-    used = 0  # evaluations of finished searches and of every polish
-    n_polish = n_restarts = nit = 0
-    best_z, best_f = search.x, search.fun
-    history = [best_f]
-    stalled = 0
-
-    def spent() -> int:
-        return used + search.nfev
-
-    def polish() -> None:
-        nonlocal used, n_polish
-        res = gauss_newton_polish(cost, parametrization, search.x, polish_nfev)
-        used += res.nfev
-        n_polish += bool(search.move_centre(res.x, res.fun))
-
-    status, message = 1, "Maximum number of function evaluations reached."
-    while spent() + per_step <= max_nfev:
-        if max_iter is not None and nit >= max_iter:
-            status, message = 2, "Maximum number of iterations reached."
-            break
-        before = search.fun
-        search.step()
-        nit += 1
-        due = polish_every and search.nit % polish_every == 0
-        if due and spent() + polish_nfev <= max_nfev:
-            polish()
-        improved = search.fun < before * (1.0 - 1e-9)
-        stalled = 0 if improved else stalled + 1
-        if search.fun < best_f:
-            best_z, best_f = search.x, search.fun
-        history.append(best_f)
-        if callback is not None and callback(
-            optimize.OptimizeResult(x=best_z.copy(), fun=best_f)
-        ):
-            status, message = 0, "The callback requested a stop."
-            break
-        if restart_after and stalled >= restart_after:
-            if spent() + n_points + per_step > max_nfev:
-                break
-            used += search.nfev
-            search = new_search(restart_points)
-            n_restarts += 1
-            stalled = 0
-    if polish_every and status != 0 and spent() + polish_nfev <= max_nfev:
-        polish()
-    if search.fun < best_f:
-        best_z, best_f = search.x, search.fun
-        history[-1] = best_f
-    f_best, b_best = cost.evaluate(parametrization.to_denominator(best_z)[None, :])
-    theta = np.r_[parametrization.to_denominator(best_z), b_best[0]]
-    return optimize.OptimizeResult(
-        x=theta,
+    res = minimize(
+        fun,
+        parametrization.bounds,
+        method,
+        n_points=n_points,
+        max_iter=max_iter,
+        max_nfev=max_nfev,
+        rng=rng,
+        vectorized=True,
+        x0=x0,
+        callback=callback,
+        bounds_policy="clip",
+        restarts=False
+        if restart_after is None
+        else Restarts(growth=1.0, stall=restart_after),
+        on_iteration=None if polish_every is None else polish,
+    )
+    z, nfev = res.x, res.nfev
+    if polish_every and res.status != 0 and nfev + polish_nfev <= max_nfev:
+        end = gauss_newton_polish(cost, parametrization, z, polish_nfev)
+        nfev += end.nfev
+        if end.fun < res.fun:
+            z = end.x
+            n_polish += 1
+    f_best, b_best = cost.evaluate(parametrization.to_denominator(z)[None, :])
+    res.update(
+        x=np.r_[parametrization.to_denominator(z), b_best[0]],
         fun=float(f_best[0]),
-        z=best_z,
-        nfev=spent(),
-        nit=nit,
+        z=z,
+        nfev=nfev,
         n_polish=n_polish,
-        n_restarts=n_restarts,
-        history=np.asarray(history, dtype=float),
-        status=status,
-        success=True,
-        message=message,
         elapsed=time.perf_counter() - t_start,
     )
+    if res.history.size:
+        res.history[-1] = min(res.history[-1], res.fun)
+    return res

@@ -17,7 +17,9 @@ ends", says why the coefficients and why a projection.
 from __future__ import annotations
 
 import numpy as np
-from scipy import optimize, signal
+from scipy import signal
+
+from spiralid.optim.result import OptimiserResult
 
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
@@ -58,7 +60,7 @@ def local_polish(
     predictor: str,
     initial: str = "rest",
     max_nfev: int | None = None,
-) -> tuple[np.ndarray, optimize.OptimizeResult]:
+) -> tuple[np.ndarray, OptimiserResult]:
     """Levenberg-Marquardt polish of the `predictor`'s error as
     :class:`PaperCost` defines it, kept stable: the search is over ``theta``
     itself, and a trial step whose denominator leaves the stable region
@@ -135,7 +137,7 @@ def local_polish(
         stall=(_STALL_WINDOW * (arx.n_params + 1), _STALL_GAIN),
     )
     res.max_nfev = max_nfev
-    res.capped = res.status == 0
+    res.capped = res.status == 1
     res.at_bound = na > 0 and bool(
         np.max(np.abs(step_down(res.x[:na]))) > KMAX * (1.0 - 1e-9)
     )

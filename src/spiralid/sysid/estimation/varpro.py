@@ -30,7 +30,8 @@ Choices where the method is silent:
 from __future__ import annotations
 
 import numpy as np
-from scipy import optimize
+
+from spiralid.optim.result import OptimiserResult
 
 from ..data import IOData
 from ..models.arx import ARX
@@ -218,7 +219,7 @@ def gauss_newton_polish(
     parametrization,
     x0,
     max_nfev: int = 10,
-) -> optimize.OptimizeResult:
+) -> OptimiserResult:
     """A few Levenberg-Marquardt steps of the projected problem.
 
     Minimises ``||y - V(A(x)) b(A(x))||^2`` over the searched denominator
@@ -243,10 +244,11 @@ def gauss_newton_polish(
 
     Returns
     -------
-    OptimizeResult
+    OptimiserResult
         ``x`` (coordinates, never worse than `x0`), ``fun`` (the paper's cost
-        there), ``nfev``, ``nit`` (accepted steps), ``status`` (1: a step
-        below the tolerance, 0: budget used), ``message``.
+        there), ``nfev``, ``nit`` (accepted steps), ``status`` (a key of
+        :data:`~spiralid.optim.result.STATUS`: 1 when the budget ended it, 0
+        at a step below the tolerance or no decrease), ``message``.
     """
     box = parametrization.bounds
     lo, hi = box[:, 0], box[:, 1]
@@ -263,7 +265,7 @@ def gauss_newton_polish(
         return float(out[0])
 
     lam = 1e-3
-    nfev, nit, status = 0, 0, 0
+    nfev, nit, status = 0, 0, 1
     message = "Evaluation budget used."
     sse = None
     while nfev < max_nfev:
@@ -297,16 +299,16 @@ def gauss_newton_polish(
                 nit += 1
                 moved = True
                 if small:
-                    status, message = 1, "Step below tolerance."
+                    status, message = 0, "Step below tolerance."
                 break
             lam *= 4.0
             if lam > 1e12:
                 break
-        if status == 1 or not moved:
+        if status == 0 or not moved:
             if not moved and nfev < max_nfev:
-                status, message = 1, "No decrease along the damped step."
+                status, message = 0, "No decrease along the damped step."
             break
-    return optimize.OptimizeResult(
+    return OptimiserResult(
         x=x,
         fun=scale * np.sqrt(sse)
         if sse is not None
@@ -316,4 +318,6 @@ def gauss_newton_polish(
         status=status,
         message=message,
         success=True,
+        n_restarts=0,
+        history=None,
     )
