@@ -8,18 +8,9 @@ This module imports nothing of ours, so ``optim`` and ``fms`` can both use it
 and still depend on nothing else in the package (docs/design-notes.md,
 "Layout and dependencies").
 
-The scalar checks have two readings, chosen by ``strict`` (default ``True``):
-
-* ``strict=True`` refuses bools and non-scalars (lists, arrays of any shape)
-  and, in ``positive``/``nonneg``, names the allowed range for every bad
-  value; the word is "a finite number".
-* ``strict=False`` takes whatever ``float()`` takes except strings and bytes
-  (so bools and 0-d arrays pass) and reports a value that is not a finite
-  real as such before looking at its range; the word is "a finite real
-  number".
-
-``fms`` uses the strict reading and ``optim`` the other; both wordings are
-pinned by the tests, which is why they are kept.
+A scalar is a Python or NumPy real number or a 0-d array; strings, bools
+and sequences are refused, and every message says "a finite number" (with
+the allowed range when there is one).
 """
 
 from __future__ import annotations
@@ -30,45 +21,39 @@ import operator
 import numpy as np
 
 
-def real(value, name: str, *, strict: bool = True) -> float:
-    """``value`` as a finite Python float (see the module for ``strict``)."""
-    if strict:
-        ok = not isinstance(value, str | bytes | bool | np.bool_) and np.isscalar(value)
-    else:
-        ok = not isinstance(value, str | bytes)
-    v = math.nan
-    if ok:
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            pass
+def real(value, name: str) -> float:
+    """``value`` as a finite Python float."""
+    v = _as_float(value)
     if not math.isfinite(v):
-        what = "a finite number" if strict else "a finite real number"
-        raise ValueError(f"`{name}` must be {what}; got {value!r}")
+        raise ValueError(f"`{name}` must be a finite number; got {value!r}")
     return v
 
 
-def _ranged(value, name: str, strict: bool, allowed: str, ok) -> float:
-    if strict:
-        try:
-            v = real(value, name)
-        except ValueError:
-            v = math.nan  # reported below with the range, not just "finite"
-    else:
-        v = real(value, name, strict=False)
-    if not ok(v):
+def _as_float(value) -> float:
+    """``float(value)`` for a real scalar, NaN for anything else."""
+    if isinstance(value, str | bytes | bool | np.bool_) or np.ndim(value) != 0:
+        return math.nan
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _ranged(value, name: str, allowed: str, ok) -> float:
+    v = _as_float(value)
+    if not (math.isfinite(v) and ok(v)):
         raise ValueError(f"`{name}` must be a finite number {allowed}; got {value!r}")
     return v
 
 
-def positive(value, name: str, *, strict: bool = True) -> float:
+def positive(value, name: str) -> float:
     """``value`` as a finite float > 0."""
-    return _ranged(value, name, strict, "> 0", lambda v: v > 0.0)
+    return _ranged(value, name, "> 0", lambda v: v > 0.0)
 
 
-def nonneg(value, name: str, *, strict: bool = True) -> float:
+def nonneg(value, name: str) -> float:
     """``value`` as a finite float >= 0."""
-    return _ranged(value, name, strict, ">= 0", lambda v: v >= 0.0)
+    return _ranged(value, name, ">= 0", lambda v: v >= 0.0)
 
 
 def integer(value, name: str, minimum: int) -> int:
@@ -125,3 +110,54 @@ def generator(rng) -> np.random.Generator:
             "`rng` must be None, a non-negative integer, a SeedSequence or a "
             f"numpy.random.Generator; got {rng!r}"
         ) from None
+
+
+def box_bounds(bounds, n: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``(low, high)`` of a box given as (low, high) pairs, an (n, 2) array
+    or a ``scipy.optimize.Bounds``: finite, ``low < high``, finite widths,
+    and `n` dimensions when `n` is given."""
+    from scipy.optimize import Bounds
+
+    what = (
+        "`bounds` must be a sequence of (low, high) pairs, an (n, 2) array or "
+        "a scipy.optimize.Bounds"
+    )
+    try:
+        if isinstance(bounds, Bounds):
+            lo = np.asarray(bounds.lb, dtype=np.float64)
+            hi = np.asarray(bounds.ub, dtype=np.float64)
+            if lo.ndim > 1 or hi.ndim > 1 or (lo.ndim == 0 and hi.ndim == 0):
+                raise ValueError(
+                    f"{what}; a Bounds needs 1-D lb/ub; got lb={bounds.lb!r}, "
+                    f"ub={bounds.ub!r}"
+                )
+            lo, hi = (np.array(a) for a in np.broadcast_arrays(lo, hi))
+        else:
+            arr = np.asarray(bounds, dtype=np.float64)
+            if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
+                raise ValueError(f"{what}; got shape {arr.shape}")
+            lo, hi = arr[:, 0].copy(), arr[:, 1].copy()
+    except (TypeError, ValueError) as err:
+        if str(err).startswith("`bounds`"):
+            raise
+        raise ValueError(f"{what}; got {bounds!r}") from None
+    if n is not None and lo.size != n:
+        raise ValueError(
+            f"`bounds` must have {n} (low, high) pairs; got {lo.size} pairs"
+        )
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        raise ValueError(f"`bounds` must be finite; got low={lo!r}, high={hi!r}")
+    bad = np.flatnonzero(lo >= hi)
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(
+            f"`bounds` must have low < high in every dimension; got "
+            f"({float(lo[i])!r}, {float(hi[i])!r}) in dimension {i}"
+        )
+    with np.errstate(over="ignore"):
+        width = hi - lo
+    if not np.all(np.isfinite(width)):
+        raise ValueError(
+            f"`bounds` must have a finite width high - low; got low={lo!r}, high={hi!r}"
+        )
+    return lo, hi

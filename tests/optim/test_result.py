@@ -53,9 +53,7 @@ def test_differential_evolution_reports_each_stop():
     assert by_nfev.status == 1 and by_nfev.nfev <= 200
     by_iter = differential_evolution(sphere, BOX, max_iter=3, rng=0)
     assert by_iter.status == 2 and by_iter.nit == 3
-    by_callback = differential_evolution(
-        sphere, BOX, rng=0, callback=lambda r: True
-    )
+    by_callback = differential_evolution(sphere, BOX, rng=0, callback=lambda r: True)
     assert by_callback.status == 0
 
 

@@ -110,7 +110,7 @@ def test_bad_n(n):
 
 @pytest.mark.parametrize("theta", [np.nan, np.inf, "x", None])
 def test_bad_theta(theta):
-    with pytest.raises(ValueError, match=r"^`theta` must be a finite real number"):
+    with pytest.raises(ValueError, match=r"^`theta` must be a finite number"):
         rotation_matrix(3, theta)
 
 

@@ -127,7 +127,7 @@ def test_constant_radius_out_of_range(radius):
 def test_constant_radius_message():
     with pytest.raises(ValueError, match=r"^`radius` must be in \(0, 1\]; got 1\.5"):
         ConstantSpiral(radius=1.5)
-    with pytest.raises(ValueError, match=r"^`angle` must be a finite real number"):
+    with pytest.raises(ValueError, match=r"^`angle` must be a finite number"):
         ConstantSpiral(angle=np.inf)
 
 
@@ -157,10 +157,10 @@ def test_linear_rule_values():
         (dict(r_l=0.0), r"^`r_l` and `r_u` must satisfy .*got r_l=0\.0"),
         (dict(r_u=1.2), r"^`r_l` and `r_u` must satisfy .*r_u=1\.2"),
         (dict(th_l=2.0, th_u=1.0), r"^`th_l` and `th_u` must satisfy th_l < th_u"),
-        (dict(th_u=np.inf), r"^`th_u` must be a finite real number"),
+        (dict(th_u=np.inf), r"^`th_u` must be a finite number"),
         (dict(r_c1=0.0), r"^`r_c1` must be a finite number > 0; got 0\.0"),
         (dict(th_c2=-1.0), r"^`th_c2` must be a finite number > 0"),
-        (dict(r_c2=np.nan), r"^`r_c2` must be a finite real number"),
+        (dict(r_c2=np.nan), r"^`r_c2` must be a finite number"),
     ],
 )
 def test_exponential_bad_constants(kwargs, match):
@@ -197,10 +197,10 @@ def test_exponential_rule_keeps_shape():
     [
         # ln(0) and ln(nan) used to give a math-domain error or NaN values.
         ((0.1, 1.0, 0.0, 1.5), r"^`c1` must be a finite number > 0; got 0\.0"),
-        ((0.1, 1.0, np.nan, 1.5), r"^`c1` must be a finite real number; got nan"),
+        ((0.1, 1.0, np.nan, 1.5), r"^`c1` must be a finite number > 0; got nan"),
         # A negative c2 would make the rule rise with d, silently.
         ((0.1, 1.0, 100.0, -1.0), r"^`c2` must be a finite number > 0; got -1\.0"),
-        ((None, 1.0, 100.0, 1.5), r"^`lower` must be a finite real number; got None"),
+        ((None, 1.0, 100.0, 1.5), r"^`lower` must be a finite number; got None"),
         ((1.0, 0.1, 100.0, 1.5), r"^`lower` and `upper` must satisfy lower < upper"),
     ],
 )

@@ -235,7 +235,7 @@ def test_oe_keeps_the_start_with_the_lower_cost(initial):
         (dict(method="oe", initial="zero"), "`initial` must be one of .*; got 'zero'"),
         (
             dict(method="ebsda", bounds=np.zeros((3, 2))),
-            r"`bounds` must have shape \(4, 2\); got shape \(3, 2\)",
+            r"`bounds` must have 4 \(low, high\) pairs; got 3 pairs",
         ),
     ],
 )
@@ -276,7 +276,9 @@ def test_user_bounds_are_the_search_box(known):
     box = [[-2, 2], [-1, 1], [0.5, 1.5], [0.0, 1.0]]
     fit = identify(est, ARX(2, 2, 1), method="sda", bounds=box, rng=0, max_iter=5)
     np.testing.assert_array_equal(fit.bounds, box)
-    with pytest.raises(ValueError, match="`bounds` must be finite with lower < upper"):
+    with pytest.raises(
+        ValueError, match="`bounds` must have low < high in every dimension"
+    ):
         identify(est, ARX(2, 2, 1), method="sda", bounds=[[0, 0]] * 4)
 
 

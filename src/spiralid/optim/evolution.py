@@ -17,7 +17,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy import optimize
 
-from spiralid._checks import generator, integer
+from spiralid._checks import box_bounds, generator, integer
 from spiralid.optim.result import OptimiserResult
 
 __all__ = ["differential_evolution"]
@@ -81,16 +81,7 @@ def differential_evolution(
     >>> bool(res.fun < 1e-8), res.nfev <= 3000, res.history.size == res.nit + 1
     (True, True, True)
     """
-    try:
-        box = np.asarray(bounds, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"`bounds` must be (low, high) pairs; got {bounds!r}"
-        ) from None
-    if box.ndim != 2 or box.shape[1] != 2 or not np.all(np.isfinite(box)):
-        raise ValueError(f"`bounds` must be finite (low, high) pairs; got {bounds!r}")
-    if np.any(box[:, 0] >= box[:, 1]):
-        raise ValueError(f"`bounds` must have low < high in every row; got {bounds!r}")
+    box = np.column_stack(box_bounds(bounds))
     n_points = integer(n_points, "n_points", 5)
     max_iter = integer(max_iter, "max_iter", 1)
     generations = max_iter

@@ -54,13 +54,11 @@ class Restarts:
     stall: int | None = None
 
     def __post_init__(self):
-        growth = positive(self.growth, "growth", strict=False)
+        growth = positive(self.growth, "growth")
         if growth < 1.0:
             raise ValueError(f"`growth` must be >= 1; got {self.growth!r}")
         object.__setattr__(self, "growth", growth)
-        object.__setattr__(
-            self, "tol_radius", positive(self.tol_radius, "tol_radius", strict=False)
-        )
+        object.__setattr__(self, "tol_radius", positive(self.tol_radius, "tol_radius"))
         if self.stall is not None:
             object.__setattr__(self, "stall", integer(self.stall, "stall", 1))
 

@@ -84,7 +84,7 @@ def rotation_matrix(n: int, theta: float) -> np.ndarray:
            [ 1.,  0.]])
     """
     n = integer(n, "n", 1)
-    theta = real(theta, "theta", strict=False)
+    theta = real(theta, "theta")
     c, s = np.cos(theta), np.sin(theta)
     out = np.eye(n)
     # Right-multiplying by R_pq mixes columns p and q only: O(n) per factor.

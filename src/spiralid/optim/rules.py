@@ -77,8 +77,8 @@ class SpiralRule(ABC):
 
 
 def _check_interval(lo, hi, lo_name, hi_name, radius: bool):
-    lo = real(lo, lo_name, strict=False)
-    hi = real(hi, hi_name, strict=False)
+    lo = real(lo, lo_name)
+    hi = real(hi, hi_name)
     if radius and not 0.0 < lo < hi <= 1.0:
         raise ValueError(
             f"`{lo_name}` and `{hi_name}` must satisfy 0 < {lo_name} < {hi_name} <= 1; "
@@ -138,11 +138,11 @@ class ConstantSpiral(SpiralRule):
     angle: float = math.pi / 4
 
     def __post_init__(self):
-        r = real(self.radius, "radius", strict=False)
+        r = real(self.radius, "radius")
         if not 0.0 < r <= 1.0:
             raise ValueError(f"`radius` must be in (0, 1]; got {self.radius!r}")
         object.__setattr__(self, "radius", r)
-        object.__setattr__(self, "angle", real(self.angle, "angle", strict=False))
+        object.__setattr__(self, "angle", real(self.angle, "angle"))
 
     def __call__(self, d, rng):
         return self.radius, self.angle
@@ -186,7 +186,7 @@ def exponential_rule(d, lower: float, upper: float, c1: float, c2: float) -> np.
     """
     d = real_array(d, "d")
     lower, upper = _check_interval(lower, upper, "lower", "upper", radius=False)
-    c1, c2 = positive(c1, "c1", strict=False), positive(c2, "c2", strict=False)
+    c1, c2 = positive(c1, "c1"), positive(c2, "c2")
     cap = max((_Z_CAP + math.log(c1)) / c2, 0.0)
     out, _, invalid = _kernels.exponential(
         d.ravel(),
@@ -252,7 +252,7 @@ class ExponentialSpiral(SpiralRule):
         object.__setattr__(self, "scale_free", bool(self.scale_free))
         values = {"r_l": r_l, "r_u": r_u, "th_l": th_l, "th_u": th_u}
         for name in ("r_c1", "r_c2", "th_c1", "th_c2"):
-            values[name] = positive(getattr(self, name), name, strict=False)
+            values[name] = positive(getattr(self, name), name)
         for name, value in values.items():
             object.__setattr__(self, name, value)
         # Radius and angle evaluated together, as `exponential_rule` does.
@@ -334,9 +334,7 @@ class LinearSpiral(SpiralRule):
         for name, value in {"r_l": r_l, "r_u": r_u, "th_l": th_l, "th_u": th_u}.items():
             object.__setattr__(self, name, value)
         if self.d_max is not None:
-            object.__setattr__(
-                self, "d_max", positive(self.d_max, "d_max", strict=False)
-            )
+            object.__setattr__(self, "d_max", positive(self.d_max, "d_max"))
 
     def _fraction(self, d: np.ndarray) -> np.ndarray:
         d_max = self.d_max
@@ -462,7 +460,7 @@ def rank_condition(points, rotation=None) -> bool:
 
 
 def _delta(value, name: str) -> float:
-    value = real(value, name, strict=False)
+    value = real(value, name)
     if not 0.0 < value < 1.0:
         raise ValueError(f"`{name}` must be in (0, 1); got {value!r}")
     return value

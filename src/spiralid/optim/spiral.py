@@ -22,9 +22,8 @@ import time
 from collections.abc import Callable
 
 import numpy as np
-from scipy.optimize import Bounds
 
-from spiralid._checks import generator, integer, real_array
+from spiralid._checks import box_bounds, generator, integer, real_array
 from spiralid.optim import _kernels
 from spiralid.optim.restarts import MIN_ITER, Restarts, parse_restarts
 from spiralid.optim.result import OptimiserResult
@@ -82,48 +81,6 @@ SpiralResult = OptimiserResult
 
 # The STATUS key of each way a search stops.
 _STATUS_CODE = {"max_iter": 2, "max_nfev": 1, "target": 0, "callback": 0, "running": 0}
-
-
-def _parse_bounds(bounds) -> tuple[np.ndarray, np.ndarray]:
-    what = (
-        "`bounds` must be a sequence of (low, high) pairs, an (n, 2) array or "
-        "a scipy.optimize.Bounds"
-    )
-    try:
-        if isinstance(bounds, Bounds):
-            lo = np.asarray(bounds.lb, dtype=np.float64)
-            hi = np.asarray(bounds.ub, dtype=np.float64)
-            if lo.ndim > 1 or hi.ndim > 1 or (lo.ndim == 0 and hi.ndim == 0):
-                raise ValueError(
-                    f"{what}; a Bounds needs 1-D lb/ub; got lb={bounds.lb!r}, "
-                    f"ub={bounds.ub!r}"
-                )
-            lo, hi = (np.array(a) for a in np.broadcast_arrays(lo, hi))
-        else:
-            arr = np.asarray(bounds, dtype=np.float64)
-            if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
-                raise ValueError(f"{what}; got shape {arr.shape}")
-            lo, hi = arr[:, 0].copy(), arr[:, 1].copy()
-    except (TypeError, ValueError) as err:
-        if str(err).startswith("`bounds`"):
-            raise
-        raise ValueError(f"{what}; got {bounds!r}") from None
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
-        raise ValueError(f"`bounds` must be finite; got low={lo!r}, high={hi!r}")
-    bad = np.flatnonzero(lo >= hi)
-    if bad.size:
-        i = int(bad[0])
-        raise ValueError(
-            f"`bounds` must have low < high in every dimension; got "
-            f"({lo[i]!r}, {hi[i]!r}) in dimension {i}"
-        )
-    with np.errstate(over="ignore"):
-        width = hi - lo
-    if not np.all(np.isfinite(width)):
-        raise ValueError(
-            f"`bounds` must have a finite width high - low; got low={lo!r}, high={hi!r}"
-        )
-    return lo, hi
 
 
 def _parse_method(method) -> SpiralRule | StepRateRule:
@@ -215,7 +172,7 @@ class SpiralSearch:
         if not callable(fun):
             raise ValueError(f"`fun` must be callable; got {fun!r}")
         self._fun = fun
-        self._lo, self._hi = _parse_bounds(bounds)
+        self._lo, self._hi = box_bounds(bounds)
         self.rule = _parse_method(method)
         self._builtin_rule = type(self.rule) in _BUILTIN
         m = integer(n_points, "n_points", 2)

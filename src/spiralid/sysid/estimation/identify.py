@@ -38,7 +38,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from spiralid._checks import generator
+from spiralid._checks import box_bounds, generator
 
 from ..data import IOData
 from ..models.arx import ARX
@@ -64,19 +64,7 @@ __all__ = [
 
 
 def _check_bounds(bounds, p: int) -> np.ndarray:
-    try:
-        box = np.asarray(bounds, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"`bounds` must be an array of shape ({p}, 2); got {bounds!r}"
-        ) from None
-    if box.shape != (p, 2):
-        raise ValueError(f"`bounds` must have shape ({p}, 2); got shape {box.shape}")
-    if not np.all(np.isfinite(box)) or np.any(box[:, 0] >= box[:, 1]):
-        raise ValueError(
-            f"`bounds` must be finite with lower < upper in each row; got {box}"
-        )
-    return box
+    return np.column_stack(box_bounds(bounds, p))
 
 
 def check_method_options(method: str, options: dict) -> None:

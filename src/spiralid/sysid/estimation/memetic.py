@@ -31,7 +31,7 @@ import numpy as np
 from scipy import signal
 
 from spiralid._checks import integer
-from spiralid.optim import OptimiserResult, Restarts, SpiralSearch, minimize
+from spiralid.optim import OptimiserResult, SpiralSearch, minimize
 
 from ..data import IOData
 from ..spectra import PSD, default_nperseg, find_resonances
@@ -102,8 +102,9 @@ def projected_spiral(
 ) -> OptimiserResult:
     """Spiral search over denominator coordinates, numerator projected out.
 
-    :func:`spiralid.optim.minimize` drives the search (its budget, restarts
-    and callback); this adds the memetic polish as its per-iteration hook.
+    :func:`spiralid.optim.minimize` drives the search (its budget and
+    callback); the memetic polish and the restarts are its per-iteration
+    hook.
     The settings have no defaults here: the recommended method's are
     :func:`~spiralid.sysid.estimation.estimators._estimate_recommended`'s.
 
@@ -126,10 +127,11 @@ def projected_spiral(
     polish_nfev : int
         Evaluations per polish.
     restart_after : int or None
-        Start a fresh population of the same size, uniform in the box, when
-        the centre has not moved for this many iterations (IPOP's restart
-        without growth, :class:`~spiralid.optim.Restarts`); the best point
-        over all populations is returned. ``None``: no restarts.
+        Start a fresh population of the same size, uniform in the box
+        (:meth:`~spiralid.optim.SpiralSearch.restart`), when the best cost
+        has not fallen by more than 1e-9 of itself for this many
+        iterations; the best point over all populations is returned.
+        ``None``: no restarts.
     x0 : array_like, shape (k, na), optional
         Initial points (the rest of the population is uniform in the box).
     max_iter : int, optional
@@ -158,16 +160,26 @@ def projected_spiral(
         restart_after = integer(restart_after, "restart_after", 1)
     max_iter = max_nfev if max_iter is None else integer(max_iter, "max_iter", 1)
     n_polish = 0
+    stalled, before = 0, np.inf
 
     def fun(z):
         return cost(parametrization.to_denominator(z))
 
-    def polish(search: SpiralSearch) -> None:
-        nonlocal n_polish
-        if search.nit % polish_every or search.nfev + polish_nfev > max_nfev:
-            return
-        res = gauss_newton_polish(cost, parametrization, search.centre, polish_nfev)
-        n_polish += search.move_centre(res.x, res.fun, nfev=res.nfev)
+    def after_step(search: SpiralSearch) -> None:
+        nonlocal n_polish, stalled, before
+        due = polish_every and search.nit % polish_every == 0
+        if due and search.nfev + polish_nfev <= max_nfev:
+            res = gauss_newton_polish(cost, parametrization, search.centre, polish_nfev)
+            n_polish += search.move_centre(res.x, res.fun, nfev=res.nfev)
+        # Progress is a fall of the best cost by more than 1e-9 of it: the
+        # polish moves the centre by less at every call near a minimum, and
+        # that must not keep a stalled population alive.
+        stalled = 0 if search.fun < before * (1.0 - 1e-9) else stalled + 1
+        before = min(before, search.fun)
+        if restart_after and stalled >= restart_after:
+            if search.nfev + 2 * n_points - 1 <= max_nfev:
+                search.restart(n_points)
+                stalled = 0
 
     res = minimize(
         fun,
@@ -181,10 +193,7 @@ def projected_spiral(
         x0=x0,
         callback=callback,
         bounds_policy="clip",
-        restarts=False
-        if restart_after is None
-        else Restarts(growth=1.0, stall=restart_after),
-        on_iteration=None if polish_every is None else polish,
+        on_iteration=after_step,
     )
     z, nfev = res.x, res.nfev
     if polish_every and res.status != 0 and nfev + polish_nfev <= max_nfev:
