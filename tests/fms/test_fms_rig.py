@@ -327,7 +327,7 @@ def test_bad_rig_parameters_raise(kwargs, match):
         (lambda r: r.simulate([1.0], fs=np.nan), "`fs` must be"),
         (lambda r: r.simulate([1.0], x0=[1.0, 2.0]), "`x0` must hold 10 finite"),
         (lambda r: r.simulate([1.0], sensors="ideal"), "`sensors` must be a Sensors"),
-        (lambda r: r.modes(0), "`n` must be a positive integer"),
+        (lambda r: r.modes(0), "`n` must be an integer >= 1"),
         (lambda r: r.modes(5), r"^`n` must be at most 2 n_elements = 4 .*got 5"),
         (lambda r: r.simulate("abc"), r"^`torque` must be an array of real numbers"),
         (lambda r: r.simulate([[1], [2, 3]]), r"^`torque` must be an array of real"),
@@ -359,8 +359,8 @@ def test_bad_simulate_arguments_raise(call, match):
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"encoder_lines": 0}, "`encoder_lines` must be a positive integer or None"),
-        ({"quadrature": 0}, "`quadrature` must be a positive integer"),
+        ({"encoder_lines": 0}, "`encoder_lines` must be an integer >= 1"),
+        ({"quadrature": 0}, "`quadrature` must be an integer >= 1"),
         ({"tach_noise": -1.0}, "`tach_noise` must be a finite number >= 0"),
         ({"accel_noise": np.nan}, "`accel_noise` must be"),
         ({"antialias_order": -1}, r"`antialias_order` must be an integer in \[0, 12\]"),
@@ -369,7 +369,7 @@ def test_bad_simulate_arguments_raise(call, match):
         ({"antialias_cutoff": "a"}, r"^`antialias_cutoff` must be in \(0, 1\]"),
         ({"tach_noise": None}, r"^`tach_noise` must be a finite number >= 0"),
         ({"accel_noise": "a"}, r"^`accel_noise` must be a finite number >= 0"),
-        ({"encoder_lines": 2048.0}, r"^`encoder_lines` must be a positive integer"),
+        ({"encoder_lines": 2048.0}, r"^`encoder_lines` must be an integer >= 1"),
         ({"antialias_order": 2.0}, r"^`antialias_order` must be an integer"),
     ],
 )

@@ -99,7 +99,7 @@ def test_paper_experiment_defaults_are_consistent():
             lambda: prbs(1, 1, 100, n_bits=1),
             r"`n_bits` must be an integer in \[2, 32\]",
         ),
-        (lambda: prbs(1, 1, 100, hold=0), "`hold` must be a positive integer"),
+        (lambda: prbs(1, 1, 100, hold=0), "`hold` must be an integer >= 1"),
         (lambda: prbs(np.inf, 1, 100), "`amplitude` must be a finite"),
         (lambda: prbs(1, 1, -100), "`fs` must be"),
         (lambda: chirp(1, 0, 80, 1, 100), r"`f1` must be in \[0, fs/2 = 50\] Hz"),

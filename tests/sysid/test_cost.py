@@ -202,7 +202,7 @@ def test_bad_arguments():
     with pytest.raises(ValueError, match=r"`predictor` must be one of .*; got 'free'"):
         PaperCost(arx, d, predictor="free")
     with pytest.raises(
-        ValueError, match="`gain` must be 'auto' or a positive number; got -1"
+        ValueError, match="`gain` must be 'auto' or a finite number > 0; got -1"
     ):
         PaperCost(arx, d, gain=-1)
     with pytest.raises(

@@ -92,7 +92,7 @@ def test_bad_inputs():
         ValueError, match=r"`u` must be a 1-D signal .* got shape \(2, 2\)"
     ):
         IOData(np.ones((2, 2)), [1, 2], ts=1.0)
-    with pytest.raises(ValueError, match="`ts` must be a positive finite number"):
+    with pytest.raises(ValueError, match="`ts` must be a finite number > 0"):
         IOData([1, 2], [1, 2], ts=0.0)
     with pytest.raises(ValueError, match="`u` must be a numeric 1-D signal"):
         IOData(["a", "b"], [1, 2], ts=1.0)

@@ -65,3 +65,13 @@ def test_a_study_file_is_checked_before_any_run(method, options, words):
     with pytest.raises(ValueError) as info:
         parse_spec(SPEC.format(method=method, options=options), where="s.toml")
     assert words in str(info.value) and "\n" not in str(info.value)
+
+
+def test_method_names_in_any_case_as_minimize_takes_them(record):
+    from spiralid.optim import minimize
+
+    upper = identify(record, ARX(2, 2, 1), method="EbSDA", rng=0, max_nfev=200)
+    lower = identify(record, ARX(2, 2, 1), method="ebsda", rng=0, max_nfev=200)
+    assert upper.method == "ebsda" and np.array_equal(upper.theta, lower.theta)
+    box = [(-1.0, 1.0)] * 2
+    assert minimize(lambda x: x @ x, box, "EBSDA", rng=0, max_iter=3).nit == 3

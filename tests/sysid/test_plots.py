@@ -96,7 +96,7 @@ def test_pole_zero_map_with_unit_circle_and_several_models():
     far = plots.plot_pole_zero({"A": ([0.5], [-47.0, 0.1])}).axes[0]
     assert far.get_xlim() == pytest.approx((-2.0, 2.0))
     assert "1 outside the view, largest |z| = 47" in far.get_title()
-    with pytest.raises(ValueError, match="`radius` must be a positive number"):
+    with pytest.raises(ValueError, match="`radius` must be a finite number > 0"):
         plots.plot_pole_zero({"A": ([0.5], [])}, radius=0.0)
     with pytest.raises(ValueError, match="`models` must be a mapping"):
         plots.plot_pole_zero([0.5])

@@ -120,7 +120,7 @@ def test_true_model_validates_perfectly():
     assert v.realization.minimal and v.realization.order == 2
     # the model's own mode is the continuous system's
     np.testing.assert_allclose(v.modes.frequency, [FN], rtol=1e-9)
-    np.testing.assert_allclose(v.modes_hz, [FN], rtol=1e-9)
+    np.testing.assert_allclose(v.modes.frequency, [FN], rtol=1e-9)
     np.testing.assert_allclose(v.modes.damping, [ZETA], rtol=1e-8)
     # and the measured spectrum peaks at its resonance
     (peak,) = v.peaks_measured.frequency[:1]
@@ -250,7 +250,7 @@ def test_validate_bad_input():
         validate(m, IOData(data.u, data.y, ts=0.01))
     with pytest.raises(ValueError, match="`residuals` must be one of"):
         validate(m, data, residuals="two-step")
-    with pytest.raises(ValueError, match="`gain` must be 'auto', 'model' or a posit"):
+    with pytest.raises(ValueError, match="`gain` must be 'auto', 'model' or a finite number > 0"):
         validate(m, data, gain="big")
     for bad in (0.0, -1.0, np.nan, "2"):
         with pytest.raises(ValueError, match="`gain` must be 'auto', 'model' or a"):

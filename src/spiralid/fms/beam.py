@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spiralid._checks import is_integer, nonneg, positive
+from spiralid._checks import integer, nonneg, positive
 
 __all__ = ["assemble", "element_matrices"]
 
@@ -131,9 +131,7 @@ def assemble(
     >>> M.shape, round(float(M[0, 0]), 12)   # I_h + rho A L^3 / 3
     ((9, 9), 1.5)
     """
-    if not is_integer(n_elements) or n_elements < 1:
-        raise ValueError(f"`n_elements` must be an integer >= 1; got {n_elements!r}")
-    n = int(n_elements)
+    n = integer(n_elements, "n_elements", 1)
     length = positive(length, "length")
     hub_inertia = positive(hub_inertia, "hub_inertia")
     payload_mass = nonneg(payload_mass, "payload_mass")

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid._checks import is_integer, positive
+from spiralid._checks import integer, positive
 from spiralid.fms.rig import FlexibleManipulator, Recording
 from spiralid.fms.sensors import Sensors
 from spiralid.fms.signals import _nsamples, bang_bang
@@ -57,9 +57,7 @@ class Experiment:
     tach_noise: float = 0.01
 
     def __post_init__(self) -> None:
-        n = self.n_pulses
-        if not is_integer(n) or n < 1:
-            raise ValueError(f"`n_pulses` must be a positive integer; got {n!r}")
+        integer(self.n_pulses, "n_pulses", 1)
         # The scalars first, so that a bad one is named before arithmetic on
         # it fails (round(nan) in torque(), say).
         for name in ("width", "period", "duration", "fs"):

@@ -23,7 +23,13 @@ from functools import cached_property, lru_cache
 import numpy as np
 from scipy.linalg import eigh
 
-from spiralid._checks import generator, is_integer, nonneg, positive, real_array
+from spiralid._checks import (
+    generator,
+    integer,
+    nonneg,
+    positive,
+    real_array,
+)
 from spiralid.fms._zoh import discretise_zoh, simulate_discrete
 from spiralid.fms.beam import assemble
 from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
@@ -185,10 +191,9 @@ class FlexibleManipulator:
                 f"`damping_ratio` must be in [0, 1); got {self.damping_ratio!r}"
             )
         object.__setattr__(self, "damping_ratio", z)
-        ne = self.n_elements
-        if not is_integer(ne) or ne < 1:
-            raise ValueError(f"`n_elements` must be an integer >= 1; got {ne!r}")
-        object.__setattr__(self, "n_elements", int(ne))
+        object.__setattr__(
+            self, "n_elements", integer(self.n_elements, "n_elements", 1)
+        )
 
     # ------------------------------------------------------------ properties
     @property
@@ -290,8 +295,7 @@ class FlexibleManipulator:
         f = self._modal[0][1:] / (2.0 * math.pi)
         if n is None:
             return f
-        if not is_integer(n) or n < 1:
-            raise ValueError(f"`n` must be a positive integer or None; got {n!r}")
+        n = integer(n, "n", 1)
         if n > f.size:
             # Fewer frequencies than asked for would go unnoticed downstream.
             raise ValueError(

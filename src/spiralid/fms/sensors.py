@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid._checks import is_integer, nonneg, real
+from spiralid._checks import integer, is_integer, nonneg, real
 
 __all__ = ["Sensors", "butterworth_ss", "quantise"]
 
@@ -73,15 +73,9 @@ class Sensors:
     antialias_cutoff: float = 0.35
 
     def __post_init__(self) -> None:
-        lines = self.encoder_lines
-        if lines is not None and (not is_integer(lines) or lines < 1):
-            raise ValueError(
-                f"`encoder_lines` must be a positive integer or None; got {lines!r}"
-            )
-        if not is_integer(self.quadrature) or self.quadrature < 1:
-            raise ValueError(
-                f"`quadrature` must be a positive integer; got {self.quadrature!r}"
-            )
+        if self.encoder_lines is not None:
+            integer(self.encoder_lines, "encoder_lines", 1)
+        integer(self.quadrature, "quadrature", 1)
         for name in ("tach_noise", "accel_noise"):
             object.__setattr__(self, name, nonneg(getattr(self, name), name))
         order = self.antialias_order

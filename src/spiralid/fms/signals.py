@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _signal
 
-from spiralid._checks import is_integer, positive, real
+from spiralid._checks import integer, is_integer, positive, real
 
 __all__ = ["bang_bang", "chirp", "prbs"]
 
@@ -108,8 +108,7 @@ def prbs(
     n = _nsamples(duration, fs)
     if not is_integer(n_bits) or not 2 <= n_bits <= 32:
         raise ValueError(f"`n_bits` must be an integer in [2, 32]; got {n_bits!r}")
-    if not is_integer(hold) or hold < 1:
-        raise ValueError(f"`hold` must be a positive integer; got {hold!r}")
+    hold = integer(hold, "hold", 1)
     nbits_needed = -(-n // hold)
     period = 2**n_bits - 1
     seq, _ = _signal.max_len_seq(int(n_bits), length=min(period, nbits_needed))

@@ -8,6 +8,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from spiralid._checks import positive
+
 __all__ = ["IOData"]
 
 
@@ -98,15 +100,7 @@ def _split_unit(header: str) -> tuple[str, str]:
 
 
 def _check_ts(ts) -> float:
-    try:
-        val = float(ts)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"`ts` must be a positive finite number (seconds); got {ts!r}"
-        ) from None
-    if not (np.isfinite(val) and val > 0):
-        raise ValueError(f"`ts` must be a positive finite number (seconds); got {ts!r}")
-    return val
+    return positive(ts, "ts")
 
 
 @dataclass(frozen=True, eq=False)

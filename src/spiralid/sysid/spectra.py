@@ -16,6 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+from spiralid._checks import integer, positive
+
 from .data import check_signal
 
 __all__ = [
@@ -108,13 +110,7 @@ class Modes:
 
 
 def _check_fs(fs) -> float:
-    try:
-        fs = float(fs)
-    except (TypeError, ValueError):
-        raise ValueError(f"`fs` must be a positive number; got {fs!r}") from None
-    if not (np.isfinite(fs) and fs > 0):
-        raise ValueError(f"`fs` must be a positive number; got {fs!r}")
-    return fs
+    return positive(fs, "fs")
 
 
 def default_nperseg(n: int) -> int:
@@ -229,10 +225,7 @@ def find_resonances(
     >>> np.round(find_resonances(psd(x, 500.0), 2).frequency, 1).tolist()
     [11.7, 39.1]
     """
-    if isinstance(n_peaks, bool) or not isinstance(n_peaks, int | np.integer):
-        raise ValueError(f"`n_peaks` must be a positive integer; got {n_peaks!r}")
-    if n_peaks < 1:
-        raise ValueError(f"`n_peaks` must be a positive integer; got {n_peaks!r}")
+    n_peaks = integer(n_peaks, "n_peaks", 1)
     if not (np.isfinite(min_prominence_db) and min_prominence_db >= 0):
         raise ValueError(
             f"`min_prominence_db` must be a non-negative number; "
@@ -305,12 +298,7 @@ def modes_from_poles(
     z = np.atleast_1d(np.asarray(poles, dtype=complex)).ravel()
     if not np.all(np.isfinite(z)):
         raise ValueError(f"`poles` must be finite; got {z!r}")
-    try:
-        ts = float(ts)
-    except (TypeError, ValueError):
-        raise ValueError(f"`ts` must be a positive number; got {ts!r}") from None
-    if not (np.isfinite(ts) and ts > 0):
-        raise ValueError(f"`ts` must be a positive number; got {ts!r}")
+    ts = positive(ts, "ts")
     if max_damping is not None and not np.isfinite(max_damping):
         raise ValueError(f"`max_damping` must be a finite number; got {max_damping!r}")
     z = z[(z.imag > tol) & (np.abs(z) > tol)]

@@ -52,11 +52,35 @@ import numba
 import numpy as np
 from scipy.signal import lfilter, lfiltic
 
+from spiralid._checks import nonneg, positive
+
 from ..data import IOData
 from ..models.arx import ARX, INITIAL_CONDITIONS
 from ..models.polynomials import is_stable_polynomial
 
-__all__ = ["INITIAL_CONDITIONS", "PaperCost"]
+__all__ = ["INITIAL_CONDITIONS", "PaperCost", "auto_gain", "cost_of_errors"]
+
+
+def auto_gain(y: np.ndarray) -> float:
+    """``gain="auto"`` of eq. (2): ``w = 100 sqrt(K) / rms(y)`` over the `K`
+    samples `y` the error is summed over (so the cost is the RMS error in
+    percent of the output's RMS)."""
+    rms = float(np.sqrt(np.mean(y * y)))
+    if rms == 0.0:
+        raise ValueError(
+            "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
+            "100 sqrt(K) / rms(y))"
+        )
+    return 100.0 * np.sqrt(y.size) / rms
+
+
+def cost_of_errors(errors, w: float, stable, penalty: float):
+    """Eq. (2)-(3) from the errors themselves: ``w sqrt(sum e^2) / K`` plus
+    `penalty` where not `stable`; `errors` of shape (K,) or (m, K)."""
+    e = np.asarray(errors, dtype=float)
+    f = (w / e.shape[-1]) * np.sqrt(np.sum(e * e, axis=-1))
+    return f + np.where(stable, 0.0, penalty)
+
 
 _PREDICTORS = ("simulation", "one-step")
 
@@ -138,14 +162,7 @@ class PaperCost:
                 f"`initial` must be one of {INITIAL_CONDITIONS}; got {initial!r}"
             )
         arx.check_length(data)
-        try:
-            pen = float(penalty)
-        except (TypeError, ValueError):
-            raise ValueError(
-                f"`penalty` must be a finite number >= 0; got {penalty!r}"
-            ) from None
-        if not (np.isfinite(pen) and pen >= 0):
-            raise ValueError(f"`penalty` must be a finite number >= 0; got {penalty!r}")
+        pen = nonneg(penalty, "penalty")
         self.arx = arx
         self.data = data
         self.predictor = predictor
@@ -159,27 +176,16 @@ class PaperCost:
         if isinstance(gain, str):
             if gain != "auto":
                 raise ValueError(
-                    f"`gain` must be 'auto' or a positive number; got {gain!r}"
+                    f"`gain` must be 'auto' or a finite number > 0; got {gain!r}"
                 )
-            rms = float(np.sqrt(np.mean(y * y)))
-            if rms == 0.0:
-                raise ValueError(
-                    "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
-                    "100 sqrt(K) / rms(y))"
-                )
-            self.w = 100.0 * np.sqrt(self.K) / rms
+            self.w = auto_gain(y)
         else:
             try:
-                w = float(gain)
-            except (TypeError, ValueError):
+                self.w = positive(gain, "gain")
+            except ValueError:
                 raise ValueError(
-                    f"`gain` must be 'auto' or a positive number; got {gain!r}"
+                    f"`gain` must be 'auto' or a finite number > 0; got {gain!r}"
                 ) from None
-            if not (np.isfinite(w) and w > 0):
-                raise ValueError(
-                    f"`gain` must be 'auto' or a positive number; got {gain!r}"
-                )
-            self.w = w
         # The one-step error always sums over t >= max_lag (all regressors
         # measured); a simulation from rest only uses it for unstable
         # candidates.
@@ -253,13 +259,6 @@ class PaperCost:
             )
             sse[idx] = out
         return sse
-
-    def sse_simulation(self, thetas) -> np.ndarray | float:
-        """``sum e^2`` of the simulation error; ``inf`` for unstable candidates
-        (they are not simulated)."""
-        th, single = self._thetas(thetas)
-        sse = self._simulate_sse(th, is_stable_polynomial(th[:, : self.arx.na]))
-        return float(sse[0]) if single else sse
 
     def simulate(self, theta) -> np.ndarray:
         """The simulated output the simulation error compares with ``y[t0:]``.

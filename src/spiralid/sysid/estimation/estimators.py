@@ -62,8 +62,7 @@ on :func:`_search` with its optimiser, which gives it the parametrisation,
 the box, the initial points, the safe start, the status and ``refine``.
 Then add one entry to :data:`METHODS`::
 
-    METHODS["name"] = Method(_estimate_name, search=True, safe_start=True,
-                             summary="...")
+    METHODS["name"] = Method(_estimate_name, search=True, safe_start=True)
 
 ``identify(method=...)``, the command line's ``--method`` choices and
 ``spiralid reproduce``'s configurations read that table; nothing else lists
@@ -195,8 +194,6 @@ class Method:
         :func:`spiralid.optim.minimize`'s.
     safe_start : bool
         Default of ``identify(safe_start=None)`` (see the module docstring).
-    summary : str
-        One line for help texts.
     parametrization : str
         Default of ``identify(parametrization=None)``.
     """
@@ -205,7 +202,6 @@ class Method:
     search: bool = True
     options: tuple[str, ...] | None = None
     safe_start: bool = False
-    summary: str = ""
     parametrization: str = DEFAULT_PARAMETRIZATION
 
 
@@ -555,16 +551,15 @@ def _estimate_fir(problem: Problem) -> EstimatorResult:
     return result
 
 
-def _rule_options() -> tuple[str, ...]:
-    """What a rule's method passes on to :func:`spiralid.optim.minimize`:
-    its keyword options, less those the estimator sets itself (the rule is
-    the method's own, so a method bound to one rule cannot be re-ruled)."""
+def _keyword_options(function: Callable, own: tuple[str, ...] = ()) -> tuple[str, ...]:
+    """The keyword-only parameters of `function`, less those in `own` (what
+    the estimator sets itself): a method's options come from the signature
+    of what runs it, so the list cannot drift from the code."""
     import inspect
 
-    own = {"method", "rng", "vectorized", "on_iteration"}
     return tuple(
         name
-        for name, par in inspect.signature(minimize).parameters.items()
+        for name, par in inspect.signature(function).parameters.items()
         if par.kind is inspect.Parameter.KEYWORD_ONLY and name not in own
     )
 
@@ -574,39 +569,26 @@ METHODS: dict[str, Method] = {
     **{
         name: Method(
             partial(_estimate_spiral, rule=name),
-            options=_rule_options(),
-            summary=f"spiral search with the rule {name!r} of spiralid.optim.RULES",
+            # The rule is the method's own, so a method bound to one rule
+            # cannot be re-ruled.
+            options=_keyword_options(
+                minimize, own=("method", "rng", "vectorized", "on_iteration")
+            ),
         )
         for name in RULES
     },
     "de": Method(
         _estimate_de,
-        options=("n_points", "max_iter", "max_nfev", "x0", "callback"),
-        summary="SciPy's differential evolution (baseline)",
+        options=_keyword_options(differential_evolution, own=("rng",)),
     ),
     "spiral": Method(
         _estimate_recommended,
-        options=(
-            "rule",
-            "n_points",
-            "max_nfev",
-            "polish_every",
-            "polish_nfev",
-            "restart_after",
-            "frequency_seeds",
-            "x0",
-            "max_iter",
-            "callback",
-        ),
+        options=_keyword_options(_estimate_recommended),
         safe_start=True,
         parametrization="modal",
-        summary=(
-            "recommended: Eb-SDA over the modes, numerator projected out, "
-            "memetic polish, restarts, safe starts"
-        ),
     ),
-    "ls": Method(_estimate_ls, search=False, summary="least squares"),
-    "oe": Method(_estimate_oe, search=False, summary="output error"),
+    "ls": Method(_estimate_ls, search=False),
+    "oe": Method(_estimate_oe, search=False),
 }
 
 DEFAULT_METHOD = "spiral"

@@ -112,7 +112,8 @@ def identify(
     arx : ARX
         Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6).
     method : str, default "spiral"
-        A key of :data:`spiralid.sysid.estimation.estimators.METHODS`: ``"spiral"``
+        A key of :data:`spiralid.sysid.estimation.estimators.METHODS`, in
+        any case: ``"spiral"``
         (the recommended spiral identification: Eb-SDA over the modes with
         the numerator projected out, a memetic Levenberg-Marquardt polish,
         restarts and safe starts; it reaches the output-error optimum, see
@@ -196,6 +197,9 @@ def identify(
         raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
     if not isinstance(integrator, bool | np.bool_):
         raise ValueError(f"`integrator` must be True or False; got {integrator!r}")
+    if isinstance(method, str):
+        # As minimize and scipy.optimize.minimize: names in any case.
+        method = method.lower()
     if integrator:
         return _identify_integrating(
             data,

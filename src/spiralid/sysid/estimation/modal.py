@@ -35,8 +35,9 @@ from itertools import combinations
 
 import numpy as np
 
+from spiralid._checks import integer
+
 from ..data import _check_ts
-from ..models.arx import _order
 
 __all__ = ["ModalParametrization"]
 
@@ -94,9 +95,9 @@ class ModalParametrization:
     def __init__(
         self, na: int, ts: float, real_poles: int | None = None, log_damping=_LOG_ZETA
     ) -> None:
-        na = _order(na, "na", 1)
+        na = integer(na, "na", 1)
         ts = _check_ts(ts)
-        n_real = na % 2 if real_poles is None else _order(real_poles, "real_poles", 0)
+        n_real = na % 2 if real_poles is None else integer(real_poles, "real_poles", 0)
         if n_real > na or (na - n_real) % 2:
             raise ValueError(
                 f"`real_poles` must be at most na={na} with the parity of na; "
@@ -351,7 +352,7 @@ class ModalParametrization:
 
     def initial_points(self, m: int, rng=None) -> np.ndarray:
         """``m`` points uniform in :attr:`bounds` (each a stable denominator)."""
-        m = _order(m, "m", 1)
+        m = integer(m, "m", 1)
         gen = np.random.default_rng(rng)
         return gen.uniform(self.bounds[:, 0], self.bounds[:, 1], size=(m, self.na))
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal
 
+from spiralid._checks import integer
 from spiralid.optim.result import OptimiserResult
 
 from ..data import IOData
@@ -197,10 +198,7 @@ def steiglitz_mcbride(
         raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
     if not isinstance(arx, ARX):
         raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
-    if isinstance(n_iter, bool) or not isinstance(n_iter, int | np.integer):
-        raise ValueError(f"`n_iter` must be an integer >= 0; got {n_iter!r}")
-    if n_iter < 0:
-        raise ValueError(f"`n_iter` must be an integer >= 0; got {n_iter!r}")
+    n_iter = integer(n_iter, "n_iter", 0)
     na, t0 = arx.na, arx.max_lag
     if theta0 is None:
         theta = arx_least_squares(data, arx)

@@ -30,6 +30,8 @@ import numba
 import numpy as np
 from scipy import signal
 
+from spiralid._checks import integer
+
 from ..data import IOData, check_signal
 from .polynomials import is_stable_polynomial
 
@@ -38,14 +40,6 @@ __all__ = ["ARX", "INITIAL_CONDITIONS", "arx_least_squares"]
 # How a free run starts: from rest (zero past samples) or from the record's
 # first measured samples.
 INITIAL_CONDITIONS = ("rest", "measured")
-
-
-def _order(value, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
-    if value < minimum:
-        raise ValueError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
-    return int(value)
 
 
 @dataclass(frozen=True)
@@ -79,9 +73,9 @@ class ARX:
     nk: int = 0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "na", _order(self.na, "na", 0))
-        object.__setattr__(self, "nb", _order(self.nb, "nb", 1))
-        object.__setattr__(self, "nk", _order(self.nk, "nk", 0))
+        object.__setattr__(self, "na", integer(self.na, "na", 0))
+        object.__setattr__(self, "nb", integer(self.nb, "nb", 1))
+        object.__setattr__(self, "nk", integer(self.nk, "nk", 0))
 
     # -- bookkeeping -------------------------------------------------------------
 
@@ -117,12 +111,6 @@ class ARX:
                 f"for {self}; got shape {arr.shape}"
             )
         return np.atleast_2d(arr), arr.ndim == 1
-
-    def split_theta(self, theta) -> tuple[np.ndarray, np.ndarray]:
-        """``(a, b)``: denominator ``a_1..a_na`` and numerator ``b_0..b_(nb-1)``."""
-        th, single = self._theta(theta)
-        a, b = th[:, : self.na], th[:, self.na :]
-        return (a[0], b[0]) if single else (a, b)
 
     def polynomials(self, theta) -> tuple[np.ndarray, np.ndarray]:
         """Numerator and denominator as coefficient arrays in ``z^-1``.

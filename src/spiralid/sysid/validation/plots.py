@@ -13,6 +13,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
+from spiralid._checks import positive
+
 from ..spectra import PSD, Modes, Peaks
 from .correlation import CorrelationTest
 
@@ -301,8 +303,8 @@ def plot_pole_zero(models, *, radius: float | None = None) -> Figure:
     ax.plot(np.cos(w), np.sin(w), color="k", lw=0.8, label="_unit circle")
     ax.axhline(0.0, color="0.7", lw=0.5)
     ax.axvline(0.0, color="0.7", lw=0.5)
-    if radius is not None and not (np.isfinite(radius) and radius > 0):
-        raise ValueError(f"`radius` must be a positive number; got {radius!r}")
+    if radius is not None:
+        radius = positive(radius, "radius")
     everything = []
     for label, pz in models.items():
         if hasattr(pz, "poles") and hasattr(pz, "zeros"):

@@ -24,7 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
+from spiralid._checks import positive
+
 from ..data import check_pair
+from ..estimation.cost import auto_gain, cost_of_errors
 from ..models.polynomials import (
     format_pole_radius,
     is_stable_polynomial,
@@ -344,17 +347,6 @@ class Validation:
     def error(self) -> np.ndarray:
         """Free-run simulation error ``y - y_sim``."""
         return self.y - self.y_sim
-
-    @property
-    def modes_hz(self) -> np.ndarray:
-        """Natural frequencies in Hz of the model's lightly damped modes
-        (``modes.frequency``)."""
-        return self.modes.frequency
-
-    @property
-    def error_one_step(self) -> np.ndarray:
-        """One-step prediction error ``y - y_pred``."""
-        return self.y - self.y_pred
 
     @property
     def order_advice(self) -> str | None:
@@ -681,7 +673,7 @@ def validate(
     # Eq. (2)-(3) on the very errors the fit and error range are computed
     # from, so the columns of a Table-2 row agree with one another.
     e_cost = e_sim if predictor == "simulation" else e_pred
-    cost = w * np.sqrt(np.sum(e_cost**2)) / n + (0.0 if stable else penalty)
+    cost = cost_of_errors(e_cost, w, stable, penalty)
 
     e_test = e_pred if residuals == "one-step" else e_sim
     fs = 1.0 / ts
@@ -765,13 +757,7 @@ def _valid_inputs(model, data, lags, residuals):
 def _gain(gain, model, y: np.ndarray) -> float:
     """The gain ``w`` of eq. (2) on the validation record (see `validate`)."""
     if isinstance(gain, str) and gain == "auto":
-        rms_y = float(np.sqrt(np.mean(y**2)))
-        if rms_y == 0.0:
-            raise ValueError(
-                "`data` has an all-zero output: nothing to fit (`gain` 'auto' is "
-                "100 sqrt(K) / rms(y))"
-            )
-        return 100.0 * np.sqrt(y.size) / rms_y
+        return auto_gain(y)
     if isinstance(gain, str) and gain == "model":
         w = float(getattr(model, "gain", np.nan))
         if not (np.isfinite(w) and w > 0):
@@ -780,14 +766,11 @@ def _gain(gain, model, y: np.ndarray) -> float:
             )
         return w
     try:
-        w = float(gain) if not isinstance(gain, str) else float("nan")
-    except (TypeError, ValueError):
-        w = float("nan")
-    if not (np.isfinite(w) and w > 0):
+        return positive(gain, "gain")
+    except ValueError:
         raise ValueError(
-            f"`gain` must be 'auto', 'model' or a positive number; got {gain!r}"
-        )
-    return w
+            f"`gain` must be 'auto', 'model' or a finite number > 0; got {gain!r}"
+        ) from None
 
 
 def _responses(model, data, warmup, max_radius: float):
