@@ -203,7 +203,7 @@ def _single_threaded_blas():
 
     The workers already run one identification per core; a threaded BLAS
     inside each oversubscribes the cores and its small least-squares solves
-    (safe starts, output-error polish) become 10-50x slower. The workers are
+    (safe starts, output-error polish) become many times slower. The workers are
     spawned, so they load BLAS afresh and read these variables; a user's own
     setting is kept.
     """

@@ -459,8 +459,8 @@ def _estimate_recommended(
     ``refine=True``), and the lowest cost is kept: the result is never above
     output error's (unless ``polish_every=None``, which asks for no
     gradient step at all). Default budget ``max_nfev = 10_000`` evaluations of the
-    search, its polish steps included (measured in
-    ``benchmarks/identification.py``). An FIR structure (``na = 0``) has no
+    search, its polish steps included (``benchmarks/identification.py``
+    measures what each ingredient does). An FIR structure (``na = 0``) has no
     modes: its cost is quadratic in the numerator and the exact minimiser is
     returned without a search.
     """

@@ -23,12 +23,11 @@ or from the measured past outputs at ``t0 = max_lag``
 (``initial="measured"``). Use ``"rest"`` for records that start at rest
 (the simulated rig's experiments); on such noisy records the measured
 start is harmful, because for lightly damped models it maps the noise of
-the ``na`` measured outputs into a large initial state (on the rig, OE from
-rest validates at about 95.9 %, the measured-past optimum at 92.6 %). Use
-``"measured"`` only for a record that starts in motion, such as the real
-arm (a slice of a periodic sweep: OE from rest validates at about 89.7 %
-there, from the measured past at 95.2 %). Least squares and the one-step
-predictor do not depend on it.
+the ``na`` measured outputs into a large initial state (the README's API
+example measures both on the rig and on the arm). Use ``"measured"`` only
+for a record that starts in motion, such as the real arm (a slice of a
+periodic sweep). Least squares and the one-step predictor do not depend on
+it.
 """
 
 from __future__ import annotations
