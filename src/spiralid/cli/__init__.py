@@ -3,7 +3,9 @@ study.
 
 Every subcommand has ``--help``. Bad arguments and bad input end with exit
 status 2 and a one-line ``spiralid <command>: error: ...`` message on
-standard error, never a traceback. Output directories must be new or empty
+standard error, never a traceback. Anything else is a bug in spiralid: exit
+status 1, one line that says so and how to report it, and the traceback
+with ``spiralid --debug <command> ...``. Output directories must be new or empty
 unless ``--force``; files are never overwritten without ``--force``.
 
 One module per subcommand, each with ``add_parser(sub)`` (which sets the
@@ -27,6 +29,8 @@ from .errors import (
     _show_warnings,
     _Terminated,
     _user_message,
+    is_user_error,
+    report_bug,
 )
 
 __all__ = ["build_parser", "main"]
@@ -47,6 +51,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--version", action="version", version=f"spiralid {version('spiralid')}"
     )
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        help="on an internal error (a bug in spiralid), print its traceback",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for command in _SUBCOMMANDS:
         command.add_parser(sub)
@@ -56,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the ``spiralid`` command; return its exit status."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    command = argv[0] if argv and not argv[0].startswith("-") else None
+    command = next((a for a in argv if not a.startswith("-")), None)
     prefix = f"spiralid {command}" if command else "spiralid"
     with _interrupts() as interrupted:
         with warnings.catch_warnings():
@@ -96,6 +105,11 @@ def _interrupts():
         yield lambda: bool(received)
     finally:
         for signum, handler in previous.items():
+            if received:
+                # Interrupted and said so: what is left is the interpreter's
+                # exit (Dask's atexit closes its cluster), where a late
+                # signal would only add a traceback to the one line.
+                handler = signal.SIG_IGN
             signal.signal(signum, handler)
 
 
@@ -110,9 +124,12 @@ def _run(argv: list[str], prefix: str) -> int:
             parser.print_help()
             return 2
         return args.run(args, argv)
-    except (UsageError, ValueError, OSError) as exc:
-        print(f"{prefix}: error: {_user_message(exc)}", file=sys.stderr)
-        return 2
+    except Exception as exc:
+        if is_user_error(exc):
+            print(f"{prefix}: error: {_user_message(exc)}", file=sys.stderr)
+            return 2
+        report_bug(prefix, exc, debug="--debug" in argv)
+        return 1
     except _Terminated:
         print(f"{prefix}: terminated", file=sys.stderr)
         return 143

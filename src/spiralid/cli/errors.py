@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+import traceback
 import warnings
+from pathlib import Path
 
 
 class UsageError(Exception):
@@ -17,6 +19,48 @@ class _Parser(argparse.ArgumentParser):
 
     def error(self, message: str):  # type: ignore[override]
         raise UsageError(message)
+
+
+_PACKAGE = Path(__file__).resolve().parents[1]
+
+
+def is_user_error(exc: BaseException) -> bool:
+    """Whether `exc` is about what the user asked for (exit 2, one line)
+    rather than a bug in spiralid (exit 1).
+
+    A usage error, an operating-system error (a missing file, a full disk,
+    a permission) and a ``ValueError`` raised by spiralid's own checks are
+    the user's; a ``ValueError`` raised from inside another library means
+    an input got past our checks, and any other exception is a bug."""
+    if isinstance(exc, UsageError | OSError):
+        return True
+    if not isinstance(exc, ValueError):
+        return False
+    tb = exc.__traceback__
+    if tb is None:
+        return True
+    while tb.tb_next is not None:
+        tb = tb.tb_next
+    return Path(tb.tb_frame.f_code.co_filename).resolve().is_relative_to(_PACKAGE)
+
+
+def report_bug(prefix: str, exc: BaseException, debug: bool) -> None:
+    """One line saying that `exc` is a bug and how to report it; the
+    traceback first with ``--debug``."""
+    if debug:
+        traceback.print_exception(exc, file=sys.stderr)
+    what = " ".join(f"{type(exc).__name__}: {exc}".split())
+    how = (
+        "please report it with the command you ran and this traceback"
+        if debug
+        else "please report it with the command you ran and the output of "
+        "`spiralid --debug` with the same arguments"
+    )
+    print(
+        f"{prefix}: internal error (a bug in spiralid, not in what you asked "
+        f"for): {what}; {how}",
+        file=sys.stderr,
+    )
 
 
 class _Terminated(KeyboardInterrupt):
