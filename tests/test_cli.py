@@ -306,3 +306,59 @@ def test_bad_arguments_exit_2_with_one_line(tmp_path, args, message):
     assert message in lines[0]
     assert "Traceback" not in proc.stderr
     assert (tmp_path / "keep.txt").read_text() == "user data"
+
+
+def _arm_identify(tmp_path, *extra):
+    from spiralid import cli
+
+    arm = resources.files("spiralid.datasets") / "daisy_robot_arm.csv"
+    argv = [*extra, "identify", str(arm), "--input", "u", "--output", "y",
+            "--ts", "0.01", "--method", "ls", "--out", str(tmp_path / "m")]  # fmt: skip
+    return cli.main(argv)
+
+
+def test_an_internal_error_says_it_is_a_bug(tmp_path, monkeypatch, capsys):
+    # A failure that is not about the user's input: exit 1, one line that
+    # says it is a bug and how to report it; the traceback with --debug.
+    import spiralid.sysid.models.arx as arx
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("broken on purpose")
+
+    monkeypatch.setattr(arx, "arx_least_squares", broken)
+    monkeypatch.setattr(
+        "spiralid.sysid.estimation.estimators.arx_least_squares", broken
+    )
+    assert _arm_identify(tmp_path) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1
+    assert err[0].startswith("spiralid identify: internal error (a bug in spiralid")
+    assert "RuntimeError: broken on purpose" in err[0] and "--debug" in err[0]
+    assert _arm_identify(tmp_path / "again", "--debug") == 1
+    err = capsys.readouterr().err
+    assert "Traceback (most recent call last)" in err and "RuntimeError" in err
+    assert err.splitlines()[-1].startswith("spiralid identify: internal error")
+
+
+def test_a_value_error_from_inside_numpy_is_a_bug(tmp_path, monkeypatch, capsys):
+    import spiralid.sysid.estimation.estimators as estimators
+
+    def numpy_fails(*args, **kwargs):
+        return np.zeros(3) + np.zeros(4)  # raises ValueError inside NumPy
+
+    monkeypatch.setattr(estimators, "arx_least_squares", numpy_fails)
+    assert _arm_identify(tmp_path) == 1
+    assert "internal error" in capsys.readouterr().err
+
+
+def test_a_bad_argument_is_the_users_error(tmp_path, capsys):
+    assert _arm_identify(tmp_path, "--debug") == 0
+    capsys.readouterr()
+    from spiralid import cli
+
+    arm = resources.files("spiralid.datasets") / "daisy_robot_arm.csv"
+    argv = ["identify", str(arm), "--input", "u", "--output", "y", "--ts", "0.01"]
+    status = cli.main([*argv, "--na", "-1", "--out", str(tmp_path / "x")])
+    assert status == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("spiralid identify: error:")
