@@ -362,3 +362,12 @@ def test_a_bad_argument_is_the_users_error(tmp_path, capsys):
     assert status == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("spiralid identify: error:")
+
+
+def test_help_texts_say_each_default_once(tmp_path):
+    simulate = run("simulate", "--help", cwd=tmp_path).stdout
+    flat = " ".join(simulate.split())
+    assert flat.count("default: paper") == 1 and "(default paper)" not in flat
+    assert "0.3 for paper, 0.3 for bang- bang, 0.1 for prbs, 0.1 for chirp" in flat
+    study = " ".join(run("study", "--help", cwd=tmp_path).stdout.split())
+    assert "(default: spiralid-study)" in study and "(default: dask)" in study

@@ -24,7 +24,6 @@ from contextlib import contextmanager
 
 from . import identify, reproduce, simulate, study, validate
 from .errors import (
-    UsageError,
     _Parser,
     _show_warnings,
     _Terminated,

@@ -31,6 +31,11 @@ def run(args, argv: list[str]) -> int:
     return 0
 
 
+# The torque (N m) of each signal when --amplitude is not given: the paper
+# experiment's pulses, and a tenth of a newton metre for the broadband ones.
+_AMPLITUDES = {"paper": 0.3, "bang-bang": 0.3, "prbs": 0.1, "chirp": 0.1}
+
+
 def _simulate_record(args):
     from spiralid.fms import (
         Experiment,
@@ -44,12 +49,13 @@ def _simulate_record(args):
     rig = FlexibleManipulator(payload_mass=args.payload)
     fs = args.fs
     paper = Experiment()
+    amp = _AMPLITUDES[args.signal] if args.amplitude is None else args.amplitude
     if args.signal == "paper":
         # One pulse per period, as many as the duration holds (even count: the
         # hub returns to where it started).
         n_pulses = max(2 * int(args.duration // (2 * paper.period)), 1)
         exp = Experiment(
-            amplitude=paper.amplitude if args.amplitude is None else args.amplitude,
+            amplitude=amp,
             width=paper.width if args.width is None else args.width,
             duration=args.duration,
             fs=fs,
@@ -57,14 +63,11 @@ def _simulate_record(args):
         )
         torque = exp.torque()
     elif args.signal == "bang-bang":
-        amp = paper.amplitude if args.amplitude is None else args.amplitude
         width = paper.width if args.width is None else args.width
         torque = bang_bang(amp, width, paper.start, args.duration, fs)
     elif args.signal == "prbs":
-        amp = 0.1 if args.amplitude is None else args.amplitude
         torque = prbs(amp, args.duration, fs)
     else:
-        amp = 0.1 if args.amplitude is None else args.amplitude
         torque = chirp(amp, 1.0, min(100.0, fs / 2), args.duration, fs)
     sensors = Sensors(accel_noise=args.accel_noise, tach_noise=args.tach_noise)
     rec = rig.simulate(torque, fs=fs, rng=args.seed, sensors=sensors)
@@ -114,10 +117,14 @@ def add_parser(sub) -> None:
         choices=["paper", "bang-bang", "prbs", "chirp"],
         default="paper",
         help="torque input: 'paper' is the reproduction's train of bang-bang "
-        "pulses (one per second), 'bang-bang' a single pulse pair (default paper)",
+        "pulses (one per second), 'bang-bang' a single pulse pair",
     )
     p.add_argument(
-        "--amplitude", type=float, default=None, help="torque (N m); default 0.3"
+        "--amplitude",
+        type=float,
+        default=None,
+        help="torque (N m); default "
+        + ", ".join(f"{v:g} for {k}" for k, v in _AMPLITUDES.items()),
     )
     p.add_argument(
         "--width",

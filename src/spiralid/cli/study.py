@@ -7,6 +7,7 @@ from pathlib import Path
 
 from .errors import UsageError
 from .options import (
+    _HelpFormatter,
     _positive_int,
     _progress,
 )
@@ -123,6 +124,7 @@ def _check_study_dir(out: Path, store: Path, force: bool) -> None:
 def add_parser(sub) -> None:
     p = sub.add_parser(
         "study",
+        formatter_class=_HelpFormatter,
         help="a study over every reading of the paper's cost, on Dask, resumable",
         description="Run every optimiser of SPEC (a TOML file; default the "
         "paper's grid) on every reading (record x predictor x parametrisation) "
@@ -130,7 +132,13 @@ def add_parser(sub) -> None:
         "store, so rerunning the same command after an interruption computes "
         "only what is missing. Then write the 'where the claim holds' report.",
     )
-    p.add_argument("spec", nargs="?", default=None, help="study specification (TOML)")
+    p.add_argument(
+        "spec",
+        nargs="?",
+        default=None,
+        help="study specification (TOML); default the paper's grid "
+        "(--show-default prints it)",
+    )
     p.add_argument(
         "--show-default",
         action="store_true",
@@ -146,8 +154,7 @@ def add_parser(sub) -> None:
         "--engine",
         choices=["dask", "processes", "local"],
         default="dask",
-        help="where runs execute: a Dask cluster (default), a process pool, or "
-        "this process",
+        help="where runs execute: a Dask cluster, a process pool, or this process",
     )
     p.add_argument(
         "--scheduler",
@@ -169,6 +176,7 @@ def add_parser(sub) -> None:
 
     p = sub.add_parser(
         "study-report",
+        formatter_class=_HelpFormatter,
         help="the report of a study's store",
         description="Analyse a study's SQLite store: per reading, Eb-SDA "
         "against SDA (rank-sum test, A12, Holm correction), convergence bands, "
