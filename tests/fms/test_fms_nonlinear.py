@@ -22,9 +22,7 @@ def test_everything_off_is_bit_identical_to_the_linear_rig():
         coulomb_friction=0.0, static_friction=0.0, torque_limit=None
     ).simulate(u, rng=3, return_state=True)
     # A limit no sample reaches clips nothing: the same floats.
-    wide = FlexibleManipulator(torque_limit=1e6).simulate(
-        u, rng=3, return_state=True
-    )
+    wide = FlexibleManipulator(torque_limit=1e6).simulate(u, rng=3, return_state=True)
     for name in ("u", "hub_angle", "hub_velocity", "end_acceleration", "state"):
         np.testing.assert_array_equal(getattr(plain, name), getattr(off, name))
         np.testing.assert_array_equal(getattr(plain, name), getattr(wide, name))

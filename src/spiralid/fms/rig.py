@@ -219,9 +219,7 @@ class FlexibleManipulator:
             )
         m = self.friction_substeps
         if not is_integer(m) or m < 1:
-            raise ValueError(
-                f"`friction_substeps` must be an integer >= 1; got {m!r}"
-            )
+            raise ValueError(f"`friction_substeps` must be an integer >= 1; got {m!r}")
         object.__setattr__(self, "friction_substeps", int(m))
         try:
             z = nonneg(self.damping_ratio, "damping_ratio")

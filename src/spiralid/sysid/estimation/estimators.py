@@ -87,6 +87,7 @@ from spiralid.optim import RULES, differential_evolution, minimize
 
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
+from . import narx as _narx
 from .cost import PaperCost
 from .outputerror import local_polish, steiglitz_mcbride
 from .parametrizations import DEFAULT_PARAMETRIZATION, Parametrization
@@ -206,6 +207,10 @@ class Method:
         One line for help texts.
     parametrization : str
         Default of ``identify(parametrization=None)``.
+    narx : callable or None
+        The estimator for a NARX structure,
+        ``narx(problem: NARXProblem, **options) -> OptimizeResult`` (see
+        :mod:`spiralid.sysid.estimation.narx`); None: ARX only.
     """
 
     estimate: Callable[..., EstimatorResult]
@@ -214,6 +219,7 @@ class Method:
     safe_start: bool = False
     summary: str = ""
     parametrization: str = DEFAULT_PARAMETRIZATION
+    narx: Callable[..., optimize.OptimizeResult] | None = None
 
 
 def search_options(options: dict) -> dict:
@@ -592,6 +598,7 @@ METHODS: dict[str, Method] = {
             partial(_estimate_spiral, rule=name),
             options=_rule_options(),
             summary=f"spiral search with the rule {name!r} of spiralid.optim.RULES",
+            narx=partial(_narx.estimate_search, rule=name),
         )
         for name in RULES
     },
@@ -616,13 +623,18 @@ METHODS: dict[str, Method] = {
         ),
         safe_start=True,
         parametrization="modal",
+        narx=_narx.estimate_spiral,
         summary=(
             "recommended: Eb-SDA over the modes, numerator projected out, "
             "memetic polish, restarts, safe starts"
         ),
     ),
-    "ls": Method(_estimate_ls, search=False, summary="least squares"),
-    "oe": Method(_estimate_oe, search=False, summary="output error"),
+    "ls": Method(
+        _estimate_ls, search=False, summary="least squares", narx=_narx.estimate_ls
+    ),
+    "oe": Method(
+        _estimate_oe, search=False, summary="output error", narx=_narx.estimate_oe
+    ),
 }
 
 DEFAULT_METHOD = "spiral"

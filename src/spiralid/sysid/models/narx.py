@@ -228,9 +228,7 @@ def _mlp_sensitivity(
 
 
 @numba.njit(cache=True)
-def _poly_free_run(
-    coef, terms, ulag, hist, ny, out
-):  # pragma: no cover - compiled
+def _poly_free_run(coef, terms, ulag, hist, ny, out):  # pragma: no cover - compiled
     """Free run of a polynomial NARX: ``sum_j coef[j] prod_d reg[terms[j, d]]``
     with index 0 the constant 1 and ``i >= 1`` regressor ``i - 1``."""
     n_t = ulag.shape[0]
@@ -539,9 +537,7 @@ class NARX(_Lags):
         p[oc + 1 :] = lin
         # Offsets: y~ = (y - ys)/sy and u~ = (u - us)/su on both sides.
         shift_y = 0.0 if self.integrator else scaling.y_shift
-        p[oc] = (
-            -shift_y * (1.0 + np.sum(a)) + np.sum(b) * scaling.u_shift
-        ) / sy
+        p[oc] = (-shift_y * (1.0 + np.sum(a)) + np.sum(b) * scaling.u_shift) / sy
         return p
 
     def __str__(self) -> str:
@@ -618,8 +614,7 @@ class PolynomialNARX(_Lags):
         if self.terms is not None:
             terms = tuple(tuple(int(i) for i in t) for t in self.terms)
             if any(
-                len(t) != deg or min(t) < 0 or max(t) > self.n_regressors
-                for t in terms
+                len(t) != deg or min(t) < 0 or max(t) > self.n_regressors for t in terms
             ):
                 raise ValueError(
                     f"`terms` must be tuples of {deg} indices in "
@@ -661,17 +656,20 @@ class PolynomialNARX(_Lags):
         return self.term_matrix(phi) @ np.asarray(params, dtype=float)
 
     def free_run_scaled(self, params, ulag, hist) -> np.ndarray:
-        """Compiled free run (scaled map outputs)."""
-        out = np.empty(ulag.shape[0])
-        _poly_free_run(
-            np.ascontiguousarray(params, dtype=float),
-            np.asarray(self.terms, dtype=np.int64),
-            np.ascontiguousarray(ulag),
-            np.ascontiguousarray(hist, dtype=float),
-            self.ny,
-            out,
-        )
-        return out
+        """Compiled free run (scaled map outputs), one per row of `params`."""
+        P = np.atleast_2d(np.asarray(params, dtype=float))
+        out = np.empty((P.shape[0], ulag.shape[0]))
+        terms = np.asarray(self.terms, dtype=np.int64).reshape(-1, self.degree)
+        for j in range(P.shape[0]):
+            _poly_free_run(
+                np.ascontiguousarray(P[j]),
+                terms,
+                np.ascontiguousarray(ulag),
+                np.ascontiguousarray(hist, dtype=float),
+                self.ny,
+                out[j],
+            )
+        return out[0] if np.ndim(params) == 1 else out
 
     def term_names(self) -> list[str]:
         """Readable names such as ``y(t-1)*u(t-2)``."""
