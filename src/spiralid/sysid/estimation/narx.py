@@ -92,7 +92,7 @@ class NARXProblem:
         self.t0, self.hist, self.ystart = structure._history(data.y, s, initial)
         self.phi, self.target = structure.regressors(data.u, data.y, s)
         n = data.n
-        self.split = n - int(round(holdout * n)) if holdout > 0 else n
+        self.split = n - round(holdout * n) if holdout > 0 else n
         lo = max(self.t0, structure.max_lag if predictor == "one-step" else 0)
         self.train = slice(lo, self.split)
         self.hold = slice(self.split, n) if self.split < n else None
@@ -118,7 +118,7 @@ class NARXProblem:
         z = st.free_run_scaled(params, self.ulag[self.t0 :], self.hist)
         y = st._unscale(z, s, self.ystart)
         if self.t0:
-            head = np.broadcast_to(self.data.y[: self.t0], y.shape[:-1] + (self.t0,))
+            head = np.broadcast_to(self.data.y[: self.t0], (*y.shape[:-1], self.t0))
             y = np.concatenate([head, y], axis=-1)
         return y
 
@@ -501,7 +501,7 @@ def estimate_spiral(
     # The final polish with early stopping, from the search's centre and
     # from the safe starts' polishes: the lowest held-back cost wins.
     finals = {"search": search.x, **starts}
-    _, name, p, rounds = _best_polished(problem, finals)
+    _, name, p, _rounds = _best_polished(problem, finals)
     return _result(
         problem,
         p,

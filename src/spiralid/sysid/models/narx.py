@@ -949,5 +949,5 @@ def simulate_structure(structure, params, scaling: Scaling, u, y0=None):
     y = structure._unscale(z, scaling, ystart)
     if t0 == 0:
         return y
-    head = np.broadcast_to(y0[:t0], y.shape[:-1] + (t0,))
+    head = np.broadcast_to(y0[:t0], (*y.shape[:-1], t0))
     return np.concatenate([head, y], axis=-1)

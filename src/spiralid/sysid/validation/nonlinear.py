@@ -71,7 +71,8 @@ class NARXValidation:
             f"  fit (free run)   {self.fit_percent:8.2f} %",
             f"  fit (one step)   {self.fit_percent_one_step:8.2f} %",
             f"  cost (eq. 2)     {self.cost:8.4g}",
-            f"  error range      [{self.error_range[0]:.4g}, {self.error_range[1]:.4g}]",
+            "  error range      "
+            f"[{self.error_range[0]:.4g}, {self.error_range[1]:.4g}]",
             f"  residuals tested: {self.residuals}",
             self.correlation.summary(),
         ]
