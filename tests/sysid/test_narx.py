@@ -101,7 +101,7 @@ def test_gradient_training_beats_arx_on_a_hammerstein_system():
 
 
 def test_spiral_search_never_ends_above_its_gradient_start():
-    est, val = _hammerstein(n=900, noise=0.01).split(2 / 3)
+    est, _val = _hammerstein(n=900, noise=0.01).split(2 / 3)
     st = NARX(2, 2, 1, hidden=(4,))
     grad = identify(est, st, method="oe", rng=1)
     spiral = identify(est, st, method="spiral", rng=1, max_nfev=1500)
