@@ -26,9 +26,10 @@ delay 1; the hub angle's models integrate (ARX(5, 4, 1) with the known
 integrator, NARX on increments).
 
 Printed per record and method: median free-run validation fit % over the
-seeds (and its quartiles; a diverging free run counts as -999), how many seeds pass all five Billings-Voon tests
-on the validation part's one-step residual, the median number of tests
-passed, and the median wall time per fit.
+seeds (and its quartiles; a diverging free run counts as -999), how many
+seeds pass all five Billings-Voon tests on the validation part's one-step
+residual, the median number of tests passed, and the median wall time per
+fit.
 
 Usage: ``python benchmarks/nonparametric.py [--seeds 10] [--workers 2]``
 """

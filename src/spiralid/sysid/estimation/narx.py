@@ -495,8 +495,11 @@ def estimate_spiral(
                 method="lm",
                 max_nfev=polish_iterations,
             )
-            f = float(problem.objective(res.x[None, :])[0])
-            n_polish += bool(search.move_centre(res.x, f))
+            # The centre must stay in the box: a polish that left it is
+            # clipped back (and scored there).
+            x = np.clip(res.x, box[:, 0], box[:, 1])
+            f = float(problem.objective(x[None, :])[0])
+            n_polish += bool(search.move_centre(x, f))
         history.append(search.fun)
     # The final polish with early stopping, from the search's centre and
     # from the safe starts' polishes: the lowest held-back cost wins.
