@@ -149,6 +149,8 @@ def test_bad_narx_arguments_are_one_line_errors():
         identify(data, NARX(2, 2, 1), method="oe", refine=True)
     with pytest.raises(ValueError, match="`holdout` must be"):
         identify(data, NARX(2, 2, 1), method="ls", holdout=0.7)
+    with pytest.raises(ValueError, match="`decay` must be"):
+        identify(data, NARX(2, 2, 1), method="ls", decay=-1.0)
     with pytest.raises(ValueError, match="too short"):
         identify(IOData(data.u[:20], data.y[:20], ts=0.01), NARX(2, 2, 1), "ls")
     with pytest.raises(ValueError, match="a NARX model must be"):

@@ -40,7 +40,9 @@ free run covers the whole record but the training residuals only the part
 before it; Levenberg-Marquardt runs in rounds of 10 iterations and stops
 after `patience` (3) rounds without a lower held-back cost, returning the
 parameters with the lowest held-back cost. Searches minimise the training
-cost only. The reported ``cost`` is the paper's (eq. (2) with the gain
+cost only. The Levenberg-Marquardt fits add a weight decay on the
+network's weights (``decay``, default 1e-3; see :func:`identify_narx`).
+The reported ``cost`` is the paper's (eq. (2) with the gain
 ``100 sqrt(K) / rms(y)``, the error's RMS in percent of the output's) over
 the whole estimation record.
 """
@@ -148,7 +150,29 @@ class NARXProblem:
 
     # -- Levenberg-Marquardt ----------------------------------------------------
     def residual_and_jacobian(self, predictor: str):
-        """Scaled training residual and its exact Jacobian (callables)."""
+        """Scaled training residual and its exact Jacobian (callables), with
+        the weight decay's rows ``sqrt(decay M) w`` on the network's weights
+        (not the bypass) appended when `decay` > 0."""
+        fun, jac = self._residual_and_jacobian(predictor)
+        decay = getattr(self, "decay", 0.0)
+        st = self.structure
+        if decay <= 0.0 or not isinstance(st, NARX) or st.h == 0:
+            return fun, jac
+        net = np.arange(st.h * (st.n_regressors + 2))
+        m = self.train.stop - self.train.start
+        w = math.sqrt(decay * m)
+
+        def fun_decay(p):
+            return np.r_[fun(p), w * p[net]]
+
+        def jac_decay(p):
+            extra = np.zeros((net.size, p.size))
+            extra[np.arange(net.size), net] = w
+            return np.vstack([jac(p), extra])
+
+        return fun_decay, jac_decay
+
+    def _residual_and_jacobian(self, predictor: str):
         st, s = self.structure, self.scaling
         tr = self.train
         scale = s.y_scale
@@ -527,10 +551,45 @@ def identify_narx(
     initial: str = "rest",
     rng=None,
     holdout: float = 0.2,
+    decay: float = 1e-3,
     **options,
 ) -> NARXModel:
     """Estimate a NARX model with the estimator `estimate` (the method's
-    ``Method.narx``); :func:`~spiralid.sysid.identify` calls it."""
+    ``Method.narx``); :func:`~spiralid.sysid.identify` calls it.
+
+    Parameters
+    ----------
+    data : IOData
+        Estimation record.
+    structure : NARX or PolynomialNARX
+        The structure.
+    method : str
+        The method's name (recorded in the model).
+    estimate : callable
+        ``estimate(problem, **options)``, the method's ``Method.narx``.
+    predictor : {"simulation", "one-step"}
+        The error the cost measures.
+    initial : {"rest", "measured"}
+        Start of the free run.
+    rng : int, Generator or None
+        Randomness of the initial weights and of a search.
+    holdout : float
+        Share of the record held back for early stopping, in [0, 0.5).
+    decay : float
+        Weight decay of the Levenberg-Marquardt fits: the network's weights
+        (not the linear bypass) cost ``decay M |w|^2`` beside the ``M``
+        squared scaled residuals (MATLAB's ``trainbr`` regularises the same
+        way, with a Bayesian choice of the weight). Default 1e-3, chosen on
+        seeds 0-4 of ``benchmarks/nonparametric.py``'s nonlinear
+        acceleration record (median validation fit 58.7 % without, 62.2 %
+        with; 1e-4 gave 61.1 %, 1e-2 62.2 %).
+    **options
+        The estimator's own options (a search's ``max_nfev``...).
+
+    Returns
+    -------
+    NARXModel
+    """
     t_start = time.perf_counter()
     if predictor not in ("simulation", "one-step"):
         raise ValueError(
@@ -544,10 +603,17 @@ def identify_narx(
         ok = False
     if not ok or isinstance(holdout, bool):
         raise ValueError(f"`holdout` must be a number in [0, 0.5); got {holdout!r}")
+    try:
+        ok = float(decay) >= 0.0 and math.isfinite(float(decay))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok or isinstance(decay, bool):
+        raise ValueError(f"`decay` must be a finite number >= 0; got {decay!r}")
     structure.check_length(data)
     problem = NARXProblem(
         data, structure, predictor, initial, float(holdout), generator(rng)
     )
+    problem.decay = float(decay)
     res = estimate(problem, **options)
     history = res.get("history")
     return NARXModel(
