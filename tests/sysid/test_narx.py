@@ -155,3 +155,19 @@ def test_bad_narx_arguments_are_one_line_errors():
         identify(IOData(data.u[:20], data.y[:20], ts=0.01), NARX(2, 2, 1), "ls")
     with pytest.raises(ValueError, match="a NARX model must be"):
         NARXModel.from_dict({"model": "arx"})
+
+
+@pytest.mark.parametrize("integrator", [False, True])
+def test_free_run_from_measured_samples_continues_the_record(integrator):
+    """A record the model itself produced, cut after 50 samples: the run
+    started from its measured samples reproduces the rest exactly."""
+    rng = np.random.default_rng(4)
+    st = NARX(3, 2, 1, hidden=(4,), integrator=integrator)
+    model = NARXModel(
+        0.3 * rng.standard_normal(st.n_params), st, Scaling(0.1, 1.2, 0.2, 0.9), 0.01
+    )
+    u = rng.standard_normal(300)
+    y = model.simulate(u)
+    tail = model.simulate(u[50:], y0=y[50:])
+    np.testing.assert_array_equal(tail[: st.max_lag], y[50 : 50 + st.max_lag])
+    np.testing.assert_allclose(tail, y[50:], rtol=1e-10, atol=1e-10)
