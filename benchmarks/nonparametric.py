@@ -19,7 +19,8 @@ Methods: ARX by output error (``oe``) and by the recommended ``spiral``;
 NARX-MLP (one hidden layer of 8 tanh units plus the linear bypass) by
 Eb-SDA, SDA (the paper's searches on the weights), the spiral method and
 the gradient baseline (``oe``: Levenberg-Marquardt with the exact
-free-run Jacobian and early stopping); polynomial NARX by FROLS (degree 2,
+free-run Jacobian and early stopping, and once more without early
+stopping); polynomial NARX by FROLS (degree 2,
 15 terms); peers SysIdentPy's FROLS and scikit-learn's ``MLPRegressor`` as
 a one-step NARX (run free afterwards). Lags: 4 past outputs, 4 past inputs,
 delay 1; the hub angle's models integrate (ARX(5, 4, 1) with the known
@@ -143,6 +144,13 @@ def run_one(job):
         )
         return mdl.simulate(data.u), mdl.predict(data)
 
+    def fit_narx_no_holdout():
+        # The gradient baseline trained to convergence on the whole
+        # estimation part (no early stopping; up to 50 rounds).
+        mdl = identify(est, st, method="oe", rng=seed, holdout=0.0, max_rounds=50)
+        return mdl.simulate(data.u), mdl.predict(data)
+
+    add("NARX oe, no early stopping", fit_narx_no_holdout)
     add("poly NARX FROLS", fit_poly)
 
     def fit_sklearn():

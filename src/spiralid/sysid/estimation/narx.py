@@ -228,7 +228,19 @@ class NARXProblem:
     ) -> tuple[np.ndarray, int]:
         """Levenberg-Marquardt in rounds with early stopping on the held-back
         cost; returns the parameters with the lowest held-back cost (the
-        training cost when nothing is held back) and the rounds run."""
+        training cost when nothing is held back) and the rounds run.
+
+        Parameters
+        ----------
+        p0 : ndarray
+            Start.
+        predictor : {"simulation", "one-step"}
+            The error minimised.
+        max_rounds : int
+            Rounds of 10 evaluations at most.
+        patience : int
+            Rounds without a lower held-back cost before stopping.
+        """
         fun, jac = self.residual_and_jacobian(predictor)
         p = np.asarray(p0, dtype=float).copy()
         pick = 1 if self.hold is not None else 0
@@ -321,7 +333,20 @@ def _result(problem, p, t0, **extra) -> optimize.OptimizeResult:
 
 
 def frols(problem: NARXProblem) -> optimize.OptimizeResult:
-    """Forward-regression orthogonal least squares of a polynomial NARX."""
+    """Forward-regression orthogonal least squares of a polynomial NARX.
+
+    Parameters
+    ----------
+    problem : NARXProblem
+        With a :class:`PolynomialNARX` structure; the fitted structure (its
+        chosen terms) replaces it.
+
+    Returns
+    -------
+    OptimizeResult
+        ``x`` the coefficients, ``err`` the chosen terms' error reduction
+        ratios in order.
+    """
     t0 = time.perf_counter()
     st = problem.structure
     cands = st.candidates()
@@ -373,7 +398,19 @@ def frols(problem: NARXProblem) -> optimize.OptimizeResult:
 
 def estimate_ls(problem: NARXProblem, **options) -> optimize.OptimizeResult:
     """``"ls"``: one-step least squares (LM for the MLP, FROLS for the
-    polynomial)."""
+    polynomial).
+
+    Parameters
+    ----------
+    problem : NARXProblem
+    **options
+        ``max_rounds`` and ``patience`` of the early stopping
+        (:meth:`NARXProblem.polish`).
+
+    Returns
+    -------
+    OptimizeResult
+    """
     if isinstance(problem.structure, PolynomialNARX):
         return frols(problem)
     t0 = time.perf_counter()
@@ -408,7 +445,20 @@ def _best_polished(problem: NARXProblem, starts: dict, **options):
 
 
 def estimate_oe(problem: NARXProblem, **options) -> optimize.OptimizeResult:
-    """``"oe"``: the gradient baseline on the predictor's error."""
+    """``"oe"``: the gradient baseline on the predictor's error.
+
+    Parameters
+    ----------
+    problem : NARXProblem
+    **options
+        ``max_rounds`` and ``patience`` of the early stopping
+        (:meth:`NARXProblem.polish`).
+
+    Returns
+    -------
+    OptimizeResult
+        ``start`` names the start that won.
+    """
     if isinstance(problem.structure, PolynomialNARX):
         raise ValueError(
             "method 'oe' trains an MLP NARX; a PolynomialNARX is estimated by "
@@ -428,7 +478,18 @@ def estimate_oe(problem: NARXProblem, **options) -> optimize.OptimizeResult:
 
 
 def default_box(problem: NARXProblem, starts=()) -> np.ndarray:
-    """Search box: +-3 in every scaled weight, widened to hold the starts."""
+    """Search box: +-3 in every scaled weight, widened to hold the starts.
+
+    Parameters
+    ----------
+    problem : NARXProblem
+    starts : sequence of ndarray
+        Points the box must hold (with a margin of half their magnitude).
+
+    Returns
+    -------
+    ndarray, shape (n_params, 2)
+    """
     n = problem.structure.n_params
     half = np.full(n, 3.0)
     for p in starts:
@@ -439,7 +500,21 @@ def default_box(problem: NARXProblem, starts=()) -> np.ndarray:
 def estimate_search(
     problem: NARXProblem, *, rule: str, **options
 ) -> optimize.OptimizeResult:
-    """The paper's spiral search (rule `rule`) over the weights."""
+    """The paper's spiral search (rule `rule`) over the weights.
+
+    Parameters
+    ----------
+    problem : NARXProblem
+    rule : str
+        A key of :data:`spiralid.optim.RULES`.
+    **options
+        :func:`spiralid.optim.minimize`'s options; ``max_nfev`` defaults to
+        10,000.
+
+    Returns
+    -------
+    OptimizeResult
+    """
     if isinstance(problem.structure, PolynomialNARX):
         raise ValueError(
             "a PolynomialNARX is estimated by method 'ls' (FROLS); searches "
@@ -478,7 +553,29 @@ def estimate_spiral(
     polish_iterations: int = 5,
     max_iter: int | None = None,
 ) -> optimize.OptimizeResult:
-    """``"spiral"``: Eb-SDA with safe starts and a memetic polish."""
+    """``"spiral"``: Eb-SDA with safe starts and a memetic polish.
+
+    Parameters
+    ----------
+    problem : NARXProblem
+    rule : str
+        The spiral rule (default Eb-SDA).
+    n_points : int
+        Population size.
+    max_nfev : int
+        Budget of cost evaluations (the polish's count too).
+    polish_every : int
+        Polish the centre every this many iterations.
+    polish_iterations : int
+        Levenberg-Marquardt evaluations per polish.
+    max_iter : int, optional
+        Cap on the iterations.
+
+    Returns
+    -------
+    OptimizeResult
+        ``start`` names the point whose final polish won.
+    """
     if isinstance(problem.structure, PolynomialNARX):
         raise ValueError(
             "a PolynomialNARX is estimated by method 'ls' (FROLS); searches "

@@ -82,7 +82,15 @@ class Scaling:
     def from_data(cls, data: IOData, integrator: bool = False) -> Scaling:
         """Mean and standard deviation of the estimation record's signals
         (of the output's increments for an integrating model, unshifted so
-        that rest stays zero)."""
+        that rest stays zero).
+
+        Parameters
+        ----------
+        data : IOData
+            Estimation record.
+        integrator : bool
+            Scale the output's increments instead of the output.
+        """
         u, y = data.u, data.y
         us = float(np.std(u)) or 1.0
         if integrator:
@@ -280,7 +288,14 @@ class _Lags:
         return max(self.ny + int(self.integrator), self.nk + self.nu - 1)
 
     def check_length(self, data: IOData, name: str = "data") -> None:
-        """Raise ``ValueError`` if `data` is too short for this structure."""
+        """Raise ``ValueError`` if `data` is too short for this structure.
+
+        Parameters
+        ----------
+        data : IOData
+        name : str
+            The argument's name in the message.
+        """
         need = self.max_lag + self.n_params + 1
         if data.n < need:
             raise ValueError(
@@ -296,7 +311,13 @@ class _Lags:
         return (y - s.y_shift) / s.y_scale
 
     def input_lags(self, u: np.ndarray, s: Scaling) -> np.ndarray:
-        """Scaled input regressors ``U[t, j] = u~(t - nk - j)``, rest before 0."""
+        """Scaled input regressors ``U[t, j] = u~(t - nk - j)``, rest before 0.
+
+        Parameters
+        ----------
+        u : ndarray, shape (N,)
+        s : Scaling
+        """
         n = u.size
         us = (np.r_[np.zeros(self.nk + self.nu), u] - s.u_shift) / s.u_scale
         off = self.nk + self.nu
@@ -307,12 +328,23 @@ class _Lags:
         return out
 
     def rest_history(self, s: Scaling) -> np.ndarray:
-        """The ``ny`` scaled past outputs of a system at rest."""
+        """The ``ny`` scaled past outputs of a system at rest.
+
+        Parameters
+        ----------
+        s : Scaling
+        """
         z0 = 0.0 if self.integrator else (0.0 - s.y_shift) / s.y_scale
         return np.full(self.ny, z0)
 
     def regressors(self, u, y, s: Scaling) -> tuple[np.ndarray, np.ndarray]:
         """One-step regressors from measured signals and the scaled target.
+
+        Parameters
+        ----------
+        u, y : ndarray, shape (N,)
+            Measured input and output.
+        s : Scaling
 
         Returns
         -------
@@ -372,8 +404,8 @@ class NARX(_Lags):
 
     Examples
     --------
-    >>> NARX(2, 2, 1, hidden=(5,)).n_params
-    36
+    >>> NARX(2, 2, 1, hidden=(5,)).n_params   # 5 x 4 + 5 + 5 + 1 + 4
+    35
     """
 
     ny: int
@@ -435,7 +467,12 @@ class NARX(_Lags):
         return np.ascontiguousarray(np.atleast_2d(arr)), arr.ndim == 1
 
     def split(self, params) -> dict[str, np.ndarray]:
-        """The named blocks ``W, b, v, c, l`` of one parameter vector."""
+        """The named blocks ``W, b, v, c, l`` of one parameter vector.
+
+        Parameters
+        ----------
+        params : array_like, shape (n_params,)
+        """
         p, _ = self._params(params)
         p = p[0]
         n, h = self.n_regressors, self.h
@@ -449,7 +486,14 @@ class NARX(_Lags):
         }
 
     def evaluate(self, params, phi: np.ndarray) -> np.ndarray:
-        """The map ``F(phi)`` (scaled), shape (N,) or (m, N)."""
+        """The map ``F(phi)`` (scaled), shape (N,) or (m, N).
+
+        Parameters
+        ----------
+        params : array_like, shape (n_params,) or (m, n_params)
+        phi : ndarray, shape (N, ny + nu)
+            Scaled regressors.
+        """
         P, single = self._params(params)
         n, h = self.n_regressors, self.h
         ob, ov, oc = h * n, h * n + h, h * n + 2 * h
@@ -462,7 +506,13 @@ class NARX(_Lags):
         return out[0] if single else out
 
     def jacobian(self, params, phi: np.ndarray) -> np.ndarray:
-        """Exact ``dF(phi_t) / d params``, shape (N, n_params)."""
+        """Exact ``dF(phi_t) / d params``, shape (N, n_params).
+
+        Parameters
+        ----------
+        params : array_like, shape (n_params,)
+        phi : ndarray, shape (N, ny + nu)
+        """
         d = self.split(params)
         n, h = self.n_regressors, self.h
         z = phi @ d["W"].T + d["b"]
@@ -475,7 +525,16 @@ class NARX(_Lags):
         return np.hstack(cols)
 
     def free_run_scaled(self, params, ulag, hist) -> np.ndarray:
-        """Compiled free run of every parameter row (scaled map outputs)."""
+        """Compiled free run of every parameter row (scaled map outputs).
+
+        Parameters
+        ----------
+        params : array_like, shape (n_params,) or (m, n_params)
+        ulag : ndarray, shape (N, nu)
+            Scaled input regressors (:meth:`input_lags`).
+        hist : ndarray, shape (ny,)
+            Scaled outputs before the first step (oldest first).
+        """
         P, single = self._params(params)
         out = np.empty((P.shape[0], ulag.shape[0]))
         _mlp_free_run(
@@ -491,7 +550,14 @@ class NARX(_Lags):
         return out[0] if single else out
 
     def free_run_jacobian(self, params, ulag, hist) -> tuple[np.ndarray, np.ndarray]:
-        """Scaled free run of one parameter vector and its exact Jacobian."""
+        """Scaled free run of one parameter vector and its exact Jacobian.
+
+        Parameters
+        ----------
+        params : array_like, shape (n_params,)
+        ulag : ndarray, shape (N, nu)
+        hist : ndarray, shape (ny,)
+        """
         P, _ = self._params(params)
         n_t = ulag.shape[0]
         out = np.empty(n_t)
@@ -512,7 +578,14 @@ class NARX(_Lags):
     def initial_params(self, rng: np.random.Generator, scale: float = 1.0):
         """Glorot-uniform hidden weights, zero biases and output weights,
         zero bypass: the network starts as the zero model's flat map, its
-        units in their linear range."""
+        units in their linear range.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+        scale : float
+            Multiplies the Glorot limit.
+        """
         n, h = self.n_regressors, self.h
         p = np.zeros(self.n_params)
         lim = scale * math.sqrt(6.0 / (n + h)) if h else 0.0
@@ -525,7 +598,14 @@ class NARX(_Lags):
         """Parameters of this structure that equal the ARX model ``(a, b)``
         (``A(q) y = B(q) u`` with ``a_1..a_ny``, ``b_0..b_(nu-1)``, delay
         ``nk``) through the linear bypass, network outputs zero. For an
-        integrating structure ``(a, b)`` model the increments."""
+        integrating structure ``(a, b)`` model the increments.
+
+        Parameters
+        ----------
+        a : array_like, shape (ny,)
+        b : array_like, shape (nu,)
+        scaling : Scaling
+        """
         if not self.linear:
             raise ValueError("`from_arx` needs the linear bypass (`linear=True`)")
         a = np.asarray(a, dtype=float)
@@ -644,7 +724,13 @@ class PolynomialNARX(_Lags):
         return self.n_terms or self.n_candidates
 
     def term_matrix(self, phi: np.ndarray, terms=None) -> np.ndarray:
-        """Columns of the given terms (default the chosen, else all) over ``phi``."""
+        """Columns of the given terms (default the chosen, else all) over ``phi``.
+
+        Parameters
+        ----------
+        phi : ndarray, shape (N, ny + nu)
+        terms : sequence of tuple, optional
+        """
         terms = self.terms if terms is None else terms
         if terms is None:
             terms = self.candidates()
@@ -652,11 +738,24 @@ class PolynomialNARX(_Lags):
         return np.prod(ext[:, np.asarray(terms)], axis=2)
 
     def evaluate(self, params, phi: np.ndarray) -> np.ndarray:
-        """The map ``F(phi)`` (scaled)."""
+        """The map ``F(phi)`` (scaled).
+
+        Parameters
+        ----------
+        params : array_like, shape (n_terms,)
+        phi : ndarray, shape (N, ny + nu)
+        """
         return self.term_matrix(phi) @ np.asarray(params, dtype=float)
 
     def free_run_scaled(self, params, ulag, hist) -> np.ndarray:
-        """Compiled free run (scaled map outputs), one per row of `params`."""
+        """Compiled free run (scaled map outputs), one per row of `params`.
+
+        Parameters
+        ----------
+        params : array_like, shape (n_terms,) or (m, n_terms)
+        ulag : ndarray, shape (N, nu)
+        hist : ndarray, shape (ny,)
+        """
         P = np.atleast_2d(np.asarray(params, dtype=float))
         out = np.empty((P.shape[0], ulag.shape[0]))
         terms = np.asarray(self.terms, dtype=np.int64).reshape(-1, self.degree)
@@ -784,7 +883,12 @@ class NARXModel:
         )
 
     def predict(self, data: IOData) -> np.ndarray:
-        """One-step-ahead prediction from the measured past (rest before 0)."""
+        """One-step-ahead prediction from the measured past (rest before 0).
+
+        Parameters
+        ----------
+        data : IOData
+        """
         if not isinstance(data, IOData):
             raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
         phi, _ = self.structure.regressors(data.u, data.y, self.scaling)
@@ -802,7 +906,13 @@ class NARXModel:
         return True
 
     def to_dict(self, *, timings: bool = True) -> dict:
-        """A JSON-safe dictionary; ``NARXModel.from_dict`` reads it back."""
+        """A JSON-safe dictionary; ``NARXModel.from_dict`` reads it back.
+
+        Parameters
+        ----------
+        timings : bool
+            Include the wall times.
+        """
         st = self.structure
         if isinstance(st, NARX):
             sd = {
@@ -865,7 +975,12 @@ class NARXModel:
 
     @classmethod
     def from_dict(cls, d: dict) -> NARXModel:
-        """Rebuild from :meth:`to_dict` output (``result`` is not restored)."""
+        """Rebuild from :meth:`to_dict` output (``result`` is not restored).
+
+        Parameters
+        ----------
+        d : dict
+        """
         if not isinstance(d, dict) or d.get("model") != "narx":
             raise ValueError("a NARX model must be a JSON object with model 'narx'")
         try:

@@ -160,9 +160,9 @@ def billings_voon(u, e, lags: int = 25, levels=_DEFAULT_LEVELS) -> BillingsVoon:
     Examples
     --------
     >>> import numpy as np
-    >>> rng = np.random.default_rng(1)
+    >>> rng = np.random.default_rng(0)
     >>> u, e = rng.standard_normal(2000), rng.standard_normal(2000)
-    >>> billings_voon(u, e).n_passed
+    >>> billings_voon(u, e).n_passed    # each test errs 5 % of the time
     5
     >>> billings_voon(u, e + 0.5 * (u**2 - 1)).passed["u2e"]
     False
