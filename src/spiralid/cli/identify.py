@@ -27,6 +27,18 @@ def _structure(args):
     return ARX(args.na, args.nb, args.nk)
 
 
+def _holdout(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 <= v < 0.5:
+        import argparse
+
+        raise argparse.ArgumentTypeError(f"must be a number in [0, 0.5); got {text!r}")
+    return v
+
+
 def _narx_structure(args):
     """--model narx / polynomial: --na past outputs, --nb past inputs."""
     from spiralid.sysid import NARX, PolynomialNARX
@@ -84,6 +96,7 @@ def _run_narx(args) -> int:
             predictor=args.predictor,
             initial=args.initial,
             rng=args.seed,
+            holdout=args.holdout,
             **options,
         )
         v_est = validate(model, est, label=f"{args.method} (estimation)")
@@ -218,6 +231,13 @@ def add_parser(sub) -> None:
         choices=["tanh", "logistic", "linear"],
         default="tanh",
         help="NARX hidden units' activation",
+    )
+    p.add_argument(
+        "--holdout",
+        type=_holdout,
+        default=0.2,
+        help="NARX: share of the estimation part held back for early stopping "
+        "(0: train to convergence)",
     )
     p.add_argument(
         "--degree", type=_positive_int, default=2, help="polynomial NARX degree"
