@@ -250,7 +250,9 @@ def test_validate_bad_input():
         validate(m, IOData(data.u, data.y, ts=0.01))
     with pytest.raises(ValueError, match="`residuals` must be one of"):
         validate(m, data, residuals="two-step")
-    with pytest.raises(ValueError, match="`gain` must be 'auto', 'model' or a finite number > 0"):
+    with pytest.raises(
+        ValueError, match="`gain` must be 'auto', 'model' or a finite number > 0"
+    ):
         validate(m, data, gain="big")
     for bad in (0.0, -1.0, np.nan, "2"):
         with pytest.raises(ValueError, match="`gain` must be 'auto', 'model' or a"):

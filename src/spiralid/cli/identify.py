@@ -27,10 +27,114 @@ def _structure(args):
     return ARX(args.na, args.nb, args.nk)
 
 
+def _holdout(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 <= v < 0.5:
+        import argparse
+
+        raise argparse.ArgumentTypeError(f"must be a number in [0, 0.5); got {text!r}")
+    return v
+
+
+def _narx_structure(args):
+    """--model narx / polynomial: --na past outputs, --nb past inputs."""
+    from spiralid.sysid import NARX, PolynomialNARX
+
+    if args.na < 1:
+        raise UsageError(f"--model {args.model} needs --na >= 1; got {args.na}")
+    if args.model == "narx":
+        return NARX(
+            args.na,
+            args.nb,
+            args.nk,
+            hidden=(args.hidden,),
+            activation=args.activation,
+            integrator=args.integrator,
+        )
+    return PolynomialNARX(
+        args.na,
+        args.nb,
+        args.nk,
+        degree=args.degree,
+        n_terms=args.terms,
+        integrator=args.integrator,
+    )
+
+
+def _run_narx(args) -> int:
+    """`spiralid identify --model narx|polynomial`."""
+    from spiralid.sysid import METHODS, identify, validate
+
+    if METHODS[args.method].narx is None:
+        able = ", ".join(n for n, m in METHODS.items() if m.narx is not None)
+        raise UsageError(f"--method {args.method} does not train NARX models: {able}")
+    if args.refine or args.parametrization is not None:
+        raise UsageError("--refine and --parametrization apply to ARX models")
+    if args.model == "polynomial" and args.method != "ls":
+        raise UsageError("--model polynomial is estimated by --method ls (FROLS)")
+    data = _load_data(args)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
+    structure = _narx_structure(args)
+    est, val = data.split(args.fraction)
+    structure.check_length(est, "estimation part of DATA")
+    options = {}
+    if METHODS[args.method].search:
+        options = {"n_points": args.points}
+        if args.budget is not None:
+            options["max_nfev"] = args.budget
+        if args.iterations is not None:
+            options["max_iter"] = args.iterations
+    with _open_folder(args.out, args.force) as folder:
+        model = identify(
+            est,
+            structure,
+            method=args.method,
+            predictor=args.predictor,
+            initial=args.initial,
+            rng=args.seed,
+            holdout=args.holdout,
+            **options,
+        )
+        v_est = validate(model, est, label=f"{args.method} (estimation)")
+        v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
+        staged = folder.path
+        (staged / "model.json").write_text(
+            json.dumps(model.to_dict(timings=False), indent=2)
+        )
+        (staged / "timings.json").write_text(json.dumps(model.timings, indent=2))
+        (staged / "validation.json").write_text(
+            json.dumps(
+                {"estimation": v_est.to_dict(), "validation": v_val.to_dict()},
+                indent=2,
+            )
+        )
+        summary = "\n\n".join(
+            [
+                f"{structure} by {args.method} on {args.data}",
+                f"estimation cost (eq. 2): {model.cost:.6g}",
+                v_est.summary(),
+                v_val.summary(),
+            ]
+        )
+        (staged / "summary.txt").write_text(summary + "\n")
+        _save_figures(v_val.plot(), staged, "validation_")
+        written = folder.commit(last="model.json")
+    if not args.quiet:
+        print(summary)
+        print(f"\nwrote {_listing(written, args.out)}")
+    return 0
+
+
 def run(args, argv: list[str]) -> int:
     from spiralid.sysid import METHODS, identify, validate
     from spiralid.sysid.validation.plots import plot_convergence
 
+    if args.model != "arx":
+        return _run_narx(args)
     data = _load_data(args)
     if args.detrend:
         data = _detrended(data, args.fraction)
@@ -114,6 +218,33 @@ def add_parser(sub) -> None:
         "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
     )
     _add_data_options(p)
+    p.add_argument(
+        "--model",
+        choices=["arx", "narx", "polynomial"],
+        default="arx",
+        help="ARX, NARX with a one-hidden-layer perceptron (--na past outputs, "
+        "--nb past inputs) or polynomial NARX by forward-regression OLS",
+    )
+    p.add_argument("--hidden", type=_positive_int, default=10, help="NARX hidden units")
+    p.add_argument(
+        "--activation",
+        choices=["tanh", "logistic", "linear"],
+        default="tanh",
+        help="NARX hidden units' activation",
+    )
+    p.add_argument(
+        "--holdout",
+        type=_holdout,
+        default=0.2,
+        help="NARX: share of the estimation part held back for early stopping "
+        "(0: train to convergence)",
+    )
+    p.add_argument(
+        "--degree", type=_positive_int, default=2, help="polynomial NARX degree"
+    )
+    p.add_argument(
+        "--terms", type=_positive_int, default=10, help="polynomial NARX terms"
+    )
     p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
     p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
     p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")

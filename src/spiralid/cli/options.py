@@ -55,6 +55,7 @@ def _number(kind: type, allowed: str, ok):
 
 
 _positive_float = _number(float, "a positive number", lambda v: v > 0)
+_nonneg_float = _number(float, "a number >= 0", lambda v: v >= 0)
 _nonneg_int = _number(int, ">= 0", lambda v: v >= 0)
 _positive_int = _number(int, ">= 1", lambda v: v >= 1)
 

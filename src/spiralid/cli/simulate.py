@@ -7,6 +7,7 @@ from pathlib import Path
 from .errors import UsageError
 from .options import (
     _HelpFormatter,
+    _nonneg_float,
     _nonneg_int,
     _positive_float,
 )
@@ -43,10 +44,19 @@ def _simulate_record(args):
         Sensors,
         bang_bang,
         chirp,
+        nonlinear_rig,
         prbs,
     )
 
-    rig = FlexibleManipulator(payload_mass=args.payload)
+    nonlinear = {
+        name: getattr(args, name)
+        for name in ("coulomb_friction", "static_friction", "torque_limit")
+        if getattr(args, name) is not None
+    }
+    if args.nonlinear:
+        rig = nonlinear_rig(payload_mass=args.payload, **nonlinear)
+    else:
+        rig = FlexibleManipulator(payload_mass=args.payload, **nonlinear)
     fs = args.fs
     paper = Experiment()
     amp = _AMPLITUDES[args.signal] if args.amplitude is None else args.amplitude
@@ -142,6 +152,31 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--tach-noise", type=float, default=0.01, help="tachometer noise std (rad/s)"
+    )
+    p.add_argument(
+        "--nonlinear",
+        action="store_true",
+        help="the rig with hub friction and torque saturation "
+        "(spiralid.fms.nonlinear_rig: Coulomb 0.02 N m, breakaway 0.03 N m, "
+        "limit 0.25 N m); the three options below override its values",
+    )
+    p.add_argument(
+        "--coulomb-friction",
+        type=_nonneg_float,
+        default=None,
+        help="hub Coulomb friction (N m); default 0 (off)",
+    )
+    p.add_argument(
+        "--static-friction",
+        type=_nonneg_float,
+        default=None,
+        help="hub breakaway torque (N m), Stribeck law above Coulomb; default 0",
+    )
+    p.add_argument(
+        "--torque-limit",
+        type=_positive_float,
+        default=None,
+        help="amplifier saturation (N m); default none",
     )
     p.add_argument("--seed", type=_nonneg_int, default=0, help="noise seed")
     p.add_argument("--out", default="rig.csv", help="output file, .csv or .npz")

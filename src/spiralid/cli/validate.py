@@ -38,7 +38,12 @@ def _read_model(name: str):
             f"{name!r} is not a valid spiralid model file (not JSON: {exc})"
         ) from None
     try:
-        model = IdentifiedModel.from_dict(fields)
+        if isinstance(fields, dict) and fields.get("model") == "narx":
+            from spiralid.sysid import NARXModel
+
+            model = NARXModel.from_dict(fields)
+        else:
+            model = IdentifiedModel.from_dict(fields)
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         message = " ".join(str(exc).split()).replace("`", "'")
         raise UsageError(

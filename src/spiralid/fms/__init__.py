@@ -6,9 +6,9 @@ zero-order-hold sampling, encoder/tachometer/accelerometer models).
 """
 
 from spiralid.fms.experiment import Experiment, paper_experiment
-from spiralid.fms.rig import FlexibleManipulator, Recording
+from spiralid.fms.rig import FlexibleManipulator, Recording, nonlinear_rig
 from spiralid.fms.sensors import Sensors
-from spiralid.fms.signals import bang_bang, chirp, prbs
+from spiralid.fms.signals import bang_bang, chirp, multilevel, prbs
 
 __all__ = [
     "Experiment",
@@ -17,6 +17,8 @@ __all__ = [
     "Sensors",
     "bang_bang",
     "chirp",
+    "multilevel",
+    "nonlinear_rig",
     "paper_experiment",
     "prbs",
 ]

@@ -1,4 +1,5 @@
-"""Torque inputs for the rig: bang-bang, PRBS and chirp, sampled at ``fs``.
+"""Torque inputs for the rig: bang-bang, PRBS, chirp and multilevel, sampled at
+``fs``.
 
 Sample ``k`` is the torque held on ``[k / fs, (k + 1) / fs)``.
 """
@@ -8,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _signal
 
-from spiralid._checks import integer, is_integer, positive, real
+from spiralid._checks import generator, integer, is_integer, positive, real
 
-__all__ = ["bang_bang", "chirp", "prbs"]
+__all__ = ["bang_bang", "chirp", "multilevel", "prbs"]
 
 
 # A record holds the torque, three outputs and the time: five float64
@@ -151,3 +152,57 @@ def chirp(
         )
     t = np.arange(n) / fs
     return amplitude * _signal.chirp(t, float(f0), float(duration), float(f1), method)
+
+
+def multilevel(
+    amplitude: float,
+    duration: float,
+    fs: float,
+    min_hold: float = 0.02,
+    max_hold: float = 0.2,
+    rng=None,
+) -> np.ndarray:
+    """Random multilevel torque (an amplitude-modulated PRBS, APRBS).
+
+    Levels uniform in ``[-amplitude, amplitude]``, each held for a time
+    uniform in ``[min_hold, max_hold]`` s: unlike a binary signal it visits
+    small torques (where friction holds the hub) and large ones (where an
+    amplifier saturates), which a nonlinear model needs to see.
+
+    Parameters
+    ----------
+    amplitude : float
+        Largest level (N m).
+    duration : float
+        Length (s).
+    fs : float
+        Sample rate (Hz).
+    min_hold, max_hold : float
+        Range of the hold times (s), ``0 < min_hold <= max_hold``.
+    rng : None, int or numpy.random.Generator
+        Seed of the levels and hold times.
+
+    Returns
+    -------
+    ndarray
+
+    Examples
+    --------
+    >>> u = multilevel(0.4, 2.0, 500.0, rng=0)
+    >>> u.size, bool(abs(u).max() <= 0.4)
+    (1000, True)
+    """
+    amplitude = real(amplitude, "amplitude")
+    n = _nsamples(duration, fs)
+    lo = positive(min_hold, "min_hold")
+    hi = positive(max_hold, "max_hold")
+    if hi < lo:
+        raise ValueError(f"`max_hold` must be >= `min_hold` = {lo!r}; got {max_hold!r}")
+    gen = generator(rng)
+    out = np.empty(n)
+    k = 0
+    while k < n:
+        hold = max(1, round(gen.uniform(lo, hi) * float(fs)))
+        out[k : k + hold] = gen.uniform(-amplitude, amplitude)
+        k += hold
+    return out

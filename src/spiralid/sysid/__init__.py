@@ -16,6 +16,9 @@ from .estimation.parametrizations import default_bounds as default_bounds
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.identified import IdentifiedModel as IdentifiedModel
+from .models.narx import NARX as NARX
+from .models.narx import NARXModel as NARXModel
+from .models.narx import PolynomialNARX as PolynomialNARX
 from .models.polynomials import fold_reflection as fold_reflection
 from .models.polynomials import format_pole_radius as format_pole_radius
 from .models.polynomials import is_stable_polynomial as is_stable_polynomial
@@ -32,6 +35,7 @@ from .spectra import psd as psd
 from .validation.correlation import CorrelationTest as CorrelationTest
 from .validation.correlation import independence_test as independence_test
 from .validation.correlation import whiteness_test as whiteness_test
+from .validation.higher_order import billings_voon as billings_voon
 from .validation.validate import Realization as Realization
 from .validation.validate import Validation as Validation
 from .validation.validate import fit_percent as fit_percent

@@ -86,6 +86,7 @@ from spiralid.optim.result import STATUS, OptimiserResult
 
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
+from . import narx as _narx
 from .cost import PaperCost
 from .outputerror import local_polish, steiglitz_mcbride
 from .parametrizations import DEFAULT_PARAMETRIZATION, Parametrization
@@ -196,6 +197,10 @@ class Method:
         Default of ``identify(safe_start=None)`` (see the module docstring).
     parametrization : str
         Default of ``identify(parametrization=None)``.
+    narx : callable or None
+        The estimator for a NARX structure,
+        ``narx(problem: NARXProblem, **options) -> OptimizeResult`` (see
+        :mod:`spiralid.sysid.estimation.narx`); None: ARX only.
     """
 
     estimate: Callable[..., EstimatorResult]
@@ -203,6 +208,7 @@ class Method:
     options: tuple[str, ...] | None = None
     safe_start: bool = False
     parametrization: str = DEFAULT_PARAMETRIZATION
+    narx: Callable[..., OptimiserResult] | None = None
 
 
 def search_options(options: dict) -> dict:
@@ -574,6 +580,7 @@ METHODS: dict[str, Method] = {
             options=_keyword_options(
                 minimize, own=("method", "rng", "vectorized", "on_iteration")
             ),
+            narx=partial(_narx.estimate_search, rule=name),
         )
         for name in RULES
     },
@@ -586,9 +593,10 @@ METHODS: dict[str, Method] = {
         options=_keyword_options(_estimate_recommended),
         safe_start=True,
         parametrization="modal",
+        narx=_narx.estimate_spiral,
     ),
-    "ls": Method(_estimate_ls, search=False),
-    "oe": Method(_estimate_oe, search=False),
+    "ls": Method(_estimate_ls, search=False, narx=_narx.estimate_ls),
+    "oe": Method(_estimate_oe, search=False, narx=_narx.estimate_oe),
 }
 
 DEFAULT_METHOD = "spiral"

@@ -42,6 +42,7 @@ from spiralid._checks import box_bounds, generator
 from ..data import IOData
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
+from ..models.narx import NARX, PolynomialNARX
 from ..models.polynomials import with_integrator
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS, Problem
@@ -108,8 +109,12 @@ def identify(
     ----------
     data : IOData
         Estimation record.
-    arx : ARX
-        Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6).
+    arx : ARX, NARX or PolynomialNARX
+        Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6). A NARX
+        structure is trained by the method's NARX estimator
+        (:mod:`spiralid.sysid.estimation.narx`; ``holdout`` passed through
+        `optimiser_options` sets its early-stopping share) and returns a
+        :class:`~spiralid.sysid.models.narx.NARXModel`.
     method : str, default "spiral"
         A key of :data:`spiralid.sysid.estimation.estimators.METHODS`, in
         any case: ``"spiral"``
@@ -192,8 +197,29 @@ def identify(
     t_start = time.perf_counter()
     if not isinstance(data, IOData):
         raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    if isinstance(arx, NARX | PolynomialNARX):
+        return _identify_narx(
+            data,
+            arx,
+            method,
+            predictor=predictor,
+            initial=initial,
+            rng=rng,
+            other=dict(
+                parametrization=parametrization,
+                refine=refine,
+                gain=gain,
+                penalty=penalty,
+                bounds=bounds,
+                safe_start=safe_start,
+                integrator=integrator,
+            ),
+            **optimiser_options,
+        )
     if not isinstance(arx, ARX):
-        raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+        raise ValueError(
+            f"`arx` must be an ARX, NARX or PolynomialNARX; got {type(arx).__name__}"
+        )
     if not isinstance(integrator, bool | np.bool_):
         raise ValueError(f"`integrator` must be True or False; got {integrator!r}")
     if isinstance(method, str):
@@ -279,6 +305,37 @@ def identify(
         u_offset=data.u_offset,
         y_offset=data.y_offset,
     )
+
+
+def _identify_narx(data, structure, method, *, other: dict, **options):
+    """`identify` for a NARX structure: the method's ``Method.narx``
+    estimator (:mod:`spiralid.sysid.estimation.narx`)."""
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
+    estimate = METHODS[method].narx
+    if estimate is None:
+        able = tuple(name for name, m in METHODS.items() if m.narx is not None)
+        raise ValueError(
+            f"`method` {method!r} does not train NARX models; use one of {able}"
+        )
+    defaults = dict(
+        parametrization=None,
+        refine=False,
+        gain="auto",
+        penalty=1e6,
+        bounds=None,
+        safe_start=None,
+        integrator=False,
+    )
+    given = sorted(k for k, v in other.items() if v is not defaults[k])
+    if given:
+        raise ValueError(
+            f"{given} apply to ARX structures; a NARX takes its integrator, "
+            "scaling and box from its structure and record"
+        )
+    from .narx import identify_narx
+
+    return identify_narx(data, structure, method=method, estimate=estimate, **options)
 
 
 def _identify_integrating(data: IOData, arx: ARX, options: dict) -> IdentifiedModel:

@@ -557,8 +557,10 @@ def validate(
 
     Parameters
     ----------
-    model : IdentifiedModel
-        From :func:`~spiralid.sysid.identify` (anything with ``theta``,
+    model : IdentifiedModel or NARXModel
+        From :func:`~spiralid.sysid.identify`. A NARX model gets a
+        :class:`~spiralid.sysid.validation.nonlinear.NARXValidation` (fits
+        and the Billings-Voon tests); an ARX model (anything with ``theta``,
         ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
         ``predict(data)``, ``poles``, ``zeros``).
     data : IOData
@@ -649,6 +651,21 @@ def validate(
     hardly decays. Pass ``warmup`` to validate such a model from the state
     it has reached.
     """
+    if getattr(model, "kind", None) == "narx":
+        # Poles, modes and realisations mean nothing for a nonlinear model:
+        # its own report (fits and the Billings-Voon tests).
+        from .nonlinear import validate_narx
+
+        return validate_narx(
+            model,
+            data,
+            lags=lags,
+            levels=levels,
+            residuals=residuals,
+            gain=gain,
+            warmup=warmup,
+            label=label,
+        )
     u, y, ts, lags, predictor = _valid_inputs(model, data, lags, residuals)
     n = y.size
     w = _gain(gain, model, y)

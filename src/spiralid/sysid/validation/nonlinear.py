@@ -1,0 +1,194 @@
+"""Validation of a NARX model: fit of the free run and the one-step
+prediction, and the Billings-Voon correlation tests.
+
+:func:`~spiralid.sysid.validate` hands a
+:class:`~spiralid.sysid.models.narx.NARXModel` to :func:`validate_narx`; the
+poles, modes and realisation tests of a linear model have no meaning for
+it, so its :class:`NARXValidation` carries what does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .correlation import check_lags
+from .higher_order import BillingsVoon, billings_voon
+from .validate import _gain, _signals_of, fit_percent, rmse
+
+__all__ = ["NARXValidation", "validate_narx"]
+
+_RESIDUALS = ("one-step", "simulation")
+
+
+@dataclass(frozen=True)
+class NARXValidation:
+    """Outcome of validating a NARX model on a record.
+
+    Attributes
+    ----------
+    label : str
+        Name for tables.
+    n_samples : int
+        Scored samples.
+    fit_percent, fit_percent_one_step : float
+        Fit of the free run and of the one-step prediction (percent).
+    rmse, rmse_one_step : float
+        Their RMS errors.
+    cost : float
+        The paper's eq. (2) on the model's predictor's error.
+    error_range : tuple of float
+        Free-run error range.
+    residuals : str
+        Which error the correlation tests examined.
+    correlation : BillingsVoon
+        The five Billings-Voon tests.
+    t, u, y, y_sim, y_pred : ndarray
+        Time, signals and responses over the scored part.
+    """
+
+    label: str
+    n_samples: int
+    fit_percent: float
+    fit_percent_one_step: float
+    rmse: float
+    rmse_one_step: float
+    cost: float
+    error_range: tuple[float, float]
+    residuals: str
+    correlation: BillingsVoon
+    t: np.ndarray
+    u: np.ndarray
+    y: np.ndarray
+    y_sim: np.ndarray
+    y_pred: np.ndarray
+
+    def summary(self) -> str:
+        """Human-readable report."""
+        lines = [
+            f"NARX validation ({self.label}), N = {self.n_samples}",
+            f"  fit (free run)   {self.fit_percent:8.2f} %",
+            f"  fit (one step)   {self.fit_percent_one_step:8.2f} %",
+            f"  cost (eq. 2)     {self.cost:8.4g}",
+            "  error range      "
+            f"[{self.error_range[0]:.4g}, {self.error_range[1]:.4g}]",
+            f"  residuals tested: {self.residuals}",
+            self.correlation.summary(),
+        ]
+        return "\n".join(lines)
+
+    def __str__(self) -> str:
+        return self.summary()
+
+    def to_dict(self, *, signals: bool = False) -> dict:
+        """JSON-safe dictionary (signals only when asked)."""
+        out = {
+            "model": "narx",
+            "label": self.label,
+            "n_samples": int(self.n_samples),
+            "fit_percent": float(self.fit_percent),
+            "fit_percent_one_step": float(self.fit_percent_one_step),
+            "rmse": float(self.rmse),
+            "rmse_one_step": float(self.rmse_one_step),
+            "cost": float(self.cost),
+            "error_range": [float(v) for v in self.error_range],
+            "residuals": self.residuals,
+            "billings_voon": self.correlation.to_dict(),
+        }
+        if signals:
+            for k in ("t", "u", "y", "y_sim", "y_pred"):
+                out[k] = [float(v) for v in getattr(self, k)]
+        return out
+
+    def plot(self) -> dict:
+        """``{"response": Figure, "billings_voon": Figure}``."""
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(8, 3.5))
+        ax.plot(self.t, self.y, label="measured", lw=1)
+        ax.plot(self.t, self.y_sim, label=f"free run ({self.fit_percent:.1f} %)", lw=1)
+        ax.set_xlabel("time (s)")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        return {"response": fig, "billings_voon": self.correlation.plot()}
+
+
+def validate_narx(
+    model,
+    data,
+    *,
+    lags: int = 25,
+    levels=(0.95, 0.99),
+    residuals: str = "one-step",
+    gain="auto",
+    warmup=None,
+    label: str | None = None,
+) -> NARXValidation:
+    """Validate a NARX model (see :func:`~spiralid.sysid.validate`, which
+    calls this for a :class:`~spiralid.sysid.models.narx.NARXModel`; the
+    parameters mean the same).
+
+    Parameters
+    ----------
+    model : NARXModel
+    data : IOData
+    lags : int
+    levels : sequence of float
+    residuals : {"one-step", "simulation"}
+    gain : "auto", "model" or float
+    warmup : IOData, optional
+    label : str, optional
+
+    Returns
+    -------
+    NARXValidation
+    """
+    u, y, ts = _signals_of(data)
+    lags = check_lags(lags, y.size)
+    if residuals not in _RESIDUALS:
+        raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
+    if not np.isclose(float(model.ts), ts, rtol=1e-9):
+        raise ValueError(
+            f"`data` sample time must match the model's ts = {float(model.ts)!r}; "
+            f"got ts = {ts!r}"
+        )
+    start = 0
+    if warmup is not None:
+        wu, wy, wts = _signals_of(warmup, "warmup")
+        if not np.isclose(wts, ts, rtol=1e-9):
+            raise ValueError(
+                f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
+            )
+        start = wu.size
+        whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
+    else:
+        whole = type(data)(u, y, ts=ts)
+    y_sim = model.simulate(whole.u)[start:]
+    y_pred = model.predict(whole)[start:]
+    if not np.all(np.isfinite(y_sim)):
+        raise ValueError(
+            "`model`'s free run diverges on this record; a free-run validation of "
+            "it is meaningless"
+        )
+    w = _gain(gain, model, y)
+    e_sim, e_pred = y - y_sim, y - y_pred
+    e_cost = e_sim if model.predictor == "simulation" else e_pred
+    e_test = e_pred if residuals == "one-step" else e_sim
+    return NARXValidation(
+        label=label if label is not None else str(model.method),
+        n_samples=y.size,
+        fit_percent=fit_percent(y, y_sim),
+        fit_percent_one_step=fit_percent(y, y_pred),
+        rmse=rmse(y, y_sim),
+        rmse_one_step=rmse(y, y_pred),
+        cost=float(w * np.sqrt(np.sum(e_cost**2)) / y.size),
+        error_range=(float(e_sim.min()), float(e_sim.max())),
+        residuals=residuals,
+        correlation=billings_voon(u, e_test, lags, levels),
+        t=(np.arange(y.size) + start) * ts,
+        u=u,
+        y=y,
+        y_sim=y_sim,
+        y_pred=y_pred,
+    )
