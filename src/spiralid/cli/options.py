@@ -8,8 +8,6 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
-from .errors import UsageError
-
 
 class _HelpFormatter(argparse.HelpFormatter):
     """--help shows the default of every option that has one."""
@@ -132,7 +130,9 @@ def _add_detrend_option(p: argparse.ArgumentParser, help_extra: str = "") -> Non
 
 def _load_data(args, default_ts: float | None = None):
     """The record the options describe, with the units they give."""
-    data = _load(args.data, args.input, args.output, args.ts, default_ts)
+    from spiralid.datasets import read_record
+
+    data = read_record(args.data, args.input, args.output, args.ts, default_ts)
     units = {
         k: v
         for k, v in (("input_unit", args.input_unit), ("output_unit", args.output_unit))
@@ -147,112 +147,6 @@ def _detrended(data, fraction: float | None):
     with, as new data would be."""
     reference = data if fraction is None else data.split(fraction)[0]
     return data.detrend(like=reference)
-
-
-def _load(path: str, input, output, ts, default_ts: float | None = None):
-    """Read CSV, NPZ or MAT into IOData, with the defaults of `simulate` files.
-
-    The sample time is `ts` if given, else the file's own (a ``time_s`` CSV
-    column, a ``ts`` variable), else `default_ts`.
-    """
-    from spiralid import datasets
-    from spiralid.sysid import IOData
-
-    file = Path(path)
-    if not file.exists() and path in datasets.NAMES:
-        if (input, output) != (None, None):
-            raise UsageError(
-                f"--input and --output do not apply to the shipped data set {path!r}"
-            )
-        return datasets.load(path, ts)
-    if not file.exists():
-        raise UsageError(
-            f"data file {path!r} does not exist (shipped data sets: "
-            f"{', '.join(datasets.NAMES)})"
-        )
-    if not file.is_file():
-        raise UsageError(f"data file {path!r} is not a file")
-    suffix = file.suffix.lower()
-    if suffix == ".csv":
-        try:
-            with file.open(encoding="utf-8-sig") as fh:
-                header = [c.strip() for c in fh.readline().strip().split(",")]
-        except UnicodeDecodeError:
-            raise UsageError(f"data file {path!r} is not a text CSV file") from None
-        written_by_us = "torque_Nm" in header
-        if input is None:
-            input = "torque_Nm" if written_by_us else "u"
-        if output is None:
-            output = "end_acceleration_m_s2" if written_by_us else "y"
-        ts_file = _csv_sample_time(file, header) if "time_s" in header else None
-        if (
-            ts is not None
-            and ts_file is not None
-            and not math.isclose(ts, ts_file, rel_tol=1e-5, abs_tol=1e-8)
-        ):
-            raise UsageError(
-                f"--ts {ts:g} contradicts the time_s column of {path!r} (steps of "
-                f"{ts_file:g} s); leave --ts out or correct the file"
-            )
-        ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
-        if ts is None:
-            raise UsageError(
-                f"--ts is required for {path!r}: a CSV file carries no sample "
-                "time (or give a 'time_s' column)"
-            )
-        data = IOData.from_csv(file, input=input, output=output, ts=ts)
-        if written_by_us:
-            data = replace(
-                data,
-                input_unit=_UNITS.get(data.input_name, data.input_unit),
-                output_unit=_UNITS.get(data.output_name, data.output_unit),
-            )
-        return data
-    if suffix in (".npz", ".mat"):
-        if input is None:
-            input = "u"
-        if output is None:
-            output = "y"
-        if isinstance(input, int) or isinstance(output, int):
-            raise UsageError(
-                f"--input/--output must be variable names for {suffix} files"
-            )
-        loader = IOData.from_npz if suffix == ".npz" else IOData.from_mat
-        try:
-            return loader(file, input=input, output=output, ts=ts)
-        except ValueError:
-            if ts is not None or default_ts is None:
-                raise
-            # The file carries no `ts`: fall back to the caller's default.
-            return loader(file, input=input, output=output, ts=default_ts)
-    raise UsageError(f"data file {path!r} must end in .csv, .npz or .mat")
-
-
-# Units of the columns `spiralid simulate` writes (their names carry them).
-_UNITS = {
-    "torque_Nm": "N m",
-    "hub_angle_rad": "rad",
-    "hub_velocity_rad_s": "rad/s",
-    "end_acceleration_m_s2": "m/s^2",
-}
-
-
-def _csv_sample_time(file: Path, header: list[str]) -> float:
-    """The step of an evenly spaced ``time_s`` column."""
-    import numpy as np
-
-    t = np.loadtxt(
-        file,
-        delimiter=",",
-        skiprows=1,
-        usecols=[header.index("time_s")],
-        encoding="utf-8-sig",
-        ndmin=1,
-    )
-    steps = np.diff(t)
-    if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
-        raise UsageError(f"the time_s column of {str(file)!r} is not evenly spaced")
-    return float(steps.mean())
 
 
 def _open_folder(path: str, force: bool):

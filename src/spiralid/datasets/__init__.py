@@ -10,9 +10,10 @@ from __future__ import annotations
 
 from importlib import resources
 
+from spiralid.datasets.files import read_record
 from spiralid.sysid.data import IOData
 
-__all__ = ["NAMES", "load", "robot_arm"]
+__all__ = ["NAMES", "load", "read_record", "robot_arm"]
 
 
 def robot_arm(ts: float = 0.01) -> IOData:

@@ -61,7 +61,7 @@ class DataSpec:
 
     def load(self):
         """The record as an :class:`~spiralid.sysid.IOData`."""
-        from spiralid.sysid import IOData
+        from spiralid.datasets import read_record
 
         s = self.settings
         if self.kind == "rig":
@@ -74,12 +74,7 @@ class DataSpec:
             from spiralid.datasets import robot_arm
 
             return robot_arm(ts=s.get("ts", 0.01))
-        data = IOData.from_csv(
-            s["path"],
-            input=s.get("input", "u"),
-            output=s.get("output", "y"),
-            ts=s.get("ts"),
-        )
+        data = read_record(s["path"], s.get("input"), s.get("output"), s.get("ts"))
         return data.detrend() if s.get("detrend", False) else data
 
 

@@ -1,0 +1,145 @@
+"""The one way a record is read: a shipped data set by name, or a file.
+
+:func:`read_record` is what ``spiralid identify``, ``validate`` and
+``reproduce`` read their DATA with and what a study file's ``csv`` records
+go through, so a file that one of them reads, all of them read the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from spiralid.sysid.data import IOData
+
+__all__ = ["read_record"]
+
+# Units of the columns `spiralid simulate` writes (their names carry them).
+SIMULATE_UNITS = {
+    "torque_Nm": "N m",
+    "hub_angle_rad": "rad",
+    "hub_velocity_rad_s": "rad/s",
+    "end_acceleration_m_s2": "m/s^2",
+}
+
+
+def read_record(
+    source: str | Path,
+    input: str | int | None = None,
+    output: str | int | None = None,
+    ts: float | None = None,
+    default_ts: float | None = None,
+) -> IOData:
+    """Read a record: a shipped data set's name, or a CSV, NPZ or MAT file.
+
+    Parameters
+    ----------
+    source : str or Path
+        A name of :data:`spiralid.datasets.NAMES`, or a file ending in
+        ``.csv``, ``.npz`` or ``.mat``.
+    input, output : str or int, optional
+        Column (CSV: name or 0-based index) or variable (NPZ, MAT) names.
+        Default ``u`` and ``y``, or for a CSV written by ``spiralid
+        simulate`` its torque and end-point acceleration (with their units).
+    ts : float, optional
+        Sample time in seconds; default the file's own (a CSV's evenly spaced
+        ``time_s`` column, an NPZ or MAT ``ts`` variable), else `default_ts`.
+    default_ts : float, optional
+        The sample time when neither `ts` nor the file gives one.
+
+    Returns
+    -------
+    IOData
+    """
+    from spiralid import datasets
+
+    file = Path(source)
+    if not file.exists() and str(source) in datasets.NAMES:
+        if (input, output) != (None, None):
+            raise ValueError(
+                f"`input` and `output` do not apply to the shipped data set "
+                f"{str(source)!r}"
+            )
+        return datasets.load(str(source), ts)
+    if not file.exists():
+        raise ValueError(
+            f"data file {str(source)!r} does not exist (shipped data sets: "
+            f"{', '.join(datasets.NAMES)})"
+        )
+    if not file.is_file():
+        raise ValueError(f"data file {str(source)!r} is not a file")
+    suffix = file.suffix.lower()
+    if suffix == ".csv":
+        return _read_csv(file, input, output, ts, default_ts)
+    if suffix in (".npz", ".mat"):
+        input = "u" if input is None else input
+        output = "y" if output is None else output
+        if isinstance(input, int) or isinstance(output, int):
+            raise ValueError(
+                f"`input` and `output` must be variable names for {suffix} files"
+            )
+        loader = IOData.from_npz if suffix == ".npz" else IOData.from_mat
+        try:
+            return loader(file, input=input, output=output, ts=ts)
+        except ValueError:
+            if ts is not None or default_ts is None:
+                raise
+            # The file carries no `ts`: fall back to the caller's default.
+            return loader(file, input=input, output=output, ts=default_ts)
+    raise ValueError(f"data file {str(source)!r} must end in .csv, .npz or .mat")
+
+
+def _read_csv(file: Path, input, output, ts, default_ts) -> IOData:
+    try:
+        with file.open(encoding="utf-8-sig") as fh:
+            header = [c.strip() for c in fh.readline().strip().split(",")]
+    except UnicodeDecodeError:
+        raise ValueError(f"data file {str(file)!r} is not a text CSV file") from None
+    written_by_us = "torque_Nm" in header
+    if input is None:
+        input = "torque_Nm" if written_by_us else "u"
+    if output is None:
+        output = "end_acceleration_m_s2" if written_by_us else "y"
+    ts_file = _csv_sample_time(file, header) if "time_s" in header else None
+    if (
+        ts is not None
+        and ts_file is not None
+        and not math.isclose(ts, ts_file, rel_tol=1e-5, abs_tol=1e-8)
+    ):
+        raise ValueError(
+            f"`ts` {ts:g} contradicts the time_s column of {str(file)!r} (steps "
+            f"of {ts_file:g} s); leave `ts` out or correct the file"
+        )
+    ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
+    if ts is None:
+        raise ValueError(
+            f"`ts` is required for {str(file)!r}: a CSV file carries no sample "
+            "time (or give a 'time_s' column)"
+        )
+    data = IOData.from_csv(file, input=input, output=output, ts=ts)
+    if written_by_us:
+        data = replace(
+            data,
+            input_unit=SIMULATE_UNITS.get(data.input_name, data.input_unit),
+            output_unit=SIMULATE_UNITS.get(data.output_name, data.output_unit),
+        )
+    return data
+
+
+def _csv_sample_time(file: Path, header: list[str]) -> float:
+    """The step of an evenly spaced ``time_s`` column."""
+    t = np.loadtxt(
+        file,
+        delimiter=",",
+        skiprows=1,
+        usecols=[header.index("time_s")],
+        encoding="utf-8-sig",
+        ndmin=1,
+    )
+    steps = np.diff(t)
+    if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
+        raise ValueError(f"the time_s column of {str(file)!r} is not evenly spaced")
+    return float(steps.mean())
