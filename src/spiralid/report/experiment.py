@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spiralid.study.runner import execute
+from spiralid.study.spec import BASELINES
 from spiralid.study.tasks import Task
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
 from spiralid.sysid.estimation.estimators import search_options
@@ -357,7 +358,7 @@ def reproduce(
     )
     tasks = [
         Task(label=label, method=method, parametrization=None, seed=None, **common)
-        for label, method in (("LS", "ls"), ("OE", "oe"))
+        for method, label in BASELINES.items()
     ] + [
         Task(
             label=c.label,
@@ -399,7 +400,7 @@ def reproduce(
         if progress is not None:
             progress(len(results), len(tasks))
 
-    baselines = {label: results[label, None] for label in ("LS", "OE")}
+    baselines = {label: results[label, None] for label in BASELINES.values()}
     runs = {c.label: [results[c.label, s] for s in seed_list] for c in configurations}
     rep = Reproduction(
         data=data,

@@ -11,6 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from spiralid.report.experiment import Reproduction
+from spiralid.study.spec import BASELINES
 from spiralid.sysid import plots
 
 __all__ = ["all_figures"]
@@ -21,7 +22,7 @@ PAPER_PAIR = ("SDA", "Eb-SDA")
 
 
 def _models(rep: Reproduction) -> dict:
-    labels = [*PAPER_PAIR, "OE"]
+    labels = [*PAPER_PAIR, BASELINES["oe"]]
     return {label: rep.best(label).model for label in labels}
 
 
@@ -72,7 +73,7 @@ def validation_response(rep: Reproduction) -> Figure:
 
 def spectrum(rep: Reproduction) -> Figure:
     """Figure 7c: PSD of measured and model outputs with resonances marked."""
-    labels = [*PAPER_PAIR, "OE"]
+    labels = [*PAPER_PAIR, BASELINES["oe"]]
     vals = {label: rep.validations[label][1] for label in labels}
     first = vals[labels[0]]
     return plots.plot_psd(

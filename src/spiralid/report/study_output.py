@@ -14,6 +14,7 @@ from pathlib import Path
 from spiralid.report.atomic import OutputFolder
 from spiralid.report.output import _CSS, _png, _table, _versions
 from spiralid.study import StudyResults
+from spiralid.study.spec import BASELINES
 
 __all__ = ["STUDY_FILES", "study_results_dict", "study_summary", "write_study_report"]
 
@@ -32,8 +33,7 @@ _CLAIM_HEAD = [
     "n",
     "median {a}",
     "median {b}",
-    "LS",
-    "OE",
+    *BASELINES.values(),
     "p",
     "p (Holm)",
     "A12",
@@ -61,8 +61,10 @@ def _claim_rows(res: StudyResults) -> list[list]:
             "/".join(map(str, c["n"])),
             _g(c[f"median {a}"]),
             _g(c[f"median {b}"]),
-            _g(_baseline_cost(res, c["data"], c["predictor"], "LS")),
-            _g(_baseline_cost(res, c["data"], c["predictor"], "OE")),
+            *(
+                _g(_baseline_cost(res, c["data"], c["predictor"], label))
+                for label in BASELINES.values()
+            ),
             f"{c['p_two_sided']:.3g}",
             f"{c['p_holm']:.3g}",
             f"{c['a12']:.2f}",

@@ -48,7 +48,10 @@ _DATA_KEYS = {
     "csv": ("name", "kind", "path", "input", "output", "ts", "detrend"),
 }
 _OPTIMIZER_KEYS = ("label", "method", "refine", "gain_scale", "safe_start", "options")
-_BASELINES = ("ls", "oe")
+# The deterministic baselines beside every metaheuristic, method -> the
+# label every table and figure gives it: the one list of them.
+BASELINES = {"ls": "LS", "oe": "OE"}
+_BASELINES = tuple(BASELINES)
 
 
 @dataclass(frozen=True)

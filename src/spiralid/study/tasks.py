@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from .spec import PREDICTORS, StudySpec
+from .spec import BASELINES, PREDICTORS, StudySpec
 
 __all__ = ["Task", "load_records", "reproducible_part", "run_task", "study_tasks"]
 
@@ -104,7 +104,7 @@ def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
                         d.name,
                         predictor,
                         None,
-                        method.upper(),
+                        BASELINES[method],
                         method,
                         None,
                         data_digest=digest,
