@@ -19,7 +19,7 @@ import numpy as np
 
 from spiralid.study.runner import execute
 from spiralid.study.spec import BASELINES
-from spiralid.study.tasks import Task
+from spiralid.study.tasks import reading_tasks
 from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
 from spiralid.sysid.estimation.estimators import search_options
 from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
@@ -348,31 +348,17 @@ def reproduce(
     gain = PaperCost(arx, est, predictor="simulation", initial=initial).w
     options = search_options({"n_points": n_points, "max_nfev": max_nfev})
     # The same tasks and runner as `spiralid study`: one execution path.
-    common = dict(
-        data="record",
-        predictor=f"simulation-{initial}",
+    tasks = reading_tasks(
+        "record",
+        f"simulation-{initial}",
+        BASELINES,
+        [(c.parametrization, c) for c in configurations],
+        seed_list,
         budget=max_nfev,
         points=n_points,
         arx=(arx.na, arx.nb, arx.nk),
         fraction=fraction,
     )
-    tasks = [
-        Task(label=label, method=method, parametrization=None, seed=None, **common)
-        for method, label in BASELINES.items()
-    ] + [
-        Task(
-            label=c.label,
-            method=c.method,
-            parametrization=c.parametrization,
-            seed=seed,
-            refine=c.refine,
-            gain_scale=c.gain_scale,
-            safe_start=c.safe_start,
-            **common,
-        )
-        for seed in seed_list
-        for c in configurations
-    ]
     n_workers = (os.cpu_count() or 1) if workers is None else int(workers)
     kinds = sorted({(c.method, c.parametrization) for c in configurations})
     warm_up = (est, arx, kinds, initial)

@@ -86,6 +86,39 @@ def load_records(spec: StudySpec) -> dict:
     return records
 
 
+def reading_tasks(
+    data: str, predictor: str, baselines, runs, seeds, **common
+) -> list[Task]:
+    """The tasks of one reading: each baseline once, then every
+    ``(parametrization, optimiser)`` of `runs` with every seed. An optimiser
+    has ``label``, ``method``, ``refine``, ``gain_scale``, ``safe_start`` and
+    optionally ``options`` (:class:`~spiralid.study.spec.OptimizerSpec`, or
+    a configuration of ``spiralid reproduce``); `common` holds the other
+    :class:`Task` fields."""
+    tasks = [
+        Task(data, predictor, None, BASELINES[method], method, None, **common)
+        for method in baselines
+    ]
+    for par, opt in runs:
+        for seed in seeds:
+            tasks.append(
+                Task(
+                    data,
+                    predictor,
+                    par,
+                    opt.label,
+                    opt.method,
+                    seed,
+                    refine=opt.refine,
+                    gain_scale=opt.gain_scale,
+                    safe_start=opt.safe_start,
+                    options=tuple(sorted(getattr(opt, "options", {}).items())),
+                    **common,
+                )
+            )
+    return tasks
+
+
 def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
     """Every run of `spec`, baselines first, in a fixed order."""
     common = dict(
@@ -94,42 +127,20 @@ def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
         arx=(spec.na, spec.nb, spec.nk),
         fraction=spec.fraction,
     )
+    runs = [(par, opt) for par in spec.parametrizations for opt in spec.optimizers]
     tasks = []
     for d in spec.data:
         digest = _digest(records[d.name])
         for predictor in spec.predictors:
-            for method in spec.baselines:
-                tasks.append(
-                    Task(
-                        d.name,
-                        predictor,
-                        None,
-                        BASELINES[method],
-                        method,
-                        None,
-                        data_digest=digest,
-                        **common,
-                    )
-                )
-            for par in spec.parametrizations:
-                for opt in spec.optimizers:
-                    for seed in spec.seeds:
-                        tasks.append(
-                            Task(
-                                d.name,
-                                predictor,
-                                par,
-                                opt.label,
-                                opt.method,
-                                seed,
-                                refine=opt.refine,
-                                gain_scale=opt.gain_scale,
-                                safe_start=opt.safe_start,
-                                options=tuple(sorted(opt.options.items())),
-                                data_digest=digest,
-                                **common,
-                            )
-                        )
+            tasks += reading_tasks(
+                d.name,
+                predictor,
+                spec.baselines,
+                runs,
+                spec.seeds,
+                data_digest=digest,
+                **common,
+            )
     return tasks
 
 
