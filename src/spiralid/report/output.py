@@ -8,9 +8,7 @@ folder is touched. The files are written atomically
 
 from __future__ import annotations
 
-import base64
 import html
-import io
 import json
 import platform
 from pathlib import Path
@@ -19,6 +17,7 @@ import numpy as np
 
 from spiralid.report.atomic import OutputFolder
 from spiralid.report.experiment import Reproduction
+from spiralid.report.html import figure, page, png, table
 from spiralid.sysid.models.polynomials import format_pole_radius
 
 __all__ = [
@@ -38,7 +37,7 @@ PAPER_TABLE2 = {
 }
 
 
-def _versions() -> dict:
+def versions() -> dict:
     import matplotlib
     import numba
     import scipy
@@ -158,7 +157,7 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
     best = {label: rep.best(label) for label in [*rep.runs, *rep.baselines]}
     return {
         "command": command,
-        "versions": _versions(),
+        "versions": versions(),
         "elapsed_seconds": rep.elapsed,
         "data": {
             **rep.source,
@@ -227,24 +226,6 @@ def _bounds(rep: Reproduction) -> dict:
         if c.parametrization not in out and bounds is not None:
             out[c.parametrization] = np.asarray(bounds).tolist()
     return out
-
-
-def _table(header: list[str], rows: list[list], fmt: str = "text") -> str:
-    cells = [[str(c) for c in row] for row in rows]
-    if fmt == "html":
-        head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
-        body = "".join(
-            "<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
-            for row in cells
-        )
-        return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-    widths = [max(len(h), *(len(r[i]) for r in cells)) for i, h in enumerate(header)]
-    line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
-    out = [line, "  ".join("-" * w for w in widths)]
-    out += [
-        "  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)) for r in cells
-    ]
-    return "\n".join(out)
 
 
 def _range(r) -> str:
@@ -330,10 +311,10 @@ def summary_text(rep: Reproduction) -> str:
             f"simulation from {d['initial']}.",
             "",
             "Table-2 (best run of each method; cost = eq. (2), % of rms(y))",
-            _table(_t2_head(rep.data.output_unit), _table2_rows(rep)),
+            table(_t2_head(rep.data.output_unit), _table2_rows(rep)),
             "",
             "Estimation cost over seeds",
-            _table(_STAT_HEAD, _stat_rows(rep)),
+            table(_STAT_HEAD, _stat_rows(rep)),
             "",
             verdict(rep),
             budget_verdict(rep)["sentence"],
@@ -342,32 +323,10 @@ def summary_text(rep: Reproduction) -> str:
     )
 
 
-def _png(fig) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    return buf.getvalue()
-
-
-_CSS = """
-body { font-family: sans-serif; max-width: 980px; margin: 2em auto; color: #222;
-       line-height: 1.45; padding: 0 1em; }
-table { border-collapse: collapse; margin: 1em 0; font-size: 0.92em; }
-th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: left; }
-th { background: #eee; }
-img { max-width: 100%; }
-code, pre { background: #f5f5f5; }
-pre { padding: 0.6em; overflow-x: auto; }
-.caption { font-size: 0.9em; color: #444; margin-bottom: 2em; }
-"""
-
-
 def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> str:
     e = html.escape
     d = rep.options
     parts = [
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        "<title>spiralid: SDA vs Eb-SDA reproduction</title>",
-        f"<style>{_CSS}</style></head><body>",
         "<h1>SDA vs exponential-based SDA: ARX modelling of a flexible "
         "manipulator</h1>",
         "<p>A reproduction of the results section of Nasir, Ismail, Ahmad and "
@@ -391,10 +350,10 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "<h2>Table-2</h2><p>Best run of each method (lowest estimation cost). "
         "Error ranges are min and max of the free-run error y - y&#770; in "
         "output units.</p>",
-        _table(_t2_head(rep.data.output_unit), _table2_rows(rep), "html"),
+        table(_t2_head(rep.data.output_unit), _table2_rows(rep), "html"),
         "<p>The paper's Table-2, on its own rig and record (its gain w is not "
         "stated, so its fitness scale is unknown):</p>",
-        _table(
+        table(
             _T2_HEAD[:4],
             [
                 [k, f"{v[0]:g}", _range(v[1]), _range(v[2])]
@@ -404,7 +363,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         ),
         "<h2>Statistics over seeds</h2><p>Estimation cost (eq. (2) at the "
         "default gain) of every run; rank-sum tests of Eb-SDA against SDA:</p>",
-        _table(_STAT_HEAD, _stat_rows(rep), "html"),
+        table(_STAT_HEAD, _stat_rows(rep), "html"),
         "<ul>",
     ]
     for t in ranksums(rep):
@@ -442,13 +401,9 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
             "costs rescored at the default gain).",
         ),
     }
-    for stem, png in images.items():
+    for stem, data in images.items():
         title, caption = figures.get(stem, (stem, ""))
-        b64 = base64.b64encode(png).decode("ascii")
-        parts.append(
-            f"<h3>{e(title)}</h3><img alt='{e(title)}' "
-            f"src='data:image/png;base64,{b64}'><p class='caption'>{e(caption)}</p>"
-        )
+        parts.append(figure(title, data, caption))
     parts.append("<h2>Transfer functions (form of eq. (9)-(10))</h2><pre>")
     for label in [*rep.runs, *rep.baselines]:
         parts.append(e(f"{label}: H(z) = {rep.best(label).model.tf_string()}") + "\n")
@@ -469,7 +424,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
             ]
         )
     parts.append(
-        _table(
+        table(
             [
                 "model",
                 "stable",
@@ -503,9 +458,8 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "test on the coefficients (the penalty's test, margin zero), the same "
         "verdict everywhere; a radius within 1e-4 of the circle is printed as "
         "its distance from 1.</li></ul>"
-        "</body></html>"
     )
-    return "".join(parts)
+    return page("spiralid: SDA vs Eb-SDA reproduction", parts)
 
 
 def ranksums(rep: Reproduction) -> list[dict]:
@@ -551,7 +505,7 @@ def _write_files(rep: Reproduction, folder: OutputFolder, command) -> list[Path]
 
     images = {}
     for stem, fig in all_figures(rep).items():
-        images[stem] = _png(fig)
+        images[stem] = png(fig)
         (folder.path / f"{stem}.png").write_bytes(images[stem])
     results = json.dumps(results_dict(rep, command), indent=2, allow_nan=True)
     (folder.path / "results.json").write_text(results)

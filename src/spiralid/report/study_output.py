@@ -6,13 +6,13 @@ computed from a study's store by :func:`spiralid.study.analyse`.
 
 from __future__ import annotations
 
-import base64
 import html
 import json
 from pathlib import Path
 
 from spiralid.report.atomic import OutputFolder
-from spiralid.report.output import _CSS, _png, _table, _versions
+from spiralid.report.html import figure, page, png, table
+from spiralid.report.output import versions
 from spiralid.study import StudyResults
 from spiralid.study.spec import BASELINES
 
@@ -165,7 +165,7 @@ def anytime_summary(res: StudyResults) -> str:
         f"evaluations, from the stored histories; Holm over all "
         f"{res.anytime['family']} tests: readings x budgets)",
         "",
-        _table(_anytime_head(res), _anytime_rows(res)),
+        table(_anytime_head(res), _anytime_rows(res)),
         "",
     ]
     flips = _crossover_lines(res)
@@ -185,7 +185,7 @@ def study_summary(res: StudyResults) -> str:
         f"(rank-sum test, Holm-adjusted over {len(res.claims)} readings, "
         f"alpha = {res.alpha:g}; A12 > 0.5 favours {a})",
         "",
-        _table(_claim_head(res), _claim_rows(res)),
+        table(_claim_head(res), _claim_rows(res)),
     ]
     wins = [c for c in res.claims if c["verdict"] == f"{a} better"]
     lines += [
@@ -203,7 +203,7 @@ def study_results_dict(res: StudyResults, spec_text: str, command=None) -> dict:
     """Everything the report shows, as JSON-ready data."""
     return {
         "command": command,
-        "versions": _versions(),
+        "versions": versions(),
         "specification": spec_text,
         "claim": list(res.claim),
         "alpha": res.alpha,
@@ -263,9 +263,6 @@ def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
     e = html.escape
     a, b = res.claim
     parts = [
-        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
-        "<title>spiralid study: where does the paper's claim hold?</title>",
-        f"<style>{_CSS}</style></head><body>",
         f"<h1>Where does the paper's claim hold? {e(a)} against {e(b)}</h1>",
         f"<p>Command: <code>{e(command or 'spiralid study')}</code></p>",
         "<p>Each reading of the paper's cost (record, predictor, "
@@ -276,7 +273,7 @@ def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
         "all readings; A12 is the probability that a run of "
         f"{e(a)} ends below a run of {e(b)}.</p>",
         "<h2>Where the claim holds</h2>",
-        _table(_claim_head(res), _claim_rows(res), "html"),
+        table(_claim_head(res), _claim_rows(res), "html"),
     ]
     if res.anytime.get("rows"):
         flips = _crossover_lines(res)
@@ -285,7 +282,7 @@ def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
             "<p>The best cost of every run after that many evaluations, read "
             "from its stored history (no run repeated); p-values Holm-adjusted "
             f"over all {res.anytime['family']} tests (readings x budgets).</p>",
-            _table(_anytime_head(res), _anytime_rows(res), "html"),
+            table(_anytime_head(res), _anytime_rows(res), "html"),
             "<p>"
             + (
                 "Where the verdict changes: " + e(" | ".join(flips))
@@ -294,17 +291,14 @@ def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
             )
             + "</p>",
         ]
-    for stem, png in images.items():
-        b64 = base64.b64encode(png).decode("ascii")
-        parts.append(
-            f"<h3>{e(stem)}</h3><img alt='{e(stem)}' src='data:image/png;base64,{b64}'>"
-        )
+    for stem, data in images.items():
+        parts.append(figure(stem, data))
     parts.append("<h2>Every reading</h2>")
     for rd in res.readings:
         parts.append(f"<h3>{e(', '.join(map(str, rd)))}</h3>")
-        parts.append(_table(_CELL_HEAD, _cell_rows(res, rd), "html"))
-    parts.append(f"<h2>Specification</h2><pre>{e(spec_text)}</pre></body></html>")
-    return "".join(parts)
+        parts.append(table(_CELL_HEAD, _cell_rows(res, rd), "html"))
+    parts.append(f"<h2>Specification</h2><pre>{e(spec_text)}</pre>")
+    return page("spiralid study: where does the paper's claim hold?", parts)
 
 
 def write_study_report(
@@ -326,7 +320,7 @@ def write_study_report(
     with OutputFolder(out, force) as folder:
         images = {}
         for stem, fig in study_figures(res).items():
-            images[stem] = _png(fig)
+            images[stem] = png(fig)
             (folder.path / f"{stem}.png").write_bytes(images[stem])
         (folder.path / "results.json").write_text(
             json.dumps(study_results_dict(res, spec_text, command), indent=2)
