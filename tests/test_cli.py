@@ -371,3 +371,13 @@ def test_help_texts_say_each_default_once(tmp_path):
     assert "0.3 for paper, 0.3 for bang- bang, 0.1 for prbs, 0.1 for chirp" in flat
     study = " ".join(run("study", "--help", cwd=tmp_path).stdout.split())
     assert "(default: spiralid-study)" in study and "(default: dask)" in study
+
+
+def test_a_search_option_for_a_method_that_searches_nothing_is_refused(tmp_path):
+    # identify() refuses the same from Python; the command must not ignore it.
+    out = run("identify", "robot_arm", "--method", "LS", "--budget", "100",
+              "--seed=3", "--out", "m", cwd=tmp_path)  # fmt: skip
+    assert out.returncode == 2 and len(out.stderr.splitlines()) == 1
+    assert "--budget, --seed apply to the search methods" in out.stderr
+    assert "--method ls takes none" in out.stderr
+    assert not (tmp_path / "m").exists()

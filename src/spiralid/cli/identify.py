@@ -129,6 +129,15 @@ def _run_narx(args) -> int:
     return 0
 
 
+# The options only a search takes.
+_SEARCH_FLAGS = ("--points", "--iterations", "--budget", "--seed", "--parametrization")
+
+
+def _given(argv: list[str], flag: str) -> bool:
+    """Whether the user wrote `flag` (``--flag value`` or ``--flag=value``)."""
+    return any(a == flag or a.startswith(flag + "=") for a in argv)
+
+
 def run(args, argv: list[str]) -> int:
     from spiralid.sysid import METHODS, identify, validate
     from spiralid.sysid.validation.plots import plot_convergence
@@ -147,9 +156,20 @@ def run(args, argv: list[str]) -> int:
         options = {"n_points": args.points, "max_nfev": args.budget}
         if args.iterations is not None:
             options["max_iter"] = args.iterations
-    elif args.refine:
-        searches = ", ".join(name for name, m in METHODS.items() if m.search)
-        raise UsageError(f"--refine applies to the search methods {searches}")
+    else:
+        # A search's option given to a method that searches nothing would
+        # be ignored without a word: refuse it, as identify() refuses the
+        # same options from Python.
+        given = [flag for flag in _SEARCH_FLAGS if _given(argv, flag)]
+        if args.refine:
+            given.append("--refine")
+        if given:
+            searches = ", ".join(name for name, m in METHODS.items() if m.search)
+            verb = "applies" if len(given) == 1 else "apply"
+            raise UsageError(
+                f"{', '.join(given)} {verb} to the search methods {searches}; "
+                f"--method {args.method} takes none"
+            )
     with _open_folder(args.out, args.force) as folder:
         model = identify(
             est,
@@ -250,6 +270,7 @@ def add_parser(sub) -> None:
     p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
     p.add_argument(
         "--method",
+        type=str.lower,
         choices=list(METHODS),
         default=DEFAULT_METHOD,
         help="estimator: a search over the paper's cost, least squares or output error",
