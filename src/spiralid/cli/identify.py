@@ -102,31 +102,40 @@ def _run_narx(args) -> int:
         v_est = validate(model, est, label=f"{args.method} (estimation)")
         v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
         staged = folder.path
-        (staged / "model.json").write_text(
-            json.dumps(model.to_dict(timings=False), indent=2)
+        summary = _write_model(
+            staged, model, v_est, v_val, f"{structure} by {args.method} on {args.data}"
         )
-        (staged / "timings.json").write_text(json.dumps(model.timings, indent=2))
-        (staged / "validation.json").write_text(
-            json.dumps(
-                {"estimation": v_est.to_dict(), "validation": v_val.to_dict()},
-                indent=2,
-            )
-        )
-        summary = "\n\n".join(
-            [
-                f"{structure} by {args.method} on {args.data}",
-                f"estimation cost (eq. 2): {model.cost:.6g}",
-                v_est.summary(),
-                v_val.summary(),
-            ]
-        )
-        (staged / "summary.txt").write_text(summary + "\n")
         _save_figures(v_val.plot(), staged, "validation_")
         written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)
         print(f"\nwrote {_listing(written, args.out)}")
     return 0
+
+
+def _write_model(staged, model, v_est, v_val, headline: str) -> str:
+    """model.json, timings.json, validation.json and summary.txt of a fitted
+    model (ARX or NARX); returns the summary. model.json holds what the seed
+    decides, byte for byte the same on a rerun; the wall times go beside it."""
+    (staged / "model.json").write_text(
+        json.dumps(model.to_dict(timings=False), indent=2)
+    )
+    (staged / "timings.json").write_text(json.dumps(model.timings, indent=2))
+    (staged / "validation.json").write_text(
+        json.dumps(
+            {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
+        )
+    )
+    summary = "\n\n".join(
+        [
+            headline,
+            f"estimation cost (eq. 2): {model.cost:.6g}",
+            v_est.summary(),
+            v_val.summary(),
+        ]
+    )
+    (staged / "summary.txt").write_text(summary + "\n")
+    return summary
 
 
 # The options only a search takes.
@@ -187,27 +196,8 @@ def run(args, argv: list[str]) -> int:
         v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
         staged = folder.path
         model.fraction = args.fraction
-        # model.json holds what the seed decides, byte for byte the same on
-        # a rerun; the wall times go beside it.
-        (staged / "model.json").write_text(
-            json.dumps(model.to_dict(timings=False), indent=2)
-        )
-        (staged / "timings.json").write_text(json.dumps(model.timings, indent=2))
-        (staged / "validation.json").write_text(
-            json.dumps(
-                {"estimation": v_est.to_dict(), "validation": v_val.to_dict()},
-                indent=2,
-            )
-        )
-        summary = "\n\n".join(
-            [
-                f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}",
-                f"estimation cost (eq. 2): {model.cost:.6g}",
-                v_est.summary(),
-                v_val.summary(),
-            ]
-        )
-        (staged / "summary.txt").write_text(summary + "\n")
+        headline = f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}"
+        summary = _write_model(staged, model, v_est, v_val, headline)
         _save_figures(v_val.plot(), staged, "validation_")
         _save_figures(v_est.plot(), staged, "estimation_")
         if model.history is not None:
