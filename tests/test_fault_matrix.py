@@ -116,7 +116,10 @@ CASES = [
     ("identify ok.csv --ts 0.01 --na -2", "--na"),
     ("identify ok.csv --ts 0.01 --nb 0", "--nb"),
     ("identify ok.csv --ts 0.01 --points 1", "--points must be an integer >= 2"),
-    ("identify ok.csv --ts 0.01 --method ls --refine", "--refine applies to the search methods"),
+    (
+        "identify ok.csv --ts 0.01 --method ls --refine",
+        "--refine applies to the search methods",
+    ),
     ("identify ok.csv --ts 0.01 --budget 10", "--budget must be an integer"),
     ("identify ok.csv --ts 0.01 --iterations 0", "--iterations"),
     ("identify ok.csv --ts 0.01 --fraction 1.5", "--fraction"),
