@@ -7,6 +7,7 @@ Knows nothing of system identification. See :func:`minimize`;
 
 from spiralid.optim import testfunctions
 from spiralid.optim.evolution import differential_evolution
+from spiralid.optim.pareto import hypervolume, minimize_pareto, non_dominated
 from spiralid.optim.restarts import Restarts
 from spiralid.optim.result import STATUS, OptimiserResult
 from spiralid.optim.rotation import planes, rotate, rotation_matrix
@@ -41,7 +42,10 @@ __all__ = [
     "descent_rotation",
     "differential_evolution",
     "exponential_rule",
+    "hypervolume",
     "minimize",
+    "minimize_pareto",
+    "non_dominated",
     "planes",
     "rank_condition",
     "rotate",
