@@ -25,6 +25,13 @@ import numpy as np
 
 from spiralid._checks import box_bounds, generator, integer, real_array
 from spiralid.optim import _kernels
+from spiralid.optim._loop import (
+    apply_bounds,
+    check_costs,
+    check_policy,
+    finite_or_inf,
+    stop_report,
+)
 from spiralid.optim.restarts import MIN_ITER, Restarts, parse_restarts
 from spiralid.optim.result import OptimiserResult
 from spiralid.optim.rotation import _sweep_order, rotation_matrix
@@ -40,24 +47,6 @@ from spiralid.optim.rules import (
 
 __all__ = ["RULES", "SpiralResult", "SpiralSearch", "minimize"]
 
-# Every stop message comes from here, so `message` is always one of these
-# (plus the notes below).
-_STATUS = {
-    "max_iter": "Maximum number of iterations reached.",
-    "max_nfev": "Maximum number of function evaluations reached.",
-    "target": "Target cost reached.",
-    "callback": "The callback requested a stop.",
-    "running": "In progress.",
-}
-_NOTES = {
-    "initial_nonfinite": (
-        "Every initial cost was non-finite; the first initial point served as "
-        "centre until a finite cost was found."
-    ),
-    "never_finite": "No finite cost was found.",
-    "target_missed": "The target cost was not reached.",
-}
-
 _METHODS = {
     "sda": ConstantSpiral,
     "ebsda": ExponentialSpiral,
@@ -72,15 +61,11 @@ _BUILTIN = (ConstantSpiral, ExponentialSpiral, LinearSpiral)
 # The one list of rule names: minimize() accepts them, and
 # spiralid.sysid.identify() offers each as an identification method.
 RULES = _METHODS
-_POLICIES = ("none", "clip", "reflect")
 
 
 # minimize's result: the one optimiser result type, under the name the
 # spiral searches have always given it.
 SpiralResult = OptimiserResult
-
-# The STATUS key of each way a search stops.
-_STATUS_CODE = {"max_iter": 2, "max_nfev": 1, "target": 0, "callback": 0, "running": 0}
 
 
 def _parse_method(method) -> SpiralRule | StepRateRule:
@@ -115,18 +100,6 @@ def _rule_output(out, k: int) -> tuple:
             raise ValueError(f"{what}; got non-finite values {value!r}")
         checked.append(arr)
     return tuple(checked)
-
-
-def _costs(raw, shape: tuple, what: str) -> np.ndarray:
-    """Check what the objective returned: real numbers of the given shape."""
-    arr = np.asarray(raw)
-    # None or strings (object arrays) would turn into NaN or fail deep in
-    # NumPy; complex costs cannot be ranked.
-    if arr.dtype.kind not in "biuf":
-        raise ValueError(f"`fun` must return real numbers; got {raw!r:.80}")
-    if arr.shape != shape:
-        raise ValueError(f"`fun` must return {what}; got shape {arr.shape}")
-    return arr
 
 
 class SpiralSearch:
@@ -176,11 +149,7 @@ class SpiralSearch:
         self.rule = _parse_method(method)
         self._builtin_rule = type(self.rule) in _BUILTIN
         m = integer(n_points, "n_points", 2)
-        if not isinstance(bounds_policy, str) or bounds_policy not in _POLICIES:
-            raise ValueError(
-                f"`bounds_policy` must be one of {_POLICIES}; got {bounds_policy!r}"
-            )
-        self.bounds_policy = bounds_policy
+        self.bounds_policy = check_policy(bounds_policy)
         if not isinstance(vectorized, bool | np.bool_):
             raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
         self.vectorized = bool(vectorized)
@@ -276,11 +245,11 @@ class SpiralSearch:
             )
             # A copy: the search reorders its costs in place, and the caller
             # may keep the array it returned.
-            return np.array(_costs(self._fun(pts.copy()), (k,), what), np.float64)
+            return np.array(check_costs(self._fun(pts.copy()), (k,), what), np.float64)
         what = "a scalar when vectorized=False (pass vectorized=True for batches)"
         out = np.empty(k)
         for i in range(k):
-            out[i] = _costs(self._fun(pts[i].copy()), (), what)
+            out[i] = check_costs(self._fun(pts[i].copy()), (), what)
         return out
 
     def _promote(self) -> None:
@@ -302,31 +271,17 @@ class SpiralSearch:
             self._matrix = (theta, matrix)
         return matrix
 
-    def _apply_bounds(self, moving: np.ndarray) -> None:
-        lo, hi = self._lo, self._hi
-        if self.bounds_policy == "clip":
-            np.clip(moving, lo, hi, out=moving)
-        elif self.bounds_policy == "reflect":
-            out = (moving < lo) | (moving > hi)
-            if out.any():
-                # Only touch escaped coordinates so that points inside the
-                # box are not perturbed by rounding.
-                w = hi - lo
-                y = np.mod(moving - lo, 2.0 * w)
-                y = np.where(y > w, 2.0 * w - y, y)
-                moving[out] = (lo + y)[out]
-
     def step(self) -> tuple[np.ndarray, float]:
         """Perform one iteration; return the best point and cost."""
         x = self._x
         k = x.shape[0] - 1
-        centre_cost = _finite_or_inf(self._f[0])
+        centre_cost = finite_or_inf(self._f[0])
         if self._fixed is not None:
             self._step_rate(x)
         else:
             self._step_angles(x, k)
         if self.bounds_policy != "none":
-            self._apply_bounds(x[1:])
+            apply_bounds(x[1:], self._lo, self._hi, self.bounds_policy)
         self._f[1:] = self._evaluate(x[1:])
         self.nfev += k
         self.nit += 1
@@ -416,7 +371,7 @@ class SpiralSearch:
     @property
     def x(self) -> np.ndarray:
         """The best point so far: the centre, or an earlier run's best."""
-        if self._archive[1] < _finite_or_inf(self._f[0]):
+        if self._archive[1] < finite_or_inf(self._f[0]):
             return self._archive[0].copy()
         return self._x[0].copy()
 
@@ -459,27 +414,10 @@ class SpiralSearch:
         ``status`` is a key of the stop-message table: "max_iter",
         "max_nfev", "target", "callback" or "running".
         """
-        if status not in _STATUS:
-            raise ValueError(
-                f"`status` must be one of {tuple(_STATUS)}; got {status!r}"
-            )
-        fun = self.fun
-        finite = math.isfinite(fun)
-        reached = target is None or (finite and fun <= target)
-        notes = [_STATUS[status]]
-        if self.initial_nonfinite and finite:
-            notes.append(_NOTES["initial_nonfinite"])
-        if not finite:
-            notes.append(_NOTES["never_finite"])
-        if status != "running" and not reached and finite:
-            notes.append(_NOTES["target_missed"])
-        success = status in ("max_iter", "max_nfev", "target") and finite and reached
         return OptimiserResult(
             x=self.x,
-            fun=fun,
-            status=_STATUS_CODE[status],
-            success=success,
-            message=" ".join(notes),
+            fun=self.fun,
+            **stop_report(status, self.fun, target, self.initial_nonfinite),
             nit=self.nit,
             nfev=self.nfev,
             n_restarts=self.restarts,
@@ -488,11 +426,6 @@ class SpiralSearch:
             mean_radius=np.array(self.mean_radius),
             mean_angle=np.array(self.mean_angle),
         )
-
-
-def _finite_or_inf(value) -> float:
-    value = float(value)
-    return value if math.isfinite(value) else math.inf
 
 
 def _fixed_rotation(rule: StepRateRule, n: int) -> np.ndarray:
