@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spiralid.optim import RULES, Restarts, minimize
+from spiralid.optim import RULES, LearnedMetricSpiral, Restarts, minimize
 
 TARGETS = 10.0 ** (2.0 - 0.2 * np.arange(51))  # COCO's 51 standard targets
 DIMS = (2, 5, 10, 20)
@@ -52,8 +52,16 @@ GROUPS = {
     "weakly structured": range(20, 25),
 }
 RESTART = "+restarts"
-REFERENCES = ("cma", "random")
-ALL_METHODS = (*RULES, *(m + RESTART for m in RULES), *REFERENCES)
+# The learned-metric rule with one ingredient taken away at a time: the
+# box's own axes instead of the learned basis, and the periodic setting's
+# budget schedule instead of success-based steps.
+INGREDIENTS = {
+    "learned-metric/axes": LearnedMetricSpiral(basis=False),
+    "learned-metric/scheduled": LearnedMetricSpiral(success_steps=False),
+}
+SPIRALS = (*RULES, *INGREDIENTS)
+REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")
+ALL_METHODS = (*SPIRALS, *(m + RESTART for m in SPIRALS), *REFERENCES)
 # Every bbob function has its optimum in [-4, 4]^D; the search box is [-5, 5]^D.
 SIGMA0 = 2.0
 
@@ -78,7 +86,7 @@ def _spiral(problem, objective, budget, rng, method, n_points):
     minimize(
         objective,
         bounds,
-        name,
+        INGREDIENTS.get(name, name),
         n_points=n_points,
         max_iter=budget,  # the evaluation budget binds first
         max_nfev=budget,
@@ -120,6 +128,66 @@ def _cma(problem, objective, budget, rng, method, n_points):
         popsize = 2 * es.popsize
 
 
+class _Spent(Exception):
+    """The budget is spent: ends a reference optimiser's run from inside."""
+
+
+def _capped(problem, objective, budget):
+    """`objective` for one point, raising _Spent instead of passing `budget`
+    or once the final target is hit."""
+
+    def fun(x):
+        if problem.final_target_hit or problem.evaluations + 1 > budget:
+            raise _Spent
+        return float(objective(np.asarray(x)[None, :])[0])
+
+    return fun
+
+
+def _bipop_cma(problem, objective, budget, rng, method, n_points):
+    """BIPOP-CMA-ES (pycma's ``fmin2(..., bipop=True)``), same budget."""
+    import cma
+
+    fun = _capped(problem, objective, budget)
+    options = {
+        "seed": int(rng.integers(1, 2**31)),
+        "verbose": -9,
+        "maxfevals": budget,
+    }
+    try:
+        cma.fmin2(
+            fun,
+            lambda: rng.uniform(-4.0, 4.0, problem.dimension),
+            SIGMA0,
+            options,
+            restarts=1000,
+            bipop=True,
+        )
+    except _Spent:
+        pass
+
+
+def _scipy_restarted(problem, objective, budget, rng, method, n_points):
+    """SciPy's BFGS (finite-difference gradients) or Nelder-Mead, restarted
+    from uniform points in [-4, 4]^D until the budget is spent."""
+    from scipy import optimize
+
+    fun = _capped(problem, objective, budget)
+    name = {"bfgs": "BFGS", "nelder-mead": "Nelder-Mead"}[method]
+    try:
+        while True:
+            x0 = rng.uniform(-4.0, 4.0, problem.dimension)
+            left = budget - problem.evaluations
+            options = {"maxiter": left} if name == "BFGS" else {"maxfev": left}
+            if name == "Nelder-Mead":
+                options.update(xatol=1e-11, fatol=1e-11, adaptive=True)
+            else:
+                options.update(gtol=1e-10)
+            optimize.minimize(fun, x0, method=name, options=options)
+    except _Spent:
+        pass
+
+
 def _random(problem, objective, budget, rng, method, n_points):
     lo, hi = problem.lower_bounds, problem.upper_bounds
     left = budget
@@ -130,7 +198,13 @@ def _random(problem, objective, budget, rng, method, n_points):
 
 
 def _runner(method):
-    return {"cma": _cma, "random": _random}.get(method, _spiral)
+    return {
+        "cma": _cma,
+        "bipop-cma": _bipop_cma,
+        "bfgs": _scipy_restarted,
+        "nelder-mead": _scipy_restarted,
+        "random": _random,
+    }.get(method, _spiral)
 
 
 class _Sphere:

@@ -1,5 +1,6 @@
 """General-purpose spiral dynamic optimisers (SDA, Eb-SDA, linear adaptive SDA,
-Tamura & Yasuda's periodic and convergent settings), with optional restarts.
+Tamura & Yasuda's periodic and convergent settings, the learned-metric
+spiral), with optional restarts.
 
 Knows nothing of system identification. See :func:`minimize`;
 :func:`differential_evolution` is the baseline beside them.
@@ -7,6 +8,11 @@ Knows nothing of system identification. See :func:`minimize`;
 
 from spiralid.optim import testfunctions
 from spiralid.optim.evolution import differential_evolution
+from spiralid.optim.learned import (
+    AdaptiveEncoding,
+    LearnedMetricSearch,
+    LearnedMetricSpiral,
+)
 from spiralid.optim.pareto import hypervolume, minimize_pareto, non_dominated
 from spiralid.optim.restarts import Restarts
 from spiralid.optim.result import STATUS, OptimiserResult
@@ -28,9 +34,12 @@ from spiralid.optim.spiral import RULES, SpiralResult, SpiralSearch, minimize
 __all__ = [
     "RULES",
     "STATUS",
+    "AdaptiveEncoding",
     "ConstantSpiral",
     "ConvergentSpiral",
     "ExponentialSpiral",
+    "LearnedMetricSearch",
+    "LearnedMetricSpiral",
     "LinearSpiral",
     "OptimiserResult",
     "PeriodicSpiral",

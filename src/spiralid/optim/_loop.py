@@ -92,3 +92,62 @@ def stop_report(status: str, fun: float, target, initial_nonfinite: bool) -> dic
         "success": success,
         "message": " ".join(notes),
     }
+
+
+def seed_points(x0, lo: np.ndarray, hi: np.ndarray, m: int) -> np.ndarray:
+    """``x0`` as ``(k, n)`` seeds of an ``m``-point population in ``[lo, hi]``."""
+    n = lo.size
+    if x0 is None:
+        return np.empty((0, n))
+    try:
+        arr = np.array(x0, dtype=np.float64, ndmin=1)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`x0` must be an array of shape ({n},) or (k, {n}) with "
+            f"1 <= k <= n_points={m}; got {x0!r}"
+        ) from None
+    if arr.ndim == 1:
+        arr = arr.reshape(1, -1)
+    if arr.ndim != 2 or arr.shape[1] != n or not 1 <= arr.shape[0] <= m:
+        raise ValueError(
+            f"`x0` must have shape ({n},) or (k, {n}) with 1 <= k <= "
+            f"n_points={m}; got shape {np.shape(x0)}"
+        )
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("`x0` must be finite; got non-finite entries")
+    outside = np.flatnonzero(np.any((arr < lo) | (arr > hi), axis=1))
+    if outside.size:
+        raise ValueError(
+            f"`x0` must lie within `bounds`; got {outside.size} point(s) "
+            f"outside, the first being row {int(outside[0])}"
+        )
+    return arr
+
+
+class Trace:
+    """A growing float record (a search's history): appending is amortised
+    O(1) and :meth:`array` copies, so a callback every iteration does not
+    turn a long run quadratic."""
+
+    __slots__ = ("_data", "_size")
+
+    def __init__(self, first: float | None = None):
+        self._data = np.empty(64)
+        self._size = 0
+        if first is not None:
+            self.append(first)
+
+    def append(self, value: float) -> None:
+        if self._size == self._data.size:
+            self._data = np.concatenate([self._data, np.empty(self._size)])
+        self._data[self._size] = value
+        self._size += 1
+
+    def set_last(self, value: float) -> None:
+        self._data[self._size - 1] = value
+
+    def __len__(self) -> int:
+        return self._size
+
+    def array(self) -> np.ndarray:
+        return self._data[: self._size].copy()

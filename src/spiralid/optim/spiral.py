@@ -30,8 +30,10 @@ from spiralid.optim._loop import (
     check_costs,
     check_policy,
     finite_or_inf,
+    seed_points,
     stop_report,
 )
+from spiralid.optim.learned import LearnedMetricSearch, LearnedMetricSpiral
 from spiralid.optim.restarts import MIN_ITER, Restarts, parse_restarts
 from spiralid.optim.result import OptimiserResult
 from spiralid.optim.rotation import _sweep_order, rotation_matrix
@@ -54,6 +56,7 @@ _METHODS = {
     "ebsda-scaled": lambda: ExponentialSpiral(scale_free=True),
     "periodic": PeriodicSpiral,
     "convergent": ConvergentSpiral,
+    "learned-metric": LearnedMetricSpiral,
 }
 # Rules whose output is right by construction (exact types: a subclass may
 # override __call__).
@@ -68,8 +71,8 @@ RULES = _METHODS
 SpiralResult = OptimiserResult
 
 
-def _parse_method(method) -> SpiralRule | StepRateRule:
-    if isinstance(method, SpiralRule | StepRateRule):
+def _parse_method(method) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
+    if isinstance(method, SpiralRule | StepRateRule | LearnedMetricSpiral):
         return method
     if isinstance(method, str) and method.lower() in _METHODS:
         return _METHODS[method.lower()]()
@@ -147,6 +150,11 @@ class SpiralSearch:
         self._fun = fun
         self._lo, self._hi = box_bounds(bounds)
         self.rule = _parse_method(method)
+        if isinstance(self.rule, LearnedMetricSpiral):
+            raise ValueError(
+                "`method` LearnedMetricSpiral polls from the centre: step it "
+                "with LearnedMetricSearch, or run it with minimize()"
+            )
         self._builtin_rule = type(self.rule) in _BUILTIN
         m = integer(n_points, "n_points", 2)
         self.bounds_policy = check_policy(bounds_policy)
@@ -154,7 +162,7 @@ class SpiralSearch:
             raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
         self.vectorized = bool(vectorized)
         n = self._lo.size
-        seeds = self._parse_x0(x0, m, n)
+        seeds = seed_points(x0, self._lo, self._hi, m)
         self._rng = generator(rng)
         self._planes = _sweep_order(n)
         self._matrix = (None, None)
@@ -209,33 +217,6 @@ class SpiralSearch:
         self._populate(np.empty((0, self._lo.size)), m)
         self.restarts += 1
         self.history.append(self._best_cost())
-
-    def _parse_x0(self, x0, m: int, n: int) -> np.ndarray:
-        if x0 is None:
-            return np.empty((0, n))
-        try:
-            arr = np.array(x0, dtype=np.float64, ndmin=1)
-        except (TypeError, ValueError):
-            raise ValueError(
-                f"`x0` must be an array of shape ({n},) or (k, {n}) with "
-                f"1 <= k <= n_points={m}; got {x0!r}"
-            ) from None
-        if arr.ndim == 1:
-            arr = arr.reshape(1, -1)
-        if arr.ndim != 2 or arr.shape[1] != n or not 1 <= arr.shape[0] <= m:
-            raise ValueError(
-                f"`x0` must have shape ({n},) or (k, {n}) with 1 <= k <= "
-                f"n_points={m}; got shape {np.shape(x0)}"
-            )
-        if not np.all(np.isfinite(arr)):
-            raise ValueError("`x0` must be finite; got non-finite entries")
-        outside = np.flatnonzero(np.any((arr < self._lo) | (arr > self._hi), axis=1))
-        if outside.size:
-            raise ValueError(
-                f"`x0` must lie within `bounds`; got {outside.size} point(s) "
-                f"outside, the first being row {int(outside[0])}"
-            )
-        return arr
 
     def _evaluate(self, pts: np.ndarray) -> np.ndarray:
         k = pts.shape[0]
@@ -569,18 +550,31 @@ def minimize(
         )
     restarts = parse_restarts(restarts)
 
+    rule = _parse_method(method)
+    n = box_bounds(bounds)[0].size
+    if isinstance(rule, LearnedMetricSpiral):
+        Search = LearnedMetricSearch
+
+        def per_step(m: int) -> int:
+            return rule.evaluations_per_period(n)
+    else:
+        Search = SpiralSearch
+
+        def per_step(m: int) -> int:
+            return m - 1  # the centre is not re-evaluated
+
     def iterations_left(m: int, nit: int, nfev: int) -> int:
         # What the budget allows a population of m after nit iterations and
         # nfev evaluations: a step-rate rule's schedule spans it.
         left = max_iter - nit
         if max_nfev is not None:
-            left = min(left, (max_nfev - nfev) // (m - 1))
+            left = min(left, (max_nfev - nfev) // per_step(m))
         return left
 
-    search = SpiralSearch(
+    search = Search(
         fun,
         bounds,
-        method,
+        rule,
         n_points=m,
         rng=rng,
         vectorized=vectorized,
@@ -596,7 +590,7 @@ def minimize(
             status = "max_iter"
             break
         m = search.n_points
-        if max_nfev is not None and search.nfev + (m - 1) > max_nfev:
+        if max_nfev is not None and search.nfev + per_step(m) > max_nfev:
             status = "max_nfev"
             break
         if restarts is not None and search.collapsed(restarts):
