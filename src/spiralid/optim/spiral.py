@@ -583,7 +583,7 @@ def minimize(
         max_iter=max(iterations_left(m, 0, m), 1),
     )
     status = None
-    if target is not None and search.history[-1] <= target:
+    if target is not None and search.fun <= target:
         status = "target"
     while status is None:
         if search.nit >= max_iter:
@@ -598,7 +598,7 @@ def minimize(
             left = iterations_left(grown, search.nit, search.nfev + grown)
             if left >= MIN_ITER:
                 search.restart(grown, max_iter=left)
-                if target is not None and search.history[-1] <= target:
+                if target is not None and search.fun <= target:
                     status = "target"
                 continue
         search.step()
@@ -609,7 +609,7 @@ def minimize(
         stop = callback is not None and callback(
             search.result("running", time.perf_counter() - start)
         )
-        if target is not None and search.history[-1] <= target:
+        if target is not None and search.fun <= target:
             status = "target"
         elif stop:
             status = "callback"
