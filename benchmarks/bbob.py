@@ -58,6 +58,8 @@ RESTART = "+restarts"
 INGREDIENTS = {
     "learned-metric/axes": LearnedMetricSpiral(basis=False),
     "learned-metric/scheduled": LearnedMetricSpiral(success_steps=False),
+    "learned-metric/no-model": LearnedMetricSpiral(model_step=False),
+    "learned-metric/polls-only": LearnedMetricSpiral(populations=False),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

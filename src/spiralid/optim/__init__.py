@@ -7,12 +7,9 @@ Knows nothing of system identification. See :func:`minimize`;
 """
 
 from spiralid.optim import testfunctions
+from spiralid.optim.encoding import AdaptiveEncoding
 from spiralid.optim.evolution import differential_evolution
-from spiralid.optim.learned import (
-    AdaptiveEncoding,
-    LearnedMetricSearch,
-    LearnedMetricSpiral,
-)
+from spiralid.optim.learned import LearnedMetricSearch, LearnedMetricSpiral
 from spiralid.optim.pareto import hypervolume, minimize_pareto, non_dominated
 from spiralid.optim.restarts import Restarts
 from spiralid.optim.result import STATUS, OptimiserResult

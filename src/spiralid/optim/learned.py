@@ -17,22 +17,36 @@ metric they are taken in:
    ``n`` pairs, ``2n`` evaluations.
 2. **A learned basis.** The directions are the columns ``b_j`` of a basis
    ``B`` learned by Adaptive Encoding (Hansen, PPSN 2008) from the best half
-   of each period's polled points (:class:`AdaptiveEncoding`): on a
-   quadratic, ``B B^T`` approaches the inverse Hessian up to scale, so the
-   poll becomes coordinate descent along the problem's principal axes.
+   of each period's polled points
+   (:class:`~spiralid.optim.encoding.AdaptiveEncoding`): on a quadratic,
+   ``B B^T`` approaches the inverse Hessian up to scale, so the poll becomes
+   coordinate descent along the problem's principal axes.
 3. **A step per direction from success.** ``s_j`` is multiplied by 2 after
    a success and by 1/2 after a failure (Loshchilov, Schoenauer & Sebag's
    Adaptive Coordinate Descent, GECCO 2011), instead of the budget schedule
    ``delta^(1/k_max)`` of the periodic setting.
+4. **A model step.** The three costs on each direction's line give a
+   parabola; after the period the centre tries the minimum of that diagonal
+   quadratic in the learned basis (one evaluation).
+5. **Two regimes of restarts** (with :func:`~spiralid.optim.minimize`'s
+   ``restarts``). A poll is a local search: it stops where no direction at
+   any step improves, which on a rugged or stepped landscape is anywhere.
+   As BIPOP-CMA-ES (Hansen, BBOB 2009) alternates a local regime with one of
+   growing populations, restarts alternate between a fresh poll (from the
+   best of a new uniform population) and a *population period*: the pairs
+   are ``x* +- sigma B z_l`` for ``lambda / 2`` random ``z_l`` (mirrored
+   samples, the spiral's opposite directions), the centre moves to the
+   weighted mean of the best half, whose cost is evaluated, and ``sigma``
+   follows the mean's path (cumulative step-size adaptation). Averaging
+   over the best half is what lets a large population see through local
+   minima; the population doubles at each such restart, as in IPOP. The
+   regime whose runs have spent fewer evaluations goes next (BIPOP's rule).
 
 The search runs in the box scaled to the unit cube, so the basis starts as
-the box's own axes and the first steps are a quarter of its widths.
-:func:`~spiralid.optim.minimize` drives it like every rule (same budget,
-bounds policy, callback and result), ``restarts=True`` included: a run that
-has collapsed (every step below ``tol_radius``, or no centre move for
-``stall`` periods, or a basis conditioned beyond 1e14) starts again from the
-best of a fresh uniform population, IPOP's growth applying to that
-population.
+the box's own axes and the first poll steps are a quarter of its widths. A
+run has collapsed when every step is below ``tol_radius`` (of the unit
+cube), or no better point has been found for ``stall`` periods, or the
+basis is conditioned beyond 1e14.
 """
 
 import math
@@ -50,15 +64,19 @@ from spiralid.optim._loop import (
     seed_points,
     stop_report,
 )
+from spiralid.optim.encoding import AdaptiveEncoding
 from spiralid.optim.restarts import Restarts
 from spiralid.optim.result import OptimiserResult
 
-__all__ = ["AdaptiveEncoding", "LearnedMetricSearch", "LearnedMetricSpiral"]
+__all__ = ["LearnedMetricSearch", "LearnedMetricSpiral"]
 
 _SCALAR = "a scalar when vectorized=False (pass vectorized=True for batches)"
 # A basis conditioned beyond this has lost the directions it learned to
 # rounding; the run counts as collapsed.
 _MAX_CONDITION = 1e14
+# A population period's first step, in the unit cube (the sigma0 = 2 that
+# IPOP-CMA-ES is run with on [-5, 5]^n).
+_SIGMA0 = 0.2
 
 
 @dataclass(frozen=True)
@@ -79,6 +97,9 @@ class LearnedMetricSpiral:
         After each period, try the minimum of the diagonal quadratic model
         that the pairs' costs give in the learned basis (one evaluation;
         default).
+    populations : bool
+        With restarts, alternate fresh polls with population periods
+        (default); False restarts polls only.
     grow, shrink : float
         Step factors after a success (``> 1``) and a failure (in (0, 1));
         default 2 and 1/2, Adaptive Coordinate Descent's.
@@ -99,12 +120,13 @@ class LearnedMetricSpiral:
     basis: bool = True
     success_steps: bool = True
     model_step: bool = True
+    populations: bool = True
     grow: float = 2.0
     shrink: float = 0.5
     delta: float = 1e-3
 
     def __post_init__(self):
-        for name in ("basis", "success_steps", "model_step"):
+        for name in ("basis", "success_steps", "model_step", "populations"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"`{name}` must be True or False")
         grow = positive(self.grow, "grow")
@@ -117,107 +139,27 @@ class LearnedMetricSpiral:
             object.__setattr__(self, name, value)
         object.__setattr__(self, "grow", grow)
 
-    def evaluations_per_period(self, n: int) -> int:
-        """At most this many evaluations per period (iteration) in dimension
-        ``n``: ``2n`` polls and the model step's one."""
+    def poll_cost(self, n: int) -> int:
+        """Evaluations of a poll period in dimension ``n``: ``2n`` polls and
+        the model step's one."""
         return 2 * n + self.model_step
 
 
-class AdaptiveEncoding:
-    """A coordinate system learned from selected points (Hansen, PPSN 2008).
-
-    Each :meth:`update` takes the ``mu`` best points of a sample, best first.
-    Their weighted mean moves from the previous one; that step and the
-    points' offsets from the previous mean, each normalised to length
-    ``sqrt(n)`` in the current metric, update a covariance ``C`` (a rank-one
-    term from the evolution path of the mean's steps, a rank-``mu`` term
-    from the points). The basis is ``B = B_o D`` with ``C = B_o D^2 B_o^T``.
-    On a convex quadratic ``C`` approaches the inverse Hessian up to scale.
-
-    Parameters
-    ----------
-    n : int
-        Dimension.
-    mu : int
-        Points per update; they get CMA-ES's log-decreasing weights.
-    c_p, c_1, c_mu : float, optional
-        Learning rates of the path and the rank-one and rank-``mu`` terms;
-        defaults ``1/sqrt(n)``, ``0.5/n`` and ``0.5/n``, Adaptive
-        Coordinate Descent's (Loshchilov et al., GECCO 2011).
-
-    Examples
-    --------
-    >>> enc = AdaptiveEncoding(2, 2)
-    >>> enc.basis.tolist()
-    [[1.0, 0.0], [0.0, 1.0]]
-    """
-
-    def __init__(self, n: int, mu: int, *, c_p=None, c_1=None, c_mu=None):
-        self.n = n = integer(n, "n", 1)
-        mu = integer(mu, "mu", 1)
-        w = np.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
-        self.weights = w / w.sum()
-        self.c_p = 1.0 / math.sqrt(n) if c_p is None else positive(c_p, "c_p")
-        self.c_1 = 0.5 / n if c_1 is None else positive(c_1, "c_1")
-        self.c_mu = 0.5 / n if c_mu is None else positive(c_mu, "c_mu")
-        if self.c_p > 1.0 or self.c_1 + self.c_mu > 1.0:
-            raise ValueError("`c_p` and `c_1 + c_mu` must be at most 1")
-        self.covariance = np.eye(n)
-        self.basis = np.eye(n)
-        self._inverse = np.eye(n)
-        self.path = np.zeros(n)
-        self.mean = None
-        self.condition = 1.0
-
-    def _normalised(self, steps: np.ndarray) -> np.ndarray:
-        """Rows scaled to length sqrt(n) in the current metric (zero rows
-        stay zero)."""
-        lengths = np.linalg.norm(steps @ self._inverse.T, axis=1)
-        scale = np.divide(
-            math.sqrt(self.n), lengths, out=np.zeros_like(lengths), where=lengths > 0
-        )
-        return steps * scale[:, None]
-
-    def update(self, points) -> None:
-        """Learn from the ``mu`` best points of a sample, best first."""
-        x = np.asarray(points, dtype=np.float64)
-        if x.shape != (self.weights.size, self.n):
-            raise ValueError(
-                f"`points` must have shape ({self.weights.size}, {self.n}); "
-                f"got {x.shape}"
-            )
-        mean = self.weights @ x
-        if self.mean is None:
-            self.mean = mean
-            return
-        old = self.mean
-        self.mean = mean
-        c_p, c_1, c_mu = self.c_p, self.c_1, self.c_mu
-        z = self._normalised(np.vstack([mean - old, x - old]))
-        self.path = (1.0 - c_p) * self.path + math.sqrt(c_p * (2.0 - c_p)) * z[0]
-        rank_mu = (z[1:].T * self.weights) @ z[1:]
-        C = (1.0 - c_1 - c_mu) * self.covariance
-        C += c_1 * np.outer(self.path, self.path) + c_mu * rank_mu
-        C = 0.5 * (C + C.T)
-        values, vectors = np.linalg.eigh(C)
-        if not (np.all(np.isfinite(values)) and values[0] > 0.0):
-            # Rounding broke positive definiteness: keep the last metric.
-            self.condition = math.inf
-            return
-        self.covariance = C
-        d = np.sqrt(values)
-        self.basis = vectors * d
-        self._inverse = (vectors / d).T
-        self.condition = float(values[-1] / values[0])
+def default_population(n: int) -> int:
+    """The first population period's size: twice CMA-ES's default
+    ``4 + floor(3 ln n)``, as IPOP's first restart (even, for mirroring)."""
+    return 2 * (4 + int(3.0 * math.log(n)))
 
 
 class LearnedMetricSearch:
-    """The learned-metric poll you can step yourself; :func:`minimize`
-    drives one for a :class:`LearnedMetricSpiral`.
+    """The learned-metric search you can step yourself;
+    :func:`~spiralid.optim.minimize` drives one for a
+    :class:`LearnedMetricSpiral`.
 
     Constructing it draws ``n_points`` uniform points (``x0`` first),
-    evaluates them and takes the best as the centre. Each :meth:`step` is
-    one period: ``2n`` evaluations.
+    evaluates them and takes the best as the centre of a poll. Each
+    :meth:`step` is one period: ``2n`` evaluations and the model step's one
+    for a poll, ``lambda + 1`` for a population period.
 
     Parameters
     ----------
@@ -260,20 +202,22 @@ class LearnedMetricSearch:
             raise ValueError("`max_iter` is required when success_steps=False")
         n = self._lo.size
         m = integer(n_points, "n_points", 1)
-        seeds = seed_points(x0, self._lo, self._hi, m)
         self.nfev = 0
         self.nit = 0
         self.restarts = 0
-        self._archive = (None, math.inf)
+        self._best = (None, math.inf)
+        self._spent = {"poll": 0, "population": 0}
+        self._population = default_population(n) // 2
         self._polled = np.empty((2 * n, n))
         self._polled_f = np.empty(2 * n)
-        self._populate(seeds, m)
+        self._start_poll(seed_points(x0, self._lo, self._hi, m), m)
         self.initial_nonfinite = not math.isfinite(self._f)
         self.history = Trace(self.fun)
         self._mean_step = Trace()
 
     # -- evaluation ----------------------------------------------------------
     def _evaluate(self, x: np.ndarray) -> np.ndarray:
+        """Costs of the rows of `x`, non-finite as inf; keeps the best."""
         k = x.shape[0]
         if self.vectorized:
             out = check_costs(self._fun(x.copy()), (k,), self._batch_shape(x))
@@ -284,6 +228,9 @@ class LearnedMetricSearch:
                 out[i] = check_costs(self._fun(x[i].copy()), (), _SCALAR)
         self.nfev += k
         out[~np.isfinite(out)] = math.inf
+        best = int(np.argmin(out))
+        if out[best] < self._best[1] or self._best[0] is None:
+            self._best = (x[best].copy(), float(out[best]))
         return out
 
     def _evaluate_pair(self, pair: np.ndarray) -> tuple[float, float]:
@@ -296,18 +243,20 @@ class LearnedMetricSearch:
             a = float(check_costs(self._fun(pair[0].copy()), (), _SCALAR))
             b = float(check_costs(self._fun(pair[1].copy()), (), _SCALAR))
         self.nfev += 2
-        return (
-            a if math.isfinite(a) else math.inf,
-            b if math.isfinite(b) else math.inf,
-        )
+        a = a if math.isfinite(a) else math.inf
+        b = b if math.isfinite(b) else math.inf
+        if min(a, b) < self._best[1]:
+            self._best = (pair[0 if a <= b else 1].copy(), min(a, b))
+        return a, b
 
     @staticmethod
     def _batch_shape(x: np.ndarray) -> str:
         k, n = x.shape
         return f"shape ({k},) for a ({k}, {n}) batch when vectorized=True"
 
-    def _populate(self, seeds: np.ndarray, m: int) -> None:
-        """Start a run from the best of `m` points (`seeds` first)."""
+    # -- runs ------------------------------------------------------------------
+    def _start_poll(self, seeds: np.ndarray, m: int) -> None:
+        """Start a poll from the best of `m` points (`seeds` first)."""
         n = self._lo.size
         x = np.empty((m, n))
         k = seeds.shape[0]
@@ -319,49 +268,93 @@ class LearnedMetricSearch:
         self._f = float(f[best])
         self._steps = np.full(n, 0.25)
         self._encoding = AdaptiveEncoding(n, n)
-        self._run_start = self.nit
+        self._regime = "poll"
+        self._flat = False
         self._m = m
+        self._run_start = self.nit
+        self._run_nfev = self.nfev - m
+        self._run_best = self._f
+        self.last_move = self.nit
+
+    def _start_population(self, size: int) -> None:
+        """Start a population run of `size` points around a uniform centre."""
+        n = self._lo.size
+        u = self._rng.uniform(size=n)
+        self._c = self._lo + u * self._width
+        self._f = float(self._evaluate(self._c[None, :])[0])
+        self._lambda = size
+        self._sigma = _SIGMA0
+        self._path = np.zeros(n)
+        self._encoding = AdaptiveEncoding.for_population(n, size // 2)
+        self._regime = "population"
+        self._flat = False
+        self._run_start = self.nit
+        self._run_nfev = self.nfev - 1
+        self._run_best = self._f
         self.last_move = self.nit
 
     def restart(self, n_points: int, max_iter: int | None = None) -> None:
-        """Start a new run from the best of ``n_points`` fresh uniform points
-        with a fresh basis and steps; the best point so far stays :attr:`x`."""
+        """Start a new run: a poll from the best of ``n_points`` fresh
+        uniform points, or (with ``populations``) a population run when
+        those have spent fewer evaluations; the best point so far stays
+        :attr:`x`."""
         m = integer(n_points, "n_points", 1)
         if max_iter is not None:
             self._k_max = integer(max_iter, "max_iter", 1)
-        if self._f < self._archive[1]:
-            self._archive = (self.centre, self._f)
-        self._populate(np.empty((0, self._lo.size)), m)
+        self._spent[self._regime] += self.nfev - self._run_nfev
+        if self.rule.populations and self._spent["population"] <= self._spent["poll"]:
+            self._population *= 2
+            self._start_population(self._population)
+        else:
+            self._start_poll(np.empty((0, self._lo.size)), m)
         self.restarts += 1
         self.history.append(self.fun)
 
-    # -- the poll ------------------------------------------------------------
+    def next_step_cost(self) -> int:
+        """At most this many evaluations in the next :meth:`step`."""
+        if self._regime == "population":
+            return self._lambda + 1
+        return self.rule.poll_cost(self._lo.size)
+
+    # -- a period ----------------------------------------------------------------
     def step(self) -> tuple[np.ndarray, float]:
-        """One period: the ``n`` opposite pairs, the model step, then the
-        basis update."""
+        """One period of the current run's regime."""
+        if self._regime == "population":
+            self._generation()
+        else:
+            self._poll_period()
+        self.nit += 1
+        if self._best[1] < self._run_best:
+            self._run_best = self._best[1]
+            self.last_move = self.nit
+        self.history.append(self.fun)
+        self._mean_step.append(float(self._step_lengths().mean()))
+        return self.x, self.fun
+
+    def _poll_period(self) -> None:
+        """The ``n`` opposite pairs, the model step, the basis update."""
         rule = self.rule
         n = self._lo.size
         # Directions in the problem's coordinates, one per row.
         directions = (self._encoding.basis.T * self._steps[:, None]) * self._width
-        cost = self._f
         model = np.zeros(n)
         for j in range(n):
             success, model[j] = self._poll(j, directions[j])
             if rule.success_steps:
                 self._steps[j] *= rule.grow if success else rule.shrink
         if rule.model_step and np.any(model):
-            self._try(self._c + model @ directions)
+            trial = (self._c + model @ directions)[None, :]
+            if self.bounds_policy != "none":
+                apply_bounds(trial, self._lo, self._hi, self.bounds_policy)
+            cost = float(self._evaluate(trial)[0])
+            if cost < self._f:
+                self._c, self._f = trial[0], cost
         if not rule.success_steps:
             self._steps *= rule.delta ** (1.0 / self._k_max)
+        self._flat = bool(np.all(self._polled_f == self._polled_f[0]))
         if rule.basis:
             best = np.argsort(self._polled_f, kind="stable")[:n]
             self._encoding.update((self._polled[best] - self._lo) / self._width)
-        self.nit += 1
-        if self._f < cost:
-            self.last_move = self.nit
-        self.history.append(self.fun)
-        self._mean_step.append(float(self._step_lengths().mean()))
-        return self.x, self.fun
 
     def _poll(self, j: int, direction: np.ndarray) -> tuple[bool, float]:
         """Poll ``x* +- direction`` (step ``j`` of the period); move the
@@ -383,21 +376,54 @@ class LearnedMetricSearch:
             return False, vertex
         self._c = pair[side].copy()
         self._f = better
-        return True, vertex - (1.0 if side == 0 else -1.0) if vertex else 0.0
+        return True, (vertex - (1.0 if side == 0 else -1.0)) if vertex else 0.0
 
-    def _try(self, point: np.ndarray) -> None:
-        """Evaluate one point; it becomes the centre if it improves."""
-        trial = point[None, :]
+    def _generation(self) -> None:
+        """A population period: mirrored pairs ``x* +- sigma B z_l``, the
+        centre to the weighted mean of the best half, cumulative step-size
+        adaptation (Hansen's tutorial, 2016) and the basis update."""
+        n = self._lo.size
+        enc = self._encoding
+        half = self._lambda // 2
+        u_centre = (self._c - self._lo) / self._width
+        z = self._rng.standard_normal((half, n))
+        steps = self._sigma * (z @ enc.basis.T)
+        u = np.concatenate([u_centre + steps, u_centre - steps])
+        x = self._lo + u * self._width
         if self.bounds_policy != "none":
-            apply_bounds(trial, self._lo, self._hi, self.bounds_policy)
-        cost = float(self._evaluate(trial)[0])
-        if cost < self._f:
-            self._c, self._f = trial[0], cost
+            apply_bounds(x, self._lo, self._hi, self.bounds_policy)
+            u = (x - self._lo) / self._width
+        f = self._evaluate(x)
+        order = np.argsort(f, kind="stable")[: enc.weights.size]
+        selected = u[order]
+        # Selection among equal costs is blind: a plateau, as pycma's
+        # tolflatfitness.
+        self._flat = bool(f[order[0]] == f[order[-1]])
+        mean = enc.weights @ selected
+        mu_eff = 1.0 / float(np.sum(enc.weights**2))
+        c_s = (mu_eff + 2.0) / (n + mu_eff + 5.0)
+        d_s = 1.0 + 2.0 * max(0.0, math.sqrt((mu_eff - 1.0) / (n + 1.0)) - 1.0) + c_s
+        move = enc.inverse @ (mean - u_centre) / self._sigma
+        self._path = (1.0 - c_s) * self._path + math.sqrt(
+            c_s * (2.0 - c_s) * mu_eff
+        ) * move
+        chi_n = math.sqrt(n) * (1.0 - 1.0 / (4.0 * n) + 1.0 / (21.0 * n * n))
+        norm = float(np.linalg.norm(self._path))
+        enc.learn(
+            math.sqrt(mu_eff) * (mean - u_centre) / self._sigma,
+            (selected - u_centre) / self._sigma,
+            normalise=False,
+        )
+        self._sigma *= math.exp(min(1.0, c_s / d_s * (norm / chi_n - 1.0)))
+        self._c = self._lo + mean * self._width
+        self._f = float(self._evaluate(self._c[None, :])[0])
 
     def _step_lengths(self) -> np.ndarray:
         """Each direction's step length in the unit cube."""
-        return self._steps * np.linalg.norm(self._encoding.basis, axis=0)
+        scale = self._sigma if self._regime == "population" else self._steps
+        return scale * np.linalg.norm(self._encoding.basis, axis=0)
 
+    # -- the centre and its state ---------------------------------------------
     def move_centre(self, x, fun: float, nfev: int = 0) -> bool:
         """Replace the centre by `x` of cost `fun` if that is lower (as
         :meth:`spiralid.optim.SpiralSearch.move_centre`)."""
@@ -413,6 +439,8 @@ class LearnedMetricSearch:
             return False
         self._c = pt.copy()
         self._f = float(fun)
+        if self._f < self._best[1]:
+            self._best = (self._c.copy(), self._f)
         self.last_move = self.nit
         self.history.set_last(self.fun)
         return True
@@ -423,16 +451,21 @@ class LearnedMetricSearch:
         n = self._lo.size
         stall = max(30, 4 * n) if restarts.stall is None else restarts.stall
         return (
-            self.nit - self.last_move >= stall
+            self._flat
+            or self.nit - self.last_move >= stall
             or float(self._step_lengths().max()) <= restarts.tol_radius
             or self._encoding.condition > _MAX_CONDITION
         )
 
-    # -- state ---------------------------------------------------------------
     @property
     def n_points(self) -> int:
-        """Size of the current run's initial population: what IPOP grows."""
+        """Size of the current poll's initial population: what IPOP grows."""
         return self._m
+
+    @property
+    def regime(self) -> str:
+        """The current run's regime: ``"poll"`` or ``"population"``."""
+        return self._regime
 
     @property
     def centre(self) -> np.ndarray:
@@ -441,15 +474,13 @@ class LearnedMetricSearch:
 
     @property
     def x(self) -> np.ndarray:
-        """The best point so far: the centre, or an earlier run's best."""
-        if self._archive[1] < self._f:
-            return self._archive[0].copy()
-        return self.centre
+        """The best point evaluated so far."""
+        return self._best[0].copy()
 
     @property
     def fun(self) -> float:
-        """The cost of :attr:`x`."""
-        return min(self._f, self._archive[1])
+        """The cost of :attr:`x` (inf while no cost was finite)."""
+        return self._best[1]
 
     @property
     def basis(self) -> np.ndarray:
@@ -458,7 +489,7 @@ class LearnedMetricSearch:
 
     @property
     def steps(self) -> np.ndarray:
-        """Each direction's step ``s_j``."""
+        """Each poll direction's step ``s_j``."""
         return self._steps.copy()
 
     def result(self, status: str = "running", elapsed: float = 0.0, target=None):

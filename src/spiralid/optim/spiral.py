@@ -366,6 +366,10 @@ class SpiralSearch:
         """The current run's centre (row 0 of :attr:`population`)."""
         return self._x[0].copy()
 
+    def next_step_cost(self) -> int:
+        """Evaluations of the next :meth:`step`: every point but the centre."""
+        return self.n_points - 1
+
     @property
     def n_points(self) -> int:
         """Size of the current run's population."""
@@ -552,16 +556,12 @@ def minimize(
 
     rule = _parse_method(method)
     n = box_bounds(bounds)[0].size
-    if isinstance(rule, LearnedMetricSpiral):
-        Search = LearnedMetricSearch
+    learned = isinstance(rule, LearnedMetricSpiral)
+    Search = LearnedMetricSearch if learned else SpiralSearch
 
-        def per_step(m: int) -> int:
-            return rule.evaluations_per_period(n)
-    else:
-        Search = SpiralSearch
-
-        def per_step(m: int) -> int:
-            return m - 1  # the centre is not re-evaluated
+    def per_step(m: int) -> int:
+        # A step-rate rule's schedule spans the iterations a run can make.
+        return rule.poll_cost(n) if learned else m - 1
 
     def iterations_left(m: int, nit: int, nfev: int) -> int:
         # What the budget allows a population of m after nit iterations and
@@ -590,7 +590,7 @@ def minimize(
             status = "max_iter"
             break
         m = search.n_points
-        if max_nfev is not None and search.nfev + per_step(m) > max_nfev:
+        if max_nfev is not None and search.nfev + search.next_step_cost() > max_nfev:
             status = "max_nfev"
             break
         if restarts is not None and search.collapsed(restarts):

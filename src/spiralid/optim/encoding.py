@@ -1,0 +1,136 @@
+"""Adaptive Encoding: a coordinate system learned from selected points.
+
+Hansen, "Adaptive Encoding: How to render search coordinate system
+invariant", PPSN 2008. The learned-metric spiral (:mod:`spiralid.optim.learned`)
+polls its directions in this basis.
+"""
+
+import math
+
+import numpy as np
+
+from spiralid._checks import integer, positive
+
+__all__ = ["AdaptiveEncoding"]
+
+
+class AdaptiveEncoding:
+    """A coordinate system learned from selected points (Hansen, PPSN 2008).
+
+    Each :meth:`update` takes the ``mu`` best points of a sample, best first.
+    Their weighted mean moves from the previous one; that step and the
+    points' offsets from the previous mean, each normalised to length
+    ``sqrt(n)`` in the current metric, update a covariance ``C`` (a rank-one
+    term from the evolution path of the mean's steps, a rank-``mu`` term
+    from the points). The basis is ``B = B_o D`` with ``C = B_o D^2 B_o^T``.
+    On a convex quadratic ``C`` approaches the inverse Hessian up to scale.
+
+    Parameters
+    ----------
+    n : int
+        Dimension.
+    mu : int
+        Points per update; they get CMA-ES's log-decreasing weights.
+    c_p, c_1, c_mu : float, optional
+        Learning rates of the path and the rank-one and rank-``mu`` terms;
+        defaults ``1/sqrt(n)``, ``0.5/n`` and ``0.5/n``, Adaptive
+        Coordinate Descent's (Loshchilov et al., GECCO 2011), for a poll
+        of ``2n`` points; :meth:`for_population` gives CMA-ES's for a
+        sampled population.
+
+    Examples
+    --------
+    >>> enc = AdaptiveEncoding(2, 2)
+    >>> enc.basis.tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
+
+    def __init__(self, n: int, mu: int, *, c_p=None, c_1=None, c_mu=None):
+        self.n = n = integer(n, "n", 1)
+        mu = integer(mu, "mu", 1)
+        w = np.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
+        self.weights = w / w.sum()
+        self.c_p = 1.0 / math.sqrt(n) if c_p is None else positive(c_p, "c_p")
+        self.c_1 = 0.5 / n if c_1 is None else positive(c_1, "c_1")
+        self.c_mu = 0.5 / n if c_mu is None else positive(c_mu, "c_mu")
+        if self.c_p > 1.0 or self.c_1 + self.c_mu > 1.0:
+            raise ValueError("`c_p` and `c_1 + c_mu` must be at most 1")
+        self.covariance = np.eye(n)
+        self.basis = np.eye(n)
+        self._inverse = np.eye(n)
+        self.path = np.zeros(n)
+        self.mean = None
+        self.condition = 1.0
+
+    @classmethod
+    def for_population(cls, n: int, mu: int) -> "AdaptiveEncoding":
+        """The learning rates CMA-ES uses for ``mu`` selected points of a
+        sampled population (Hansen's tutorial, 2016, table 1)."""
+        enc = cls(n, mu)
+        mu_eff = 1.0 / float(np.sum(enc.weights**2))
+        enc.c_p = (4.0 + mu_eff / n) / (n + 4.0 + 2.0 * mu_eff / n)
+        enc.c_1 = 2.0 / ((n + 1.3) ** 2 + mu_eff)
+        enc.c_mu = min(
+            1.0 - enc.c_1,
+            2.0 * (mu_eff - 2.0 + 1.0 / mu_eff) / ((n + 2.0) ** 2 + mu_eff),
+        )
+        return enc
+
+    @property
+    def inverse(self) -> np.ndarray:
+        """``B^-1``."""
+        return self._inverse
+
+    def _normalised(self, steps: np.ndarray) -> np.ndarray:
+        """Rows scaled to length sqrt(n) in the current metric (zero rows
+        stay zero)."""
+        lengths = np.linalg.norm(steps @ self._inverse.T, axis=1)
+        scale = np.divide(
+            math.sqrt(self.n), lengths, out=np.zeros_like(lengths), where=lengths > 0
+        )
+        return steps * scale[:, None]
+
+    def update(self, points) -> None:
+        """Learn from the ``mu`` best points of a sample, best first."""
+        x = np.asarray(points, dtype=np.float64)
+        if x.shape != (self.weights.size, self.n):
+            raise ValueError(
+                f"`points` must have shape ({self.weights.size}, {self.n}); "
+                f"got {x.shape}"
+            )
+        mean = self.weights @ x
+        if self.mean is None:
+            self.mean = mean
+            return
+        old = self.mean
+        self.mean = mean
+        self.learn(mean - old, x - old)
+
+    def learn(self, shift, steps, *, normalise: bool = True) -> None:
+        """Update the metric from the mean's `shift` (the path's step) and
+        the selected `steps`, best first (the rank-``mu`` term).
+
+        With `normalise` (Adaptive Encoding), each is first scaled to length
+        ``sqrt(n)`` in the current metric, so only directions count;
+        without, they are taken as they are (CMA-ES's update, for steps
+        divided by the step size and a shift by ``sigma / sqrt(mu_eff)``).
+        """
+        c_p, c_1, c_mu = self.c_p, self.c_1, self.c_mu
+        z = np.vstack([shift, steps])
+        if normalise:
+            z = self._normalised(z)
+        self.path = (1.0 - c_p) * self.path + math.sqrt(c_p * (2.0 - c_p)) * z[0]
+        rank_mu = (z[1:].T * self.weights) @ z[1:]
+        C = (1.0 - c_1 - c_mu) * self.covariance
+        C += c_1 * np.outer(self.path, self.path) + c_mu * rank_mu
+        C = 0.5 * (C + C.T)
+        values, vectors = np.linalg.eigh(C)
+        if not (np.all(np.isfinite(values)) and values[0] > 0.0):
+            # Rounding broke positive definiteness: keep the last metric.
+            self.condition = math.inf
+            return
+        self.covariance = C
+        d = np.sqrt(values)
+        self.basis = vectors * d
+        self._inverse = (vectors / d).T
+        self.condition = float(values[-1] / values[0])
