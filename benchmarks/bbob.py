@@ -177,7 +177,7 @@ def _scipy_restarted(problem, objective, budget, rng, method, n_points):
     fun = _capped(problem, objective, budget)
     name = {"bfgs": "BFGS", "nelder-mead": "Nelder-Mead"}[method]
     try:
-        while True:
+        while problem.evaluations < budget and not problem.final_target_hit:
             x0 = rng.uniform(-4.0, 4.0, problem.dimension)
             left = budget - problem.evaluations
             options = {"maxiter": left} if name == "BFGS" else {"maxfev": left}
