@@ -1,0 +1,274 @@
+"""The learned-metric spiral (spiralid.optim.learned) and Adaptive Encoding.
+
+References are independent of the code: the Hessian of a quadratic (its
+eigenvectors and condition), the geometric sequences a success rule must
+follow, and the same search on a rotated copy of the problem.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.stats import special_ortho_group
+
+from spiralid.optim import (
+    RULES,
+    AdaptiveEncoding,
+    LearnedMetricSearch,
+    LearnedMetricSpiral,
+    Restarts,
+    SpiralSearch,
+    minimize,
+)
+
+
+def _quadratic(H):
+    return lambda x: float(x @ H @ x)
+
+
+def _rotated_ellipsoid(n, condition, seed):
+    Q = special_ortho_group.rvs(n, random_state=seed)
+    return Q @ np.diag(condition ** np.linspace(0.0, 1.0, n)) @ Q.T
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_learned_basis_recovers_the_axes_and_condition_of_a_rotated_ellipsoid(seed):
+    # B B^T approaches the inverse Hessian up to scale: same eigenvectors,
+    # same condition. Checked once the search has converged to 1e-6, i.e.
+    # when the metric has had to be learned (it starts as the identity).
+    H = _rotated_ellipsoid(6, 1e3, seed=3)
+    search = LearnedMetricSearch(
+        _quadratic(H), [(-5, 5)] * 6, LearnedMetricSpiral(), n_points=1, rng=seed
+    )
+    while search.fun > 1e-6:
+        search.step()
+        assert search.nit < 200
+    C = search.basis @ search.basis.T
+    values, vectors = np.linalg.eigh(C)
+    _, expected_vectors = np.linalg.eigh(np.linalg.inv(H))
+    cosines = np.abs(np.sum(vectors * expected_vectors, axis=0))
+    assert cosines.min() >= 0.85
+    condition = values[-1] / values[0]
+    assert 1e3 / 4 <= condition <= 1e3 * 4
+
+
+def test_steps_shrink_geometrically_at_a_minimum():
+    # At the minimum no poll improves: every step halves each period.
+    rule = LearnedMetricSpiral(basis=False, model_step=False)
+    search = LearnedMetricSearch(
+        lambda x: float(x @ x), [(-1, 1)] * 3, rule, n_points=1, x0=np.zeros(3)
+    )
+    for k in range(1, 8):
+        search.step()
+        np.testing.assert_array_equal(search.steps, 0.25 * 0.5**k)
+    assert search.fun == 0.0 and search.nfev == 1 + 7 * 6
+
+
+def test_steps_grow_geometrically_on_a_linear_slope():
+    # On a plane one side of every pair improves: every step doubles.
+    rule = LearnedMetricSpiral(basis=False, model_step=False)
+    slope = np.array([1.0, -2.0, 0.5])
+    search = LearnedMetricSearch(
+        lambda x: float(slope @ x), [(-1, 1)] * 3, rule, n_points=1, x0=np.zeros(3)
+    )
+    for k in range(1, 6):
+        search.step()
+        np.testing.assert_array_equal(search.steps, 0.25 * 2.0**k)
+    # Each coordinate moved down the slope by the sum of its steps (x2 for
+    # the box width of 2).
+    expected = -np.sign(slope) * 2.0 * 0.25 * (2.0**5 - 1.0)
+    np.testing.assert_allclose(search.x, expected)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_invariant_to_a_rotation_of_the_problem(seed):
+    # f(x) and f(Qx), f itself a rotated ellipsoid (condition 1e4, n = 8):
+    # the evaluations to reach 1e-10 agree within a factor of 1.5 (seen:
+    # 0.81 to 1.19).
+    A = _rotated_ellipsoid(8, 1e4, seed=5)
+    Q = special_ortho_group.rvs(8, random_state=100 + seed)
+    nfev = []
+    for H in (A, Q.T @ A @ Q):
+        res = minimize(
+            _quadratic(H),
+            [(-5, 5)] * 8,
+            "learned-metric",
+            n_points=2,
+            max_iter=10**6,
+            max_nfev=40_000,
+            target=1e-10,
+            rng=seed,
+        )
+        assert res.message == "Target cost reached."
+        nfev.append(res.nfev)
+    assert 1 / 1.5 <= nfev[1] / nfev[0] <= 1.5
+
+
+def test_an_ill_conditioned_quadratic_that_the_paper_rules_cannot_solve():
+    # Condition 1e6, rotated, n = 10, 10,000 evaluations: the learned metric
+    # reaches 1e-8; the periodic setting (the best paper-era rule on BBOB)
+    # stays orders of magnitude above.
+    H = _rotated_ellipsoid(10, 1e6, seed=1)
+    learned = minimize(
+        _quadratic(H), [(-5, 5)] * 10, "learned-metric", max_nfev=10_000, rng=0
+    )
+    periodic = minimize(
+        _quadratic(H), [(-5, 5)] * 10, "periodic", max_nfev=10_000, rng=0
+    )
+    assert learned.fun < 1e-8
+    assert periodic.fun > 1e3 * learned.fun
+
+
+def test_plugs_into_minimize_like_every_rule():
+    H = _rotated_ellipsoid(4, 1e2, seed=2)
+    seen = []
+    res = minimize(
+        _quadratic(H),
+        [(-5, 5)] * 4,
+        LearnedMetricSpiral(),
+        max_nfev=1000,
+        rng=7,
+        callback=lambda r: seen.append(r.nfev) and False,
+    )
+    assert res.status == 1 and res.nfev <= 1000 and res.nit == len(seen)
+    assert res.history.size == res.nit + 1
+    assert np.all(np.diff(res.history) <= 0.0)
+    assert res.fun == pytest.approx(_quadratic(H)(res.x), abs=0.0)
+    assert np.all(np.isnan(res.mean_angle)) and res.mean_radius.size == res.nit
+    again = minimize(
+        _quadratic(H), [(-5, 5)] * 4, LearnedMetricSpiral(), max_nfev=1000, rng=7
+    )
+    np.testing.assert_array_equal(again.x, res.x)
+    assert again.fun == res.fun
+    assert isinstance(RULES["learned-metric"](), LearnedMetricSpiral)
+
+
+def test_vectorized_and_scalar_objectives_give_the_same_run():
+    H = _rotated_ellipsoid(5, 1e3, seed=4)
+
+    def batch(X):
+        return np.einsum("ij,jk,ik->i", X, H, X)
+
+    runs = [
+        minimize(
+            fun, [(-5, 5)] * 5, "learned-metric", max_nfev=3000, rng=1, vectorized=v
+        )
+        for fun, v in ((lambda x: float(batch(x[None])[0]), False), (batch, True))
+    ]
+    assert runs[0].nfev == runs[1].nfev
+    np.testing.assert_array_equal(runs[0].x, runs[1].x)
+
+
+@pytest.mark.parametrize("policy", ["clip", "reflect"])
+def test_bounds_policy_keeps_every_evaluated_point_in_the_box(policy):
+    seen = []
+
+    def fun(x):
+        seen.append(x.copy())
+        return float(np.sum((x - 4.9) ** 2))  # the minimum near a corner
+
+    minimize(
+        fun,
+        [(-5, 5)] * 3,
+        "learned-metric",
+        max_nfev=600,
+        rng=0,
+        bounds_policy=policy,
+        restarts=True,
+    )
+    pts = np.array(seen)
+    assert pts.min() >= -5.0 and pts.max() <= 5.0
+
+
+def test_restarts_alternate_polls_and_population_periods():
+    # Rastrigin: polls stop in local minima, so restarts come; the
+    # population regime must get its share of the budget.
+    def rastrigin(x):
+        return float(10 * x.size + np.sum(x**2 - 10 * np.cos(2 * np.pi * x)))
+
+    regimes = []
+
+    def hook(search):
+        regimes.append(search.regime)
+
+    res = minimize(
+        rastrigin,
+        [(-5, 5)] * 5,
+        "learned-metric",
+        max_nfev=20_000,
+        rng=3,
+        restarts=Restarts(),
+        on_iteration=hook,
+    )
+    assert res.n_restarts >= 2
+    assert {"poll", "population"} <= set(regimes)
+    assert res.nfev <= 20_000
+    assert res.fun < 5.0  # the population regime finds a deep basin
+
+
+def test_non_finite_costs_rank_worst_and_never_become_the_best():
+    def fun(x):
+        return math.nan if x[0] > 0 else float(x @ x)
+
+    res = minimize(fun, [(-5, 5)] * 2, "learned-metric", max_nfev=400, rng=0)
+    assert math.isfinite(res.fun) and res.x[0] <= 0
+
+
+def test_x0_seeds_the_first_poll():
+    res = minimize(
+        lambda x: float(x @ x),
+        [(-5, 5)] * 3,
+        "learned-metric",
+        x0=np.zeros(3),
+        max_nfev=100,
+        rng=0,
+    )
+    assert res.fun == 0.0 and res.history[0] == 0.0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"grow": 1.0}, "`grow` must be > 1"),
+        ({"shrink": 1.5}, r"`shrink` must be in \(0, 1\)"),
+        ({"delta": 0.0}, "`delta`"),
+        ({"basis": "yes"}, "`basis` must be True or False"),
+        ({"populations": 1}, "`populations` must be True or False"),
+    ],
+)
+def test_bad_settings_are_named(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        LearnedMetricSpiral(**kwargs)
+
+
+def test_a_spiral_population_refuses_the_learned_rule():
+    with pytest.raises(ValueError, match="LearnedMetricSearch"):
+        SpiralSearch(lambda x: 0.0, [(-1, 1)] * 2, LearnedMetricSpiral())
+
+
+def test_scheduled_steps_need_the_budget():
+    with pytest.raises(ValueError, match="`max_iter` is required"):
+        LearnedMetricSearch(
+            lambda x: 0.0, [(-1, 1)] * 2, LearnedMetricSpiral(success_steps=False)
+        )
+    rule = LearnedMetricSpiral(success_steps=False, basis=False)
+    res = minimize(lambda x: float(x @ x), [(-1, 1)] * 2, rule, max_iter=50, rng=0)
+    # The periodic setting's schedule: every step shrinks by
+    # delta^(1/k_max) per period, delta over the 50 periods.
+    assert res.nit == 50
+    np.testing.assert_allclose(
+        res.mean_radius, 0.25 * 1e-3 ** (np.arange(1, 51) / 50), rtol=1e-12
+    )
+
+
+def test_adaptive_encoding_checks_its_input_and_keeps_a_valid_metric():
+    enc = AdaptiveEncoding(3, 2)
+    with pytest.raises(ValueError, match=r"`points` must have shape \(2, 3\)"):
+        enc.update(np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="`mu` must be an integer"):
+        AdaptiveEncoding(3, 0)
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        enc.update(rng.normal(size=(2, 3)))
+    np.testing.assert_allclose(enc.basis @ enc.inverse, np.eye(3), atol=1e-10)
+    assert enc.condition >= 1.0
