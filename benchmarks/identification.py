@@ -29,6 +29,19 @@ points):
 - ``modal+VP+memetic``: Levenberg-Marquardt polish of the centre every 5
   iterations (10 evaluations each).
 - ``spiral (no gradient)``: restarts and safe starts, no polish.
+- ``Eb-SDA+fseed (no gradient)``: ``spiral``'s search (Eb-SDA, restarts
+  after 20 stalled iterations) with 25 first points at the frequency
+  response's peaks, no polish and no safe start: the comparison for the
+  learned-metric rows below.
+- ``learned-metric (modal+VP)``: the learned-metric spiral
+  (``spiralid.optim.LearnedMetricSpiral``) over the modal coordinates,
+  numerator projected out, with its restarts (polls and population
+  periods); nothing else.
+- ``learned-metric (no gradient)``: ``spiral``'s search with the
+  learned-metric rule, restarts after 20 stalled periods, no polish and no
+  safe start (no least-squares or Steiglitz-McBride model anywhere).
+- ``learned-metric+fseed (no gradient)``: the same with 25 first points at
+  the frequency response's peaks (the best of them starts the first poll).
 - ``spiral``: the recommended method, ``identify(method="spiral")`` at its
   default budget of 10,000 evaluations: Eb-SDA, modal, VP, memetic,
   restarts, safe starts.
@@ -293,6 +306,32 @@ METHODS = {
         False,
     ),
     "spiral (no gradient)": (_identify("spiral", polish_every=None), False, False),
+    "Eb-SDA+fseed (no gradient)": (
+        _identify("spiral", polish_every=None, safe_start=False, frequency_seeds=25),
+        False,
+        False,
+    ),
+    "learned-metric (modal+VP)": (
+        _identify("learned-metric", "modal", restarts=True),
+        False,
+        False,
+    ),
+    "learned-metric (no gradient)": (
+        _identify("spiral", rule="learned-metric", polish_every=None, safe_start=False),
+        False,
+        False,
+    ),
+    "learned-metric+fseed (no gradient)": (
+        _identify(
+            "spiral",
+            rule="learned-metric",
+            polish_every=None,
+            safe_start=False,
+            frequency_seeds=25,
+        ),
+        False,
+        False,
+    ),
     "spiral": (_identify("spiral", budget_cap=10_000), True, False),
     "DE": (_paper("de"), False, False),
     "CMA-ES": (_cma_coefficients, False, False),
