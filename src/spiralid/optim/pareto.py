@@ -204,6 +204,7 @@ def minimize_pareto(
     rng=None,
     vectorized: bool = False,
     callback: Callable | None = None,
+    x0=None,
 ) -> OptimiserResult:
     """Approximate the Pareto front of a vector objective by a spiral search.
 
@@ -235,6 +236,11 @@ def minimize_pareto(
     callback : callable, optional
         ``callback(intermediate)`` after every iteration with the result so
         far; returning True stops the search.
+    x0 : array_like, shape (q, n) or (n,), optional
+        Known points (e.g. a single-objective estimate) that take the place
+        of the first ``q`` uniform draws of the initial population (clipped
+        into the box; at most the population size). The draws are made
+        anyway, so a seed changes nothing else.
 
     Returns
     -------
@@ -276,6 +282,14 @@ def minimize_pareto(
     n = lo.size
 
     x = gen.uniform(lo, hi, size=(m, n))
+    if x0 is not None:
+        seeds = np.atleast_2d(np.asarray(x0, dtype=float))
+        if seeds.ndim != 2 or seeds.shape[1] != n or not np.all(np.isfinite(seeds)):
+            raise ValueError(
+                f"`x0` must be finite points of shape (q, {n}); got shape {seeds.shape}"
+            )
+        q = min(seeds.shape[0], m)
+        x[:q] = np.clip(seeds[:q], lo, hi)
     f = _evaluate(fun, x, bool(vectorized), None)
     k = f.shape[1]
     if k not in (2, 3):
