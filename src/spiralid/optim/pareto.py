@@ -171,7 +171,14 @@ def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray
     if vectorized:
         f = np.asarray(fun(x.copy()), dtype=float)
     else:
-        f = np.array([np.asarray(fun(row.copy()), dtype=float) for row in x])
+        rows = [np.asarray(fun(row.copy()), dtype=float) for row in x]
+        shapes = {r.shape for r in rows}
+        if len(shapes) != 1:
+            raise ValueError(
+                "`fun` must return the same number of objectives for every "
+                f"point; got shapes {sorted(shapes)}"
+            )
+        f = np.array(rows)
     if f.ndim != 2 or f.shape[0] != x.shape[0] or (k is not None and f.shape[1] != k):
         want = f"({x.shape[0]}, {'k' if k is None else k})"
         raise ValueError(

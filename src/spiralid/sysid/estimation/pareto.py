@@ -35,9 +35,14 @@ least-squares, Steiglitz-McBride and output-error (``identify(method="oe")``)
 estimates of each order into the first population, mapped into the searched
 coordinates, and keeps them among the final candidates, so the front's
 ``"cost"`` end is never above output error's (where the parametrisation
-represents its denominator) and a weak search cannot lose it. Which
-candidate each front model came from is its ``result.start``
-(``"search"``, ``"ls"``, ``"steiglitz-mcbride"`` or ``"oe"``).
+represents its denominator) and a weak search cannot lose it. The search's
+candidates are the non-dominated set of every iteration's incumbents (an
+incumbent that a neighbour replaced can still be on the front). Then each
+searched objective's best candidate is polished on that objective alone by
+L-BFGS-B in the box (``polish_nfev`` evaluations each, 0 for none) and
+joins the candidates. Which candidate each front model came from is its
+``result.start`` (``"search"``, ``"polish"``, ``"ls"``,
+``"steiglitz-mcbride"`` or ``"oe"``); every evaluation counts in ``nfev``.
 
 Knee
 ----
@@ -58,7 +63,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from spiralid._checks import generator
+from spiralid._checks import generator, integer
 from spiralid.optim.pareto import minimize_pareto, non_dominated
 
 from ..data import IOData
@@ -339,6 +344,68 @@ def _candidates(par, cost: PaperCost):
     return plain
 
 
+class _Archive:
+    """The non-dominated set of every iteration's incumbents (a MOEA/D
+    incumbent that a neighbour replaces can still be on the front)."""
+
+    def __init__(self) -> None:
+        self.x: np.ndarray | None = None
+        self.f: np.ndarray | None = None
+
+    def add(self, intermediate) -> bool:
+        x, f = np.asarray(intermediate.x), np.asarray(intermediate.fun)
+        if self.x is not None:
+            x, f = np.concatenate([self.x, x]), np.concatenate([self.f, f])
+        keep = non_dominated(f)
+        self.x, self.f = x[keep], f[keep]
+        return False
+
+
+def _objective_function(par, cost: PaperCost, error: FrequencyError, searched, gain):
+    """``x -> (theta, objectives)`` for a population of searched points, the
+    columns in the order of `searched`; an unstable candidate pays the
+    cost's penalty in every objective."""
+    candidates = _candidates(par, cost)
+    one_step = (
+        PaperCost(cost.arx, cost.data, "one-step", gain=gain, penalty=cost.penalty)
+        if "one-step" in searched
+        else None
+    )
+
+    def evaluate(x):
+        theta, f_cost = candidates(np.atleast_2d(x))
+        extra = np.where(cost.stable(theta), 0.0, cost.penalty)
+        columns = {"cost": f_cost}
+        if "frequency" in searched:
+            columns["frequency"] = error(theta) + extra
+        if one_step is not None:
+            columns["one-step"] = one_step(theta)
+        return theta, np.column_stack([columns[n] for n in searched])
+
+    return evaluate
+
+
+def _polish_extremes(evaluate, archive: _Archive, box: np.ndarray, budget: int):
+    """Each objective's best archived point polished on that objective alone
+    by L-BFGS-B in the box (finite-difference gradient, at most `budget`
+    evaluations each); returns the polished points and the evaluations."""
+    from scipy.optimize import minimize
+
+    points, used = [], 0
+    for j in range(archive.f.shape[1]):
+        start = archive.x[int(np.argmin(archive.f[:, j]))]
+        res = minimize(
+            lambda x, j=j: float(evaluate(x)[1][0, j]),
+            start,
+            method="L-BFGS-B",
+            bounds=box,
+            options={"maxfun": budget},
+        )
+        points.append(np.clip(res.x, box[:, 0], box[:, 1]))
+        used += int(res.nfev)
+    return np.array(points), used
+
+
 def identify_pareto(
     data: IOData,
     orders,
@@ -351,6 +418,7 @@ def identify_pareto(
     nk: int = 0,
     parametrization: str = "modal",
     seed_estimates: bool = True,
+    polish_nfev: int = 200,
     initial: str = "rest",
     gain: str | float = "auto",
     penalty: float = 1e6,
@@ -392,6 +460,8 @@ def identify_pareto(
         Seed each search with the least-squares, Steiglitz-McBride and
         output-error estimates and keep them among the candidates (module
         docstring).
+    polish_nfev : int, default 200
+        Budget of each extreme's polish (module docstring); 0: no polish.
     initial : {"rest", "measured"}
         Initial condition of the simulation error (see ``identify``).
     gain, penalty
@@ -434,6 +504,7 @@ def identify_pareto(
         raise ValueError(
             f"`seed_estimates` must be True or False; got {seed_estimates!r}"
         )
+    polish_nfev = integer(polish_nfev, "polish_nfev", 0)
     if isinstance(method, str):
         method = method.lower()
     gen = generator(rng)
@@ -449,31 +520,13 @@ def identify_pareto(
         arx.check_length(data)
         par = make_parametrization(parametrization, data, arx)
         cost = PaperCost(arx, data, gain=gain, penalty=penalty, initial=initial)
-        candidates = _candidates(par, cost)
-        error = FrequencyError(arx, estimate)
-        one_step = (
-            PaperCost(arx, data, "one-step", gain=gain, penalty=penalty)
-            if "one-step" in names
-            else None
+        evaluate = _objective_function(
+            par, cost, FrequencyError(arx, estimate), searched, gain
         )
-
-        def evaluate(
-            x, candidates=candidates, error=error, one_step=one_step, cost=cost
-        ):
-            theta, f_cost = candidates(x)
-            unstable = ~np.asarray(cost.stable(theta), bool)
-            columns = {"cost": f_cost}
-            if "frequency" in searched:
-                columns["frequency"] = error(theta) + np.where(
-                    unstable, cost.penalty, 0.0
-                )
-            if one_step is not None:
-                columns["one-step"] = one_step(theta)
-            return theta, np.column_stack([columns[n] for n in searched])
-
         box = par.default_bounds()
         seeds = _seed_thetas(data, arx, par, initial) if seed_estimates else {}
         x0 = np.array([par.from_theta(t) for t in seeds.values()]) if seeds else None
+        archive = _Archive()
         res = minimize_pareto(
             lambda x, evaluate=evaluate: evaluate(x)[1],
             box,
@@ -484,17 +537,26 @@ def identify_pareto(
             rng=gen,
             vectorized=True,
             x0=x0,
+            callback=archive.add,
         )
+        archive.add(res)
         nfev += res.nfev
         label = str(arx)
         histories[label] = np.asarray(res.history)
         meta[label] = (res, cost, box)
-        points = [(res.x, ["search"] * res.x.shape[0])]
-        if x0 is not None:
-            points.append((np.clip(x0, box[:, 0], box[:, 1]), list(seeds)))
-            nfev += x0.shape[0]
+        # Seeds first: of exact twins the first is kept, with its origin.
+        points = (
+            [] if x0 is None else [(np.clip(x0, box[:, 0], box[:, 1]), list(seeds))]
+        )
+        points.append((archive.x, ["search"] * archive.x.shape[0]))
+        if polish_nfev:
+            polished, used = _polish_extremes(evaluate, archive, box, polish_nfev)
+            points.append((polished, ["polish"] * polished.shape[0]))
+            nfev += used
         for x, origin in points:
+            # Evaluated again for their theta (counted).
             theta, f = evaluate(x)
+            nfev += x.shape[0]
             thetas.extend(theta)
             rows.extend(f)
             starts.extend(origin)
