@@ -9,6 +9,9 @@ from spiralid.sysid.estimation.pareto import OBJECTIVES, ParetoIdentification
 
 __all__ = ["front_figure"]
 
+# Fronts up to this size have every point numbered.
+_LABELLED = 60
+
 
 def front_figure(front: ParetoIdentification, chosen: int | None = None) -> Figure:
     """The front in its first two objectives, a third as the colour.
@@ -23,7 +26,8 @@ def front_figure(front: ParetoIdentification, chosen: int | None = None) -> Figu
     Returns
     -------
     matplotlib.figure.Figure
-        Every point numbered as its ``point-<i>`` folder; the knee a star.
+        Points numbered as their ``point-<i>`` folders (fronts of up to 60
+        points); the knee a star.
     """
     f = front.objectives
     names = front.names
@@ -35,7 +39,8 @@ def front_figure(front: ParetoIdentification, chosen: int | None = None) -> Figu
         fig.colorbar(dots, ax=ax, label=OBJECTIVES[names[2]])
     else:
         ax.plot(x, y, "o-", color="tab:blue", ms=6, lw=0.8, zorder=2)
-    for i, (a, b) in enumerate(zip(x, y, strict=True)):
+    # Numbered as the point-<i> folders, while the numbers stay legible.
+    for i, (a, b) in enumerate(zip(x, y, strict=True) if len(x) <= _LABELLED else ()):
         ax.annotate(
             str(i), (a, b), textcoords="offset points", xytext=(4, 4), fontsize=7
         )
