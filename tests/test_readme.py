@@ -48,3 +48,31 @@ def test_readme_own_data_commands_run(tmp_path):
     assert (tmp_path / "rig-val" / "validation.json").is_file()
     fit = json.loads((tmp_path / "rig-val" / "validation.json").read_text())
     assert fit["fit_percent"] > 50
+
+
+def test_readme_pareto_example_runs(monkeypatch, tmp_path, capsys):
+    text = (ROOT / "README.md").read_text()
+    block = re.search(
+        r"<!-- pareto-example -->\n```python\n(.*?)```", text, flags=re.S
+    ).group(1)
+    monkeypatch.chdir(tmp_path)
+    exec(compile(block, "README.md", "exec"), {})
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith("('cost', 'frequency', 'order')")
+    # The knee and the choice validate as the comments say (within a point).
+    assert abs(float(lines[1].split()[-1]) - 89.6) <= 1.0
+    assert abs(float(lines[2].split()[-1]) - 91.2) <= 1.0
+
+
+def test_readme_pareto_command_runs(tmp_path):
+    from clitools import run
+
+    text = (ROOT / "README.md").read_text()
+    block = re.search(r"<!-- pareto-commands -->\n```\n(.*?)```", text, flags=re.S)
+    command = block.group(1).strip().split()
+    assert command[0] == "spiralid"
+    proc = run(*command[1:], cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / command[command.index("--out") + 1]
+    assert (out / "front.csv").is_file() and (out / "point-0" / "model.json").is_file()
+    assert json.loads((out / "validation.json").read_text())["validation"]

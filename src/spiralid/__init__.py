@@ -29,6 +29,7 @@ _NAMES = {
     "arx_least_squares": "sysid",
     "steiglitz_mcbride": "sysid",
     "identify": "sysid",
+    "identify_pareto": "sysid",
     "validate": "sysid",
 }
 __all__ = ["__version__", *_SUBPACKAGES, *_NAMES]

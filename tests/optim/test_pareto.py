@@ -114,3 +114,53 @@ def test_a_bad_objective_is_a_clear_error(fun, match):
 def test_step_rate_rules_are_refused():
     with pytest.raises(ValueError, match="`method` must be a rule that sets"):
         minimize_pareto(_zdt1, [(0, 1)] * 2, "periodic", n_points=10, max_nfev=40)
+
+
+def _later(bad):
+    """An objective that turns bad after the first population."""
+    calls = []
+
+    def fun(x):
+        calls.append(1)
+        f = np.column_stack([x[:, 0], 1 - x[:, 0]])
+        return bad(f) if len(calls) > 1 else f
+
+    return fun
+
+
+@pytest.mark.parametrize(
+    "bad, match",
+    [
+        (lambda f: np.where(f > 0.5, np.nan, f), "non-finite objective"),
+        (lambda f: np.column_stack([f, f[:, :1]]), r"must return \(10, 2\)"),
+        (lambda f: f[:, :1], r"must return \(10, 2\)"),
+    ],
+)
+def test_an_objective_that_turns_bad_later_is_a_clear_error(bad, match):
+    with pytest.raises(ValueError, match=match):
+        minimize_pareto(_later(bad), [(0, 1)] * 2, n_points=10, max_nfev=40,
+                        rng=0, vectorized=True)  # fmt: skip
+
+
+def test_a_point_wise_objective_of_varying_length_is_a_clear_error():
+    def fun(x):
+        return [x[0], 1 - x[0]] if x[0] < 0.5 else [x[0], 1 - x[0], 0.0]
+
+    with pytest.raises(ValueError, match="`fun` must return"):
+        minimize_pareto(fun, [(0, 1)] * 2, n_points=10, max_nfev=40, rng=0)
+
+
+def test_seed_points_take_the_first_places_of_the_population():
+    seen = []
+
+    def fun(x):
+        seen.append(x.copy())
+        return np.column_stack([x[:, 0], 1 - x[:, 0]])
+
+    seeds = [[0.25, 0.5], [2.0, 0.5]]  # the second is clipped into the box
+    minimize_pareto(fun, [(0, 1)] * 2, n_points=10, max_nfev=40, rng=0,
+                    vectorized=True, x0=seeds)  # fmt: skip
+    np.testing.assert_array_equal(seen[0][:2], [[0.25, 0.5], [1.0, 0.5]])
+    with pytest.raises(ValueError, match="`x0`"):
+        minimize_pareto(fun, [(0, 1)] * 2, n_points=10, max_nfev=40,
+                        vectorized=True, x0=[[0.1, 0.2, 0.3]])  # fmt: skip

@@ -1,5 +1,5 @@
-"""The ``spiralid`` command: simulate the rig, identify, validate, reproduce,
-study.
+"""The ``spiralid`` command: simulate the rig, identify (one model or a
+Pareto front), validate, reproduce, study.
 
 Every subcommand has ``--help``. Bad arguments and bad input end with exit
 status 2 and a one-line ``spiralid <command>: error: ...`` message on
@@ -22,7 +22,7 @@ import sys
 import warnings
 from contextlib import contextmanager
 
-from . import identify, reproduce, simulate, study, validate
+from . import identify, pareto, reproduce, simulate, study, validate
 from .errors import (
     _Parser,
     _show_warnings,
@@ -35,7 +35,7 @@ from .errors import (
 __all__ = ["build_parser", "main"]
 
 # In the order `spiralid --help` lists them.
-_SUBCOMMANDS = (simulate, identify, validate, reproduce, study)
+_SUBCOMMANDS = (simulate, identify, pareto, validate, reproduce, study)
 
 
 def build_parser() -> argparse.ArgumentParser:

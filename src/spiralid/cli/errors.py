@@ -88,6 +88,10 @@ _USER_WORDS = {
     "duration": "--duration",
     "fs": "--fs",
     "lags": "the number of residual-test lags (25)",
+    "orders": "--orders",
+    "objectives": "--objectives",
+    "polish_nfev": "--polish",
+    "min_coherence": "--min-coherence",
 }
 
 

@@ -138,6 +138,20 @@ def _write_model(staged, model, v_est, v_val, headline: str) -> str:
     return summary
 
 
+def write_arx_model(staged, model, est, val, label: str, headline: str) -> str:
+    """An ARX model validated on both parts of the record, written as
+    ``spiralid identify`` writes it (:func:`_write_model` and the
+    estimation and validation figures); returns the summary."""
+    from spiralid.sysid import validate
+
+    v_est = validate(model, est, label=f"{label} (estimation)")
+    v_val = validate(model, val, warmup=est, label=f"{label} (validation)")
+    summary = _write_model(staged, model, v_est, v_val, headline)
+    _save_figures(v_val.plot(), staged, "validation_")
+    _save_figures(v_est.plot(), staged, "estimation_")
+    return summary
+
+
 # The options only a search takes.
 _SEARCH_FLAGS = ("--points", "--iterations", "--budget", "--seed", "--parametrization")
 
@@ -148,7 +162,7 @@ def _given(argv: list[str], flag: str) -> bool:
 
 
 def run(args, argv: list[str]) -> int:
-    from spiralid.sysid import METHODS, identify, validate
+    from spiralid.sysid import METHODS, identify
     from spiralid.sysid.validation.plots import plot_convergence
 
     if args.model != "arx":
@@ -192,14 +206,10 @@ def run(args, argv: list[str]) -> int:
             rng=args.seed,
             **options,
         )
-        v_est = validate(model, est, label=f"{args.method} (estimation)")
-        v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
         staged = folder.path
         model.fraction = args.fraction
         headline = f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}"
-        summary = _write_model(staged, model, v_est, v_val, headline)
-        _save_figures(v_val.plot(), staged, "validation_")
-        _save_figures(v_est.plot(), staged, "estimation_")
+        summary = write_arx_model(staged, model, est, val, args.method, headline)
         if model.history is not None:
             plot_convergence(
                 {args.method: model.history},

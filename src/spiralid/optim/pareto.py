@@ -171,7 +171,14 @@ def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray
     if vectorized:
         f = np.asarray(fun(x.copy()), dtype=float)
     else:
-        f = np.array([np.asarray(fun(row.copy()), dtype=float) for row in x])
+        rows = [np.asarray(fun(row.copy()), dtype=float) for row in x]
+        shapes = {r.shape for r in rows}
+        if len(shapes) != 1:
+            raise ValueError(
+                "`fun` must return the same number of objectives for every "
+                f"point; got shapes {sorted(shapes)}"
+            )
+        f = np.array(rows)
     if f.ndim != 2 or f.shape[0] != x.shape[0] or (k is not None and f.shape[1] != k):
         want = f"({x.shape[0]}, {'k' if k is None else k})"
         raise ValueError(
@@ -204,6 +211,7 @@ def minimize_pareto(
     rng=None,
     vectorized: bool = False,
     callback: Callable | None = None,
+    x0=None,
 ) -> OptimiserResult:
     """Approximate the Pareto front of a vector objective by a spiral search.
 
@@ -235,6 +243,11 @@ def minimize_pareto(
     callback : callable, optional
         ``callback(intermediate)`` after every iteration with the result so
         far; returning True stops the search.
+    x0 : array_like, shape (q, n) or (n,), optional
+        Known points (e.g. a single-objective estimate) that take the place
+        of the first ``q`` uniform draws of the initial population (clipped
+        into the box; at most the population size). The draws are made
+        anyway, so a seed changes nothing else.
 
     Returns
     -------
@@ -276,6 +289,14 @@ def minimize_pareto(
     n = lo.size
 
     x = gen.uniform(lo, hi, size=(m, n))
+    if x0 is not None:
+        seeds = np.atleast_2d(np.asarray(x0, dtype=float))
+        if seeds.ndim != 2 or seeds.shape[1] != n or not np.all(np.isfinite(seeds)):
+            raise ValueError(
+                f"`x0` must be finite points of shape (q, {n}); got shape {seeds.shape}"
+            )
+        q = min(seeds.shape[0], m)
+        x[:q] = np.clip(seeds[:q], lo, hi)
     f = _evaluate(fun, x, bool(vectorized), None)
     k = f.shape[1]
     if k not in (2, 3):

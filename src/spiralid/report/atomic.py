@@ -188,6 +188,18 @@ def _remove_empty(folders: list[Path]) -> None:
             d.rmdir()
 
 
+def _replace(source: Path, target: Path) -> None:
+    """Move `source` onto `target`; a folder onto an existing folder is
+    merged file by file (the files written replace those of the same name,
+    nothing else in it is touched), as the target folder itself is."""
+    if source.is_dir() and target.is_dir() and not target.is_symlink():
+        for child in sorted(source.iterdir()):
+            _replace(child, target / child.name)
+        source.rmdir()
+        return
+    os.replace(source, target)
+
+
 class _Lock:
     """An exclusive ``flock`` on a file beside the target, removed on release.
 
@@ -371,7 +383,7 @@ class OutputFolder(_Staged):
                     os.rename(self.path, t)
                 else:
                     for name in names:
-                        os.replace(self.path / name, t / name)
+                        _replace(self.path / name, t / name)
             except OSError as exc:
                 raise OutputError(
                     f"cannot move the results into {str(t)!r}: {_why(exc)}"

@@ -13,6 +13,10 @@ from .estimation.identify import identify as identify
 from .estimation.outputerror import steiglitz_mcbride as steiglitz_mcbride
 from .estimation.parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
 from .estimation.parametrizations import default_bounds as default_bounds
+from .estimation.pareto import ParetoIdentification as ParetoIdentification
+from .estimation.pareto import choose as choose
+from .estimation.pareto import identify_pareto as identify_pareto
+from .estimation.pareto import knee_point as knee_point
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.identified import IdentifiedModel as IdentifiedModel

@@ -1,0 +1,239 @@
+"""``spiralid pareto``: a Pareto front of ARX models, the knee validated."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+
+from .errors import UsageError
+from .identify import _given, write_arx_model
+from .options import (
+    _add_data_options,
+    _add_detrend_option,
+    _detrended,
+    _fraction,
+    _HelpFormatter,
+    _listing,
+    _load_data,
+    _nonneg_float,
+    _nonneg_int,
+    _open_folder,
+    _positive_int,
+)
+
+
+def _orders(text: str) -> list[int]:
+    """``2:12`` (both ends included) or ``2,4,8``."""
+    try:
+        if ":" in text:
+            lo, hi = (int(v) for v in text.split(":"))
+            values = list(range(lo, hi + 1))
+        else:
+            values = [int(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if not values or min(values) < 1 or len(set(values)) != len(values):
+        raise argparse.ArgumentTypeError(
+            f"must be orders such as 2:12 or 2,4,8 (integers >= 1, increasing "
+            f"ranges); got {text!r}"
+        )
+    return values
+
+
+def _objectives(text: str) -> tuple[str, ...]:
+    return tuple(v.strip() for v in text.split(",") if v.strip())
+
+
+def _coherence(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not 0.0 <= v < 1.0:
+        raise argparse.ArgumentTypeError(f"must be a number in [0, 1); got {text!r}")
+    return v
+
+
+def _write_front(staged, front) -> None:
+    """front.csv (one row per point) and point-<i>/model.json."""
+    with open(staged / "front.csv", "w", newline="") as fh:
+        out = csv.writer(fh)
+        out.writerow(["point", "na", "nb", "nk", "start", *front.names, "knee"])
+        for i, (model, row) in enumerate(
+            zip(front.models, front.objectives, strict=True)
+        ):
+            arx = model.arx
+            values = [f"{v:.10g}" for v in row]
+            knee = int(i == front.knee)
+            out.writerow([i, arx.na, arx.nb, arx.nk, model.result.start, *values, knee])
+    for i, model in enumerate(front.models):
+        folder = staged / f"point-{i}"
+        folder.mkdir()
+        (folder / "model.json").write_text(
+            json.dumps(model.to_dict(timings=False), indent=2)
+        )
+
+
+def run(args, argv: list[str]) -> int:
+    from spiralid.report.pareto_figures import front_figure
+    from spiralid.sysid import ARX, identify_pareto
+
+    if args.orders is not None and any(_given(argv, flag) for flag in ("--na", "--nb")):
+        raise UsageError("--orders replaces --na and --nb (each order n is ARX(n, n))")
+    data = _load_data(args)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
+    if args.orders is None:
+        structure = ARX(args.na, args.nb, args.nk)
+        structures = [structure]
+    else:
+        structure = args.orders
+        structures = [ARX(n, n, args.nk) for n in structure]
+    est, val = data.split(args.fraction)
+    for arx in structures:
+        arx.check_length(est, "estimation part of DATA")
+    with _open_folder(args.out, args.force) as folder:
+        front = identify_pareto(
+            est,
+            structure,
+            args.objectives,
+            method=args.method,
+            rng=args.seed,
+            max_nfev=args.budget,
+            n_points=args.points,
+            nk=args.nk,
+            parametrization=args.parametrization,
+            seed_estimates=not args.no_seeds,
+            polish_nfev=args.polish,
+            min_coherence=args.min_coherence,
+        )
+        if args.max_frequency is not None:
+            if "frequency" not in front.names:
+                raise UsageError("--max-frequency needs the frequency objective")
+            chosen = front.choose(max_frequency=args.max_frequency)
+            why = f"lowest cost with frequency error <= {args.max_frequency:g} dB"
+        else:
+            chosen, why = front.knee, "the knee"
+        staged = folder.path
+        _write_front(staged, front)
+        front_figure(front, chosen).savefig(staged / "front.png", dpi=110)
+        model = front.models[chosen]
+        model.fraction = args.fraction
+        values = ", ".join(
+            f"{n} {v:.4g}"
+            for n, v in zip(front.names, front.objectives[chosen], strict=True)
+        )
+        headline = (
+            f"Pareto front of {len(front)} stable models ({', '.join(front.names)}) "
+            f"by {args.method} on {args.data}, {front.nfev} evaluations; point "
+            f"{chosen} ({why}): {model.arx}, {values}, H(z) = {model.tf_string()}"
+        )
+        summary = write_arx_model(staged, model, est, val, f"point {chosen}", headline)
+        written = folder.commit(last="model.json")
+    if not args.quiet:
+        print(summary)
+        files = [p for p in written if not p.name.startswith("point-")]
+        points = (
+            f"point-0..{len(front) - 1}/model.json"
+            if len(front) > 1
+            else "point-0/model.json"
+        )
+        print(f"\nwrote {points}, {_listing(files, args.out)}")
+    return 0
+
+
+def add_parser(sub) -> None:
+    from spiralid.optim import RULES
+    from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS
+    from spiralid.sysid.estimation.pareto import OBJECTIVES
+
+    p = sub.add_parser(
+        "pareto",
+        formatter_class=_HelpFormatter,
+        help="a Pareto front of ARX models (time and frequency errors)",
+        description="Search a Pareto front of stable ARX models on the first "
+        "--fraction of DATA by the multi-objective spiral search; write "
+        "front.csv, front.png and point-<i>/model.json, and validate the knee "
+        "(or the --max-frequency choice) as `spiralid identify` does.",
+    )
+    p.add_argument(
+        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+    )
+    _add_data_options(p)
+    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
+    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
+    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
+    p.add_argument(
+        "--orders",
+        type=_orders,
+        default=None,
+        help="several orders n, each ARX(n, n, nk), e.g. 2:12 or 2,4,8; adds the "
+        "number of parameters as an objective",
+    )
+    p.add_argument(
+        "--objectives",
+        type=_objectives,
+        default=("cost", "frequency"),
+        help=f"comma-separated, among {', '.join(OBJECTIVES)} "
+        "(default: cost,frequency)",
+    )
+    p.add_argument(
+        "--method",
+        type=str.lower,
+        choices=[
+            name for name in RULES if name in ("sda", "ebsda", "lasda", "ebsda-scaled")
+        ],
+        default="ebsda",
+        help="spiral rule of the search",
+    )
+    p.add_argument(
+        "--parametrization",
+        choices=list(PARAMETRIZATIONS),
+        default="modal",
+        help="what the search moves (modal: the denominator's modes, numerator "
+        "projected out)",
+    )
+    _add_detrend_option(p)
+    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+    p.add_argument(
+        "--budget",
+        type=_positive_int,
+        default=5000,
+        help="cost evaluations of each order's search",
+    )
+    p.add_argument(
+        "--polish",
+        type=_nonneg_int,
+        default=200,
+        help="evaluations of each extreme's local polish (0: none)",
+    )
+    p.add_argument(
+        "--no-seeds",
+        action="store_true",
+        help="do not seed the search with the LS, Steiglitz-McBride and OE estimates",
+    )
+    p.add_argument(
+        "--min-coherence",
+        type=_coherence,
+        default=0.5,
+        help="frequency bins with lower input-output coherence are not scored",
+    )
+    p.add_argument(
+        "--max-frequency",
+        type=_nonneg_float,
+        default=None,
+        help="validate the lowest-cost point with a frequency error at most this "
+        "many dB instead of the knee",
+    )
+    p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
+    p.add_argument(
+        "--fraction",
+        type=_fraction,
+        default="2/3",
+        help="share of the record that estimates; the rest validates",
+    )
+    p.add_argument("--out", default="spiralid-pareto", help="output directory")
+    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
+    p.add_argument("--quiet", action="store_true", help="print nothing")
+    p.set_defaults(run=run)

@@ -1,0 +1,632 @@
+"""identify_pareto(): a Pareto front of ARX models, and choosing one from it.
+
+The spiral search of :func:`spiralid.optim.minimize_pareto` (SDA or Eb-SDA by
+Tchebycheff decomposition) runs over the same coordinates and box as
+``identify``'s search methods (default ``"modal"``: the denominator's modes
+in natural frequency and log damping ratio, the numerator projected out by
+least squares on the simulation error, every candidate stable), against
+two or three of these objectives, all minimised:
+
+``"cost"``
+    The paper's cost, eq. (2)-(3): the free-run simulation error as a
+    percentage of the output's RMS, plus the penalty for an unstable pole
+    (:class:`~spiralid.sysid.PaperCost`).
+``"frequency"``
+    The coherence-weighted RMS error of the model's log gain against the
+    record's H1 estimate, in dB
+    (:class:`~spiralid.sysid.estimation.frequency.FrequencyError`); an
+    unstable candidate pays the same penalty.
+``"one-step"``
+    The paper's cost with the one-step prediction error.
+``"order"``
+    The number of parameters ``na + nb``. Given several orders the search
+    runs once per order over the other (two) objectives and the fronts are
+    merged by :func:`~spiralid.optim.pareto.non_dominated` with the order as
+    a third objective; it is added by itself then.
+
+With the modal parametrisation the numerator of every candidate is the one
+that minimises the simulation error for its denominator, so the front is
+the trade-off over denominators (poles) at that numerator; the ``"cost"``
+end is where output error is. ``parametrization="coefficients"`` or
+``"reflection"`` search the numerator too (larger, slower searches).
+
+Seeding (``seed_estimates=True``, the default) puts the stabilised
+least-squares, Steiglitz-McBride and output-error (``identify(method="oe")``)
+estimates of each order into the first population, mapped into the searched
+coordinates, and keeps them among the final candidates, so the front's
+``"cost"`` end is never above output error's (where the parametrisation
+represents its denominator) and a weak search cannot lose it. The search's
+candidates are the non-dominated set of every iteration's incumbents (an
+incumbent that a neighbour replaced can still be on the front). Then each
+searched objective's best candidate is polished on that objective alone by
+L-BFGS-B in the box (``polish_nfev`` evaluations each, 0 for none) and
+joins the candidates. Which candidate each front model came from is its
+``result.start`` (``"search"``, ``"polish"``, ``"ls"``,
+``"steiglitz-mcbride"`` or ``"oe"``); every evaluation counts in ``nfev``.
+
+Knee
+----
+:func:`knee_point`: with the objectives normalised to [0, 1] over the
+front, the point farthest from the line through the two extreme points
+(for three objectives the plane through the three), on the side of the
+ideal point: where a unit of one objective costs most of the others.
+When the extremes do not span a line (plane), the point nearest the ideal
+point. :func:`choose` picks instead the lowest value of one objective under
+bounds on the others.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from spiralid._checks import generator, integer
+from spiralid.optim.pareto import minimize_pareto, non_dominated
+
+from ..data import IOData
+from ..models.arx import ARX
+from ..models.identified import IdentifiedModel
+from .cost import PaperCost
+from .estimators import EstimatorResult
+from .frequency import (
+    DEFAULT_MIN_COHERENCE,
+    FrequencyError,
+    FrequencyEstimate,
+    h1_estimate,
+)
+from .outputerror import steiglitz_mcbride
+from .parametrizations import Modal, make_parametrization
+
+__all__ = [
+    "OBJECTIVES",
+    "ParetoIdentification",
+    "choose",
+    "identify_pareto",
+    "knee_point",
+]
+
+# Every objective by name, with its axis label.
+OBJECTIVES: dict[str, str] = {
+    "cost": "simulation cost, eq. (2) (% of rms(y))",
+    "frequency": "frequency-response error (dB, coherence-weighted RMS)",
+    "one-step": "one-step cost, eq. (2) (% of rms(y))",
+    "order": "parameters na + nb",
+}
+_SEEDS = ("ls", "steiglitz-mcbride", "oe")
+
+
+@dataclass
+class ParetoIdentification:
+    """The front of :func:`identify_pareto`, sorted by the first objective.
+
+    Attributes
+    ----------
+    models : list of IdentifiedModel
+        One stable model per front point (validate each as ``identify``'s
+        result); ``result.start`` says which candidate it came from and
+        ``result.objectives`` holds its objective values by name.
+    objectives : ndarray, shape (m, k)
+        The objective values of the models, columns in the order of `names`.
+    names : tuple of str
+        The objectives (keys of :data:`OBJECTIVES`).
+    knee : int
+        Index of the knee point (:func:`knee_point`).
+    hypervolume : dict of str to ndarray
+        Each search's hypervolume history (index 0: the initial population),
+        by structure, e.g. ``"ARX(8, 8, 0)"``; each in its own objectives
+        and reference point, so comparable within a search only.
+    nfev : int
+        Objective evaluations of all searches (the seeds' included).
+    elapsed : float
+        Wall time in seconds.
+    n_unstable : int
+        Non-dominated candidates left out for an unstable pole.
+    frequency : FrequencyEstimate
+        The measured response the ``"frequency"`` objective scores against.
+    seeded : bool
+        Whether the single-objective estimates seeded the searches.
+    """
+
+    models: list[IdentifiedModel]
+    objectives: np.ndarray
+    names: tuple[str, ...]
+    knee: int
+    hypervolume: dict[str, np.ndarray] = field(default_factory=dict)
+    nfev: int = 0
+    elapsed: float = 0.0
+    n_unstable: int = 0
+    frequency: FrequencyEstimate | None = None
+    seeded: bool = True
+
+    def __len__(self) -> int:
+        return len(self.models)
+
+    @property
+    def knee_model(self) -> IdentifiedModel:
+        """The model at the knee point."""
+        return self.models[self.knee]
+
+    def choose(self, minimise: str = "cost", **limits: float) -> int:
+        """Index of the lowest `minimise` under upper bounds, see :func:`choose`.
+
+        Parameters
+        ----------
+        minimise : str, default "cost"
+            The objective to minimise.
+        **limits : float
+            ``max_<objective>=bound``, e.g. ``max_frequency=3.0``.
+        """
+        return choose(self, minimise, **limits)
+
+
+def knee_point(objectives) -> int:
+    """The knee of a front: farthest from the extremes' line (plane).
+
+    Parameters
+    ----------
+    objectives : array_like, shape (m, k)
+        A non-dominated set (minimisation), ``k`` >= 2.
+
+    Returns
+    -------
+    int
+        Row index (the first of equals).
+
+    Examples
+    --------
+    >>> knee_point([[0, 10], [1, 2], [5, 1], [10, 0]])
+    1
+    """
+    f = np.asarray(objectives, dtype=float)
+    if f.ndim != 2 or f.shape[0] < 1 or f.shape[1] < 2 or not np.all(np.isfinite(f)):
+        raise ValueError(
+            "`objectives` must be a finite (m, k) array with m >= 1, k >= 2; got "
+            f"shape {f.shape}"
+        )
+    lo, hi = f.min(axis=0), f.max(axis=0)
+    g = (f - lo) / np.where(hi > lo, hi - lo, 1.0)
+    nearest = int(np.argmin(np.linalg.norm(g, axis=1)))
+    k = g.shape[1]
+    # Each objective's best point (ties: the one best in the others).
+    extremes = [int(np.lexsort((g.sum(axis=1), g[:, j]))[0]) for j in range(k)]
+    if len(set(extremes)) < k:
+        return nearest
+    e = g[extremes]
+    # The hyperplane n . x = 1 through the extremes.
+    try:
+        normal = np.linalg.solve(e, np.ones(k))
+    except np.linalg.LinAlgError:
+        return nearest
+    if not np.all(np.isfinite(normal)) or np.linalg.cond(e) > 1e12:
+        return nearest
+    if np.all(normal <= 0):
+        return nearest
+    distance = (1.0 - g @ normal) / np.linalg.norm(normal)
+    return int(np.argmax(distance))
+
+
+def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int:
+    """Index of the front point with the lowest `minimise` under bounds.
+
+    Parameters
+    ----------
+    front : ParetoIdentification
+        From :func:`identify_pareto`.
+    minimise : str, default "cost"
+        The objective to minimise, one of ``front.names``.
+    **limits : float
+        ``max_<objective>=bound`` for objectives in ``front.names``, e.g.
+        ``choose(front, max_frequency=3.0)``: the lowest-cost model whose
+        frequency-response error is at most 3 dB.
+
+    Returns
+    -------
+    int
+        Row index into ``front.models`` (ties: the first).
+    """
+    if not isinstance(front, ParetoIdentification):
+        raise ValueError(
+            f"`front` must be a ParetoIdentification; got {type(front).__name__}"
+        )
+    names = front.names
+    if minimise not in names:
+        raise ValueError(f"`minimise` must be one of {names}; got {minimise!r}")
+    ok = np.ones(len(front), bool)
+    for key, bound in limits.items():
+        name = key.removeprefix("max_")
+        if not key.startswith("max_") or name not in names:
+            allowed = ", ".join(f"max_{n}" for n in names)
+            raise ValueError(f"limits must be among {allowed}; got `{key}`")
+        try:
+            b = float(bound)
+        except (TypeError, ValueError):
+            b = float("nan")
+        if not np.isfinite(b):
+            raise ValueError(f"`{key}` must be a finite number; got {bound!r}")
+        ok &= front.objectives[:, names.index(name)] <= b
+    if not ok.any():
+        raise ValueError(
+            f"no front point meets {', '.join(f'{k}={v!r}' for k, v in limits.items())}"
+        )
+    column = np.where(ok, front.objectives[:, names.index(minimise)], np.inf)
+    return int(np.argmin(column))
+
+
+def _structures(orders, nk: int) -> list[ARX]:
+    if isinstance(orders, ARX):
+        return [orders]
+    if isinstance(orders, int | np.integer) and not isinstance(orders, bool):
+        orders = [orders]
+    if isinstance(orders, str) or not isinstance(orders, Iterable):
+        raise ValueError(
+            f"`orders` must be an ARX or model orders (integers >= 1); got {orders!r}"
+        )
+    values = list(orders)
+    bad = [
+        v
+        for v in values
+        if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 1
+    ]
+    if not values or bad:
+        raise ValueError(
+            "`orders` must be an ARX or a non-empty list of model orders "
+            f"(integers >= 1); got {values!r}"
+        )
+    if len(set(values)) != len(values):
+        raise ValueError(f"`orders` must not repeat an order; got {values!r}")
+    return [ARX(int(n), int(n), nk) for n in values]
+
+
+def _names(objectives, several: bool) -> tuple[str, ...]:
+    if isinstance(objectives, str) or not isinstance(objectives, Iterable):
+        raise ValueError(
+            f"`objectives` must be a list of names among {tuple(OBJECTIVES)}; "
+            f"got {objectives!r}"
+        )
+    names = tuple(objectives)
+    unknown = [n for n in names if not isinstance(n, str) or n not in OBJECTIVES]
+    if unknown:
+        raise ValueError(
+            f"`objectives` must be among {tuple(OBJECTIVES)}; got {unknown[0]!r}"
+        )
+    if len(set(names)) != len(names):
+        raise ValueError(f"`objectives` must not repeat a name; got {names!r}")
+    if several and "order" not in names:
+        names = (*names, "order")
+    if not several and "order" in names:
+        raise ValueError(
+            "`objectives` 'order' needs several orders (e.g. orders=range(2, 13)); "
+            "one structure has one order"
+        )
+    searched = [n for n in names if n != "order"]
+    if not 2 <= len(names) <= 3 or len(searched) < 2:
+        raise ValueError(
+            "`objectives` must name 2 or 3 objectives, at least two of them "
+            "searched ('order' counts as one); got "
+            f"{names if several else tuple(objectives)!r}"
+        )
+    return names
+
+
+def _seed_thetas(data: IOData, arx: ARX, par, initial: str) -> dict[str, np.ndarray]:
+    """The single-objective estimates that seed a search."""
+    from .identify import identify
+
+    theta_ls = par.theta_ls
+    return {
+        "ls": theta_ls,
+        "steiglitz-mcbride": steiglitz_mcbride(data, arx, theta_ls),
+        "oe": identify(data, arx, method="oe", initial=initial).theta,
+    }
+
+
+def _candidates(par, cost: PaperCost):
+    """``x -> (theta, cost)`` for a population of searched points; with the
+    modal parametrisation the projected numerator is computed once."""
+    if isinstance(par, Modal):
+        projected = par.projected(cost)
+        modes = par.modes
+
+        def modal(x):
+            a = modes.to_denominator(x)
+            f, b = projected.evaluate(a)
+            return np.concatenate([a, b], axis=1), f
+
+        return modal
+
+    def plain(x):
+        theta = par.to_theta(x)
+        return theta, cost(theta)
+
+    return plain
+
+
+class _Archive:
+    """The non-dominated set of every iteration's incumbents (a MOEA/D
+    incumbent that a neighbour replaces can still be on the front)."""
+
+    def __init__(self) -> None:
+        self.x: np.ndarray | None = None
+        self.f: np.ndarray | None = None
+
+    def add(self, intermediate) -> bool:
+        x, f = np.asarray(intermediate.x), np.asarray(intermediate.fun)
+        if self.x is not None:
+            x, f = np.concatenate([self.x, x]), np.concatenate([self.f, f])
+        keep = non_dominated(f)
+        self.x, self.f = x[keep], f[keep]
+        return False
+
+
+def _objective_function(par, cost: PaperCost, error: FrequencyError, searched, gain):
+    """``x -> (theta, objectives)`` for a population of searched points, the
+    columns in the order of `searched`; an unstable candidate pays the
+    cost's penalty in every objective."""
+    candidates = _candidates(par, cost)
+    one_step = (
+        PaperCost(cost.arx, cost.data, "one-step", gain=gain, penalty=cost.penalty)
+        if "one-step" in searched
+        else None
+    )
+
+    def evaluate(x):
+        theta, f_cost = candidates(np.atleast_2d(x))
+        extra = np.where(cost.stable(theta), 0.0, cost.penalty)
+        columns = {"cost": f_cost}
+        if "frequency" in searched:
+            columns["frequency"] = error(theta) + extra
+        if one_step is not None:
+            columns["one-step"] = one_step(theta)
+        return theta, np.column_stack([columns[n] for n in searched])
+
+    return evaluate
+
+
+def _polish_extremes(evaluate, archive: _Archive, box: np.ndarray, budget: int):
+    """Each objective's best archived point polished on that objective alone
+    by L-BFGS-B in the box (finite-difference gradient, at most `budget`
+    evaluations each); returns the polished points and the evaluations."""
+    from scipy.optimize import minimize
+
+    points, used = [], 0
+    for j in range(archive.f.shape[1]):
+        start = archive.x[int(np.argmin(archive.f[:, j]))]
+        res = minimize(
+            lambda x, j=j: float(evaluate(x)[1][0, j]),
+            start,
+            method="L-BFGS-B",
+            bounds=box,
+            options={"maxfun": budget},
+        )
+        points.append(np.clip(res.x, box[:, 0], box[:, 1]))
+        used += int(res.nfev)
+    return np.array(points), used
+
+
+def identify_pareto(
+    data: IOData,
+    orders,
+    objectives=("cost", "frequency"),
+    method: str = "ebsda",
+    *,
+    rng=None,
+    max_nfev: int = 5_000,
+    n_points: int = 50,
+    nk: int = 0,
+    parametrization: str = "modal",
+    seed_estimates: bool = True,
+    polish_nfev: int = 200,
+    initial: str = "rest",
+    gain: str | float = "auto",
+    penalty: float = 1e6,
+    nperseg: int | None = None,
+    fmin: float | None = None,
+    fmax: float | None = None,
+    min_coherence: float = DEFAULT_MIN_COHERENCE,
+    neighbours: int = 10,
+) -> ParetoIdentification:
+    """A Pareto front of stable ARX models on an estimation record.
+
+    Parameters
+    ----------
+    data : IOData
+        Estimation record (as for ``identify``: e.g. the first 2/3 of a
+        record, ``data.split(2 / 3)[0]``); the frequency objective's H1
+        estimate is made on it too.
+    orders : ARX, int or iterable of int
+        One structure, or orders ``n`` each searched as ``ARX(n, n, nk)``
+        (several add the ``"order"`` objective).
+    objectives : sequence of str, default ("cost", "frequency")
+        Names from :data:`OBJECTIVES` (see the module docstring).
+    method : {"ebsda", "sda"} or another rule of
+        :func:`~spiralid.optim.pareto.minimize_pareto`
+        The spiral rule.
+    rng : None, int or numpy.random.Generator
+        Seed of the searches (one generator, orders in the given order).
+    max_nfev : int, default 5000
+        Evaluation budget of each order's search.
+    n_points : int, default 50
+        Population size (one subproblem each).
+    nk : int, default 0
+        Input delay of the structures built from `orders`.
+    parametrization : {"modal", "coefficients", "reflection"}
+        What the search moves (see
+        :mod:`~spiralid.sysid.estimation.parametrizations`); ``"modal"``
+        needs ``initial="rest"``.
+    seed_estimates : bool, default True
+        Seed each search with the least-squares, Steiglitz-McBride and
+        output-error estimates and keep them among the candidates (module
+        docstring).
+    polish_nfev : int, default 200
+        Budget of each extreme's polish (module docstring); 0: no polish.
+    initial : {"rest", "measured"}
+        Initial condition of the simulation error (see ``identify``).
+    gain, penalty
+        The cost's gain and stability penalty (:class:`PaperCost`).
+    nperseg : int, optional
+        Welch segment length of the H1 estimate
+        (:func:`~spiralid.sysid.estimation.frequency.h1_estimate`).
+    fmin, fmax : float, optional
+        Band of the frequency objective in Hz (default: one resolution cell
+        to 0.8 of the Nyquist frequency).
+    min_coherence : float, default 0.5
+        Bins with lower coherence are not scored.
+    neighbours : int, default 10
+        Neighbourhood of the decomposition (``minimize_pareto``).
+
+    Returns
+    -------
+    ParetoIdentification
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.signal import lfilter
+    >>> u = np.random.default_rng(0).standard_normal(1500)
+    >>> y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    >>> y = y + 0.5 * np.random.default_rng(1).standard_normal(1500)
+    >>> front = identify_pareto(IOData(u, y, ts=0.01), ARX(2, 2, 1), rng=0,
+    ...                         max_nfev=400, n_points=20)
+    >>> front.names, all(m.is_stable for m in front.models)
+    (('cost', 'frequency'), True)
+    >>> bool(np.allclose(front.knee_model.theta[:2], [-1.5, 0.7], atol=0.05))
+    True
+    """
+    t_start = time.perf_counter()
+    if not isinstance(data, IOData):
+        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    structures = _structures(orders, nk)
+    names = _names(objectives, len(structures) > 1)
+    if not isinstance(seed_estimates, bool | np.bool_):
+        raise ValueError(
+            f"`seed_estimates` must be True or False; got {seed_estimates!r}"
+        )
+    polish_nfev = integer(polish_nfev, "polish_nfev", 0)
+    if isinstance(method, str):
+        method = method.lower()
+    gen = generator(rng)
+    estimate = h1_estimate(
+        data, nperseg=nperseg, fmin=fmin, fmax=fmax, min_coherence=min_coherence
+    )
+    searched = [n for n in names if n != "order"]
+    thetas, rows, starts, arxs = [], [], [], []
+    histories: dict[str, np.ndarray] = {}
+    meta: dict[str, tuple] = {}
+    nfev = 0
+    for arx in structures:
+        arx.check_length(data)
+        par = make_parametrization(parametrization, data, arx)
+        cost = PaperCost(arx, data, gain=gain, penalty=penalty, initial=initial)
+        evaluate = _objective_function(
+            par, cost, FrequencyError(arx, estimate), searched, gain
+        )
+        box = par.default_bounds()
+        seeds = _seed_thetas(data, arx, par, initial) if seed_estimates else {}
+        x0 = np.array([par.from_theta(t) for t in seeds.values()]) if seeds else None
+        archive = _Archive()
+        res = minimize_pareto(
+            lambda x, evaluate=evaluate: evaluate(x)[1],
+            box,
+            method,
+            n_points=n_points,
+            max_nfev=max_nfev,
+            neighbours=neighbours,
+            rng=gen,
+            vectorized=True,
+            x0=x0,
+            callback=archive.add,
+        )
+        archive.add(res)
+        nfev += res.nfev
+        label = str(arx)
+        histories[label] = np.asarray(res.history)
+        meta[label] = (res, cost, box)
+        # Seeds first: of exact twins the first is kept, with its origin.
+        points = (
+            [] if x0 is None else [(np.clip(x0, box[:, 0], box[:, 1]), list(seeds))]
+        )
+        points.append((archive.x, ["search"] * archive.x.shape[0]))
+        if polish_nfev:
+            polished, used = _polish_extremes(evaluate, archive, box, polish_nfev)
+            points.append((polished, ["polish"] * polished.shape[0]))
+            nfev += used
+        for x, origin in points:
+            # Evaluated again for their theta (counted).
+            theta, f = evaluate(x)
+            nfev += x.shape[0]
+            thetas.extend(theta)
+            rows.extend(f)
+            starts.extend(origin)
+            arxs.extend([arx] * len(origin))
+    f = np.asarray(rows)
+    if "order" in names:
+        order = np.array([a.n_params for a in arxs], dtype=float)
+        f = np.insert(f, names.index("order"), order, axis=1)
+    stable = np.array([a.is_stable(t) for a, t in zip(arxs, thetas, strict=True)])
+    keep = np.flatnonzero(non_dominated(f))
+    n_unstable = int(np.sum(~stable[keep]))
+    keep = keep[stable[keep]]
+    # Non-dominated among the stable ones (dropping an unstable point can
+    # leave what it dominated), sorted by the first objective.
+    keep = keep[non_dominated(f[keep])]
+    keep = keep[np.lexsort(f[keep].T[::-1])]
+    models = []
+    for i in keep:
+        arx = arxs[i]
+        res, cost, box = meta[str(arx)]
+        theta = np.asarray(thetas[i])
+        fun = float(cost(theta))
+        result = EstimatorResult(
+            x=theta,
+            fun=fun,
+            status=int(res.status),
+            success=True,
+            message=str(res.message),
+            nfev=int(res.nfev),
+            nit=int(res.nit),
+            start=starts[i],
+            objectives=dict(zip(names, (float(v) for v in f[i]), strict=True)),
+            raw=res,
+        )
+        models.append(
+            IdentifiedModel(
+                theta,
+                arx=arx,
+                ts=data.ts,
+                method=f"pareto-{method}",
+                parametrization=parametrization,
+                initial=initial,
+                gain=cost.w,
+                penalty=cost.penalty,
+                cost=fun,
+                result=result,
+                timings={"search": float(res.elapsed)},
+                bounds=box,
+                input_name=data.input_name,
+                output_name=data.output_name,
+                input_unit=data.input_unit,
+                output_unit=data.output_unit,
+                u_offset=data.u_offset,
+                y_offset=data.y_offset,
+            )
+        )
+    if not models:
+        raise ValueError(
+            "`data` gave no stable model on the front; try parametrization='modal'"
+        )
+    front = f[keep]
+    return ParetoIdentification(
+        models=models,
+        objectives=front,
+        names=names,
+        knee=knee_point(front) if len(front) > 1 else 0,
+        hypervolume=histories,
+        nfev=nfev,
+        elapsed=time.perf_counter() - t_start,
+        n_unstable=n_unstable,
+        frequency=estimate,
+        seeded=bool(seed_estimates),
+    )

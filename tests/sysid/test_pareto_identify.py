@@ -1,0 +1,167 @@
+"""identify_pareto: a front of stable, validatable ARX models."""
+
+import numpy as np
+import pytest
+
+import spiralid as sid
+from spiralid.optim import minimize_pareto  # noqa: F401  (the search it runs)
+from spiralid.optim.pareto import non_dominated
+from spiralid.sysid import ARX, PaperCost, choose, identify_pareto, knee_point
+from spiralid.sysid.estimation.frequency import FrequencyError
+
+SMALL = dict(max_nfev=600, n_points=20, polish_nfev=50)
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return sid.datasets.robot_arm().split(2 / 3)
+
+
+@pytest.fixture(scope="module")
+def front(arm):
+    est, _ = arm
+    return identify_pareto(est, ARX(4, 4, 0), rng=0, **SMALL)
+
+
+def test_every_front_model_is_stable_and_validates(arm, front):
+    est, val = arm
+    assert len(front) >= 2
+    for model in front.models:
+        assert model.is_stable
+        rep = sid.validate(model, val, warmup=est)
+        assert rep.stable and np.isfinite(rep.fit_percent)
+    # Saved and read back as identify's models are.
+    again = sid.IdentifiedModel.from_dict(front.knee_model.to_dict())
+    np.testing.assert_array_equal(again.theta, front.knee_model.theta)
+
+
+def test_the_front_is_non_dominated_and_its_values_are_recomputable(arm, front):
+    est, _ = arm
+    assert non_dominated(front.objectives).all()
+    assert np.all(np.diff(front.objectives[:, 0]) >= 0)  # sorted by cost
+    cost = PaperCost(ARX(4, 4, 0), est)
+    error = FrequencyError(ARX(4, 4, 0), front.frequency)
+    for model, row in zip(front.models, front.objectives, strict=True):
+        assert row[0] == pytest.approx(cost(model.theta), rel=1e-9)
+        assert row[1] == pytest.approx(error(model.theta), rel=1e-9)
+        assert model.cost == pytest.approx(row[0], rel=1e-9)
+        assert model.result.objectives == {"cost": row[0], "frequency": row[1]}
+
+
+def test_the_seeded_front_reaches_output_error(arm, front):
+    est, _ = arm
+    oe = sid.identify(est, ARX(4, 4, 0), method="oe")
+    assert front.objectives[:, 0].min() <= oe.cost * (1 + 1e-6)
+    assert front.seeded
+    assert {m.result.start for m in front.models} <= {
+        "search", "polish", "ls", "steiglitz-mcbride", "oe"
+    }  # fmt: skip
+
+
+def test_same_seed_same_front(arm, front):
+    est, _ = arm
+    again = identify_pareto(est, ARX(4, 4, 0), rng=0, **SMALL)
+    np.testing.assert_array_equal(again.objectives, front.objectives)
+    for a, b in zip(again.models, front.models, strict=True):
+        np.testing.assert_array_equal(a.theta, b.theta)
+    assert again.knee == front.knee
+
+
+def test_several_orders_add_the_order_objective(arm):
+    est, val = arm
+    front = identify_pareto(est, [2, 4], rng=1, seed_estimates=False, **SMALL)
+    assert front.names == ("cost", "frequency", "order")
+    assert non_dominated(front.objectives).all()
+    for model, row in zip(front.models, front.objectives, strict=True):
+        assert row[2] == model.arx.n_params and model.arx.na in (2, 4)
+        assert model.is_stable
+        sid.validate(model, val, warmup=est)
+    assert set(front.hypervolume) == {"ARX(2, 2, 0)", "ARX(4, 4, 0)"}
+    # The incumbents' hypervolume need not grow (MOEA/D replaces incumbents).
+    assert all(h.size > 1 and np.all(h >= 0) for h in front.hypervolume.values())
+
+
+def test_the_paper_coefficients_search_keeps_only_stable_models(arm):
+    est, _ = arm
+    front = identify_pareto(est, ARX(2, 2, 0), parametrization="coefficients",
+                            rng=0, **SMALL)  # fmt: skip
+    assert all(m.is_stable for m in front.models)
+    assert front.objectives[:, 0].max() < 1e6  # no penalised point
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"objectives": ("cost", "gain")}, "`objectives` must be among"),
+        ({"objectives": "cost"}, "`objectives` must be a list"),
+        ({"objectives": ("cost",)}, "`objectives` must name 2 or 3"),
+        ({"objectives": ("cost", "cost")}, "must not repeat"),
+        ({"objectives": ("cost", "frequency", "order")}, "needs several orders"),
+        ({"orders": [2, 0]}, "`orders` must be"),
+        ({"orders": [2, 2]}, "`orders` must not repeat"),
+        ({"orders": "2:12"}, "`orders` must be"),
+        ({"orders": []}, "`orders` must be"),
+        ({"orders": [2.5]}, "`orders` must be"),
+        ({"method": "periodic"}, "`method` must be a rule"),
+        ({"seed_estimates": "yes"}, "`seed_estimates`"),
+        ({"polish_nfev": -1}, "`polish_nfev`"),
+        ({"max_nfev": 10}, "`max_nfev`"),
+    ],
+)
+def test_bad_arguments_are_clear_errors_naming_them(arm, kwargs, match):
+    est, _ = arm
+    args = {"orders": ARX(2, 2, 0), **SMALL, **kwargs}
+    orders = args.pop("orders")
+    with pytest.raises(ValueError, match=match):
+        identify_pareto(est, orders, **args)
+
+
+def test_several_orders_with_three_searched_objectives_is_refused(arm):
+    est, _ = arm
+    with pytest.raises(ValueError, match="`objectives` must name 2 or 3"):
+        identify_pareto(est, [2, 3], ("cost", "frequency", "one-step"), **SMALL)
+
+
+def test_three_searched_objectives_on_one_structure(arm):
+    est, _ = arm
+    front = identify_pareto(est, ARX(2, 2, 0), ("cost", "frequency", "one-step"),
+                            rng=0, **SMALL)  # fmt: skip
+    assert front.objectives.shape[1] == 3
+    one_step = PaperCost(ARX(2, 2, 0), est, "one-step")
+    for model, row in zip(front.models, front.objectives, strict=True):
+        assert row[2] == pytest.approx(one_step(model.theta), rel=1e-9)
+
+
+def test_knee_is_farthest_from_the_extremes_line():
+    # Normalised, the line runs from (0, 1) to (1, 0); (0.1, 0.2) is
+    # farthest below it.
+    f = [[0, 10], [1, 2], [5, 1], [10, 0]]
+    assert knee_point(f) == 1
+    # A straight front has no knee: every point is on the line; the first.
+    assert knee_point([[0, 2], [1, 1], [2, 0]]) == 0
+    # One point, or extremes that coincide: the one nearest the ideal point.
+    assert knee_point([[3, 4]]) == 0
+    # Three objectives: the plane through the three extremes.
+    f3 = [[0, 1, 1], [1, 0, 1], [1, 1, 0], [0.2, 0.2, 0.2], [0.5, 0.5, 0.4]]
+    assert knee_point(f3) == 3
+    with pytest.raises(ValueError, match="`objectives`"):
+        knee_point([[np.nan, 1.0]])
+
+
+def test_choose_the_lowest_cost_under_a_bound(front):
+    i = choose(front, max_frequency=front.objectives[:, 1].max())
+    assert i == 0  # no bound binds: the lowest cost
+    bound = np.median(front.objectives[:, 1])
+    j = front.choose(max_frequency=bound)
+    ok = front.objectives[:, 1] <= bound
+    assert ok[j] and front.objectives[j, 0] == front.objectives[ok, 0].min()
+    k = front.choose("frequency", max_cost=front.objectives[:, 0].min())
+    assert k == 0
+    with pytest.raises(ValueError, match="no front point meets"):
+        front.choose(max_frequency=-1.0)
+    with pytest.raises(ValueError, match="max_cost, max_frequency"):
+        front.choose(max_gain=1.0)
+    with pytest.raises(ValueError, match="`minimise`"):
+        front.choose("order")
+    with pytest.raises(ValueError, match="`max_cost`"):
+        front.choose(max_cost="a lot")
