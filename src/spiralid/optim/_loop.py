@@ -49,6 +49,15 @@ def check_costs(raw, shape: tuple, what: str) -> np.ndarray:
     return arr
 
 
+def check_objective(fun, vectorized) -> bool:
+    """Check `fun` is callable and `vectorized` a flag; return the flag."""
+    if not callable(fun):
+        raise ValueError(f"`fun` must be callable; got {fun!r}")
+    if not isinstance(vectorized, bool | np.bool_):
+        raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
+    return bool(vectorized)
+
+
 def check_policy(bounds_policy) -> str:
     if not isinstance(bounds_policy, str) or bounds_policy not in POLICIES:
         raise ValueError(

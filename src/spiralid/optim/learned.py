@@ -60,6 +60,7 @@ from spiralid.optim._loop import (
     Trace,
     apply_bounds,
     check_costs,
+    check_objective,
     check_policy,
     seed_points,
     stop_report,
@@ -184,18 +185,14 @@ class LearnedMetricSearch:
         bounds_policy: str = "none",
         max_iter: int | None = None,
     ):
-        if not callable(fun):
-            raise ValueError(f"`fun` must be callable; got {fun!r}")
+        self.vectorized = check_objective(fun, vectorized)
         if not isinstance(method, LearnedMetricSpiral):
             raise ValueError(f"`method` must be a LearnedMetricSpiral; got {method!r}")
-        if not isinstance(vectorized, bool | np.bool_):
-            raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
         self._fun = fun
         self.rule = method
         self._lo, self._hi = box_bounds(bounds)
         self._width = self._hi - self._lo
         self.bounds_policy = check_policy(bounds_policy)
-        self.vectorized = bool(vectorized)
         self._rng = generator(rng)
         self._k_max = None if max_iter is None else integer(max_iter, "max_iter", 1)
         if not method.success_steps and self._k_max is None:

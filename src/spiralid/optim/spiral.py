@@ -28,6 +28,7 @@ from spiralid.optim import _kernels
 from spiralid.optim._loop import (
     apply_bounds,
     check_costs,
+    check_objective,
     check_policy,
     finite_or_inf,
     seed_points,
@@ -145,8 +146,7 @@ class SpiralSearch:
         bounds_policy: str = "none",
         max_iter: int | None = None,
     ):
-        if not callable(fun):
-            raise ValueError(f"`fun` must be callable; got {fun!r}")
+        self.vectorized = check_objective(fun, vectorized)
         self._fun = fun
         self._lo, self._hi = box_bounds(bounds)
         self.rule = _parse_method(method)
@@ -158,9 +158,6 @@ class SpiralSearch:
         self._builtin_rule = type(self.rule) in _BUILTIN
         m = integer(n_points, "n_points", 2)
         self.bounds_policy = check_policy(bounds_policy)
-        if not isinstance(vectorized, bool | np.bool_):
-            raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
-        self.vectorized = bool(vectorized)
         n = self._lo.size
         seeds = seed_points(x0, self._lo, self._hi, m)
         self._rng = generator(rng)
