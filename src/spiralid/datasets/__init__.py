@@ -48,7 +48,7 @@ NAMES = {"robot_arm": robot_arm}
 
 
 def load(name: str, ts: float | None = None) -> IOData:
-    """A shipped data set by name (one of :data:`NAMES`); `ts` overrides its own."""
+    """A shipped data set by `name` (one of :data:`NAMES`); `ts` overrides its own."""
     if name not in NAMES:
         raise ValueError(f"`name` must be one of {sorted(NAMES)}; got {name!r}")
     return NAMES[name]() if ts is None else NAMES[name](ts=ts)

@@ -100,6 +100,19 @@ def prbs(
     repeats to fill ``duration``.  Deterministic: the register starts from
     all ones.  Note the free hub integrates a PRBS's mean and drift.
 
+    Parameters
+    ----------
+    amplitude : float
+        Torque level (N m).
+    duration : float
+        Length (s).
+    fs : float
+        Sampling rate (Hz).
+    n_bits : int
+        Register length, 2..32.
+    hold : int
+        Samples each bit is held.
+
     Examples
     --------
     >>> prbs(2.0, 0.7, 10.0, n_bits=3)
@@ -129,6 +142,18 @@ def chirp(
 
     ``amplitude * scipy.signal.chirp(t, f0, duration, f1, method)``, with
     both frequencies at most the Nyquist frequency ``fs / 2``.
+
+    Parameters
+    ----------
+    amplitude : float
+        Torque amplitude (N m).
+    f0, f1 : float
+        Start and end frequencies (Hz).
+    duration, fs : float
+        Length (s) and sampling rate (Hz).
+    method : str
+        The sweep, as in ``scipy.signal.chirp``: ``"linear"``,
+        ``"quadratic"``, ``"logarithmic"`` or ``"hyperbolic"``.
 
     Examples
     --------

@@ -224,6 +224,15 @@ class ExponentialSpiral(SpiralRule):
     angles and hence the whole search unchanged. The paper's rule depends
     on the cost's scale through ``c2 d``.
 
+    Parameters
+    ----------
+    r_l, r_u, r_c1, r_c2 : float
+        Radius limits and constants of eq. (4) and (7).
+    th_l, th_u, th_c1, th_c2 : float
+        Angle limits (radians) and constants, eq. (8).
+    scale_free : bool
+        Divide the deviations by the population's cost spread first.
+
     Examples
     --------
     >>> import numpy as np

@@ -152,7 +152,8 @@ class StudySpec:
 
 
 def load_spec(path: str | Path | None = None) -> StudySpec:
-    """Read and check a TOML study specification (default: the paper's grid).
+    """Read and check the TOML study specification at `path` (default: the
+    paper's grid).
 
     Relative data paths are resolved against the specification's folder.
     The records themselves are read by :func:`spiralid.study.load_records`,

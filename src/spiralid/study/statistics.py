@@ -40,7 +40,7 @@ def a12(x, y) -> float:
 
 
 def holm(pvalues) -> np.ndarray:
-    """Holm-adjusted p-values (family-wise error control, any dependence).
+    """Holm-adjusted `pvalues` (family-wise error control, any dependence).
 
     The k-th smallest of m p-values is multiplied by ``m - k + 1``, made
     non-decreasing in that order, and capped at 1.

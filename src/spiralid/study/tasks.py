@@ -27,6 +27,35 @@ class Task:
 
     ``seed`` and ``parametrization`` are None for the deterministic
     baselines (least squares, output error), which search no parameters.
+
+    Attributes
+    ----------
+    data : str
+        The reading (record) name in the study specification.
+    predictor, parametrization : str
+        As for :func:`~spiralid.sysid.identify`.
+    label : str
+        The configuration's name in tables and figures.
+    method : str
+        The identification method.
+    seed : int or None
+        The search's seed.
+    refine : bool
+        Polish the search's best by a local method.
+    gain_scale : float
+        Factor on the reading's default cost gain (the gain sweep).
+    safe_start : bool or None
+        As for :func:`~spiralid.sysid.identify` (None: the method's own).
+    options : tuple
+        Further method options as ``(name, value)`` pairs.
+    budget, points : int
+        Evaluation budget and population size.
+    arx : tuple of int
+        ``(na, nb, nk)``.
+    fraction : float
+        Share of the record that estimates.
+    data_digest : str
+        Digest of the record's samples, so a store never mixes records.
     """
 
     data: str
@@ -120,7 +149,8 @@ def reading_tasks(
 
 
 def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
-    """Every run of `spec`, baselines first, in a fixed order."""
+    """Every run of `spec` on its `records` (name to IOData, from
+    :func:`load_records`), baselines first, in a fixed order."""
     common = dict(
         budget=spec.budget,
         points=spec.points,
@@ -145,7 +175,8 @@ def study_tasks(spec: StudySpec, records: dict) -> list[Task]:
 
 
 def run_task(task: Task, data, detail: bool = False) -> dict:
-    """Run one task on its record and return its row for the store.
+    """Run one `task` on its record `data` (an IOData) and return its row
+    for the store.
 
     The row holds the estimation cost (the paper's eq. (2)-(3) on the
     estimation part at the reading's default gain, whatever gain the search
@@ -210,7 +241,7 @@ def run_task(task: Task, data, detail: bool = False) -> dict:
 
 
 def reproducible_part(row: dict) -> dict:
-    """A row without its wall times: what the seed alone decides.
+    """A store's `row` without its wall times: what the seed alone decides.
 
     Two runs of the same task agree on this part bit for bit, whatever the
     engine, the worker count or the order of completion.

@@ -55,6 +55,18 @@ class IdentifiedModel:
         Wall times in seconds: ``"search"``, ``"refine"``, ``"total"``.
     bounds : ndarray or None, shape (p, 2)
         The search box of a spiral method (in the searched parameters).
+    input_name, output_name, input_unit, output_unit : str
+        The record's signal names and units, for tables and figure labels.
+    u_offset, y_offset : float
+        Offsets removed from the record before estimation; ``spiralid
+        validate`` removes the same from new data.
+    fraction : float or None
+        The share of the record that estimated the model (the CLI's
+        ``--fraction``), when known.
+    integrator : bool
+        A known integrator (pole at ``z = 1``) was factored out before
+        estimation (``identify(integrator=True)``): the model is marginally
+        stable by design, not unstable.
     """
 
     theta: np.ndarray

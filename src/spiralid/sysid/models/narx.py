@@ -662,6 +662,9 @@ class PolynomialNARX(_Lags):
         ``1 - sum(ERR)`` at which forward regression stops.
     integrator : bool
         Predict the increment (see the module docstring).
+    terms : tuple of tuple of int, optional
+        The chosen terms (indices of the regressors multiplied together),
+        set by estimation; None before.
 
     Examples
     --------
@@ -833,6 +836,8 @@ class NARXModel:
         Signal names and units.
     u_offset, y_offset : float
         Offsets removed before estimation (the record's, as for ARX).
+    gain, penalty : float
+        The cost's gain and stability penalty.
     """
 
     params: np.ndarray

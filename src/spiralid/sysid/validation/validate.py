@@ -308,6 +308,9 @@ class Validation:
         continues from its end.
     output_name, output_unit : str
         The record's output name and unit, for figure labels.
+    integrator : bool
+        The model has a known integrator (pole at ``z = 1``) by design, so
+        ``stable`` is judged without it.
     """
 
     label: str
