@@ -1,8 +1,8 @@
 """Pareto identification on the simulated rig and the real arm.
 
-For each record (``rig``, ``rig-long``, ``rig-payload``: the simulated rig
-and two variants, as ``benchmarks/identification.py`` makes them, whose
-records it loads; ``arm``: the real DaISy arm), the first 2/3 estimates and
+For each record (``rig``, ``rig-long``, ``rig-payload``, ``rig-noisy``: the
+simulated rig and its three variants, as ``benchmarks/identification.py``
+makes them, whose records it loads; ``arm``: the real DaISy arm), the first 2/3 estimates and
 the last 1/3 validates. ``spiralid.sysid.identify_pareto`` searches orders
 ``--orders`` (default 2..12, each ARX(n, n, 0)) against the simulation cost
 (eq. 2) and the frequency-response error (dB), with the number of
@@ -19,7 +19,9 @@ none for the arm); and whether some front point costs at most 1.01 times
 output error's cost at its own order (``identify(method="oe")``) with its
 first three natural frequencies within 1 % of the finite-element model's
 (for the arm: the cost test alone), with how many points pass the cost test
-and the best such point.
+and the best such point; and the order where validation fit stops improving
+(the lowest order whose output-error model validates within one point of the
+best order's) beside the knee's order.
 
 With ``--alone`` each record is run again with the search alone (no seeds,
 no polish), to show what the spiral search itself finds.
@@ -47,6 +49,7 @@ RIGS = {
     "rig": {},
     "rig-long": {"length": 1.2},
     "rig-payload": {"payload_mass": 0.1},
+    "rig-noisy": {},  # the rig itself, with five times the accelerometer noise
 }
 RECORDS = (*RIGS, "arm")
 MAX_DAMPING = 0.3
@@ -69,7 +72,12 @@ def one(record, seed, orders, budget, points, seeded=True):
     data = load_record(record)
     est, val = data.split(2 / 3)
     fem = FlexibleManipulator(**RIGS[record]).modes()[:3] if record in RIGS else None
-    oe = {n: identify(est, ARX(n, n, 0), method="oe").cost for n in orders}
+    oe_models = {n: identify(est, ARX(n, n, 0), method="oe") for n in orders}
+    oe = {n: m.cost for n, m in oe_models.items()}
+    # Where validation fit stops improving: the lowest order whose output
+    # error model validates within one point of the best order's.
+    oe_fit = {n: validate(m, val, warmup=est).fit_percent for n, m in oe_models.items()}
+    enough = min(n for n in orders if oe_fit[n] >= max(oe_fit.values()) - 1.0)
     t = time.perf_counter()
     front = identify_pareto(
         est,
@@ -98,6 +106,9 @@ def one(record, seed, orders, budget, points, seeded=True):
         f"  knee: point {front.knee}, {knee.arx}, cost {knee.cost:.3f} "
         f"(OE at this order {oe[knee.arx.na]:.3f}), frequency error "
         f"{front.objectives[front.knee, 1]:.2f} dB, validation fit {fit:.1f} %",
+        f"  validation fit stops improving at order {enough} (OE's fit by order: "
+        + ", ".join(f"{n}: {oe_fit[n]:.1f}" for n in orders)
+        + f"); the knee is at order {knee.arx.na}",
         f"  knee modes (Hz) {_fmt(f_knee)}, damping {_fmt(z_knee, 4)}"
         + ("" if fem is None else f"; FEM (Hz) {_fmt(fem)}"),
         f"  front points within 1 % of OE's cost at their order: {len(near_oe)}",
