@@ -2,9 +2,10 @@
 
 For each record (``rig``, ``rig-long``, ``rig-payload``, ``rig-noisy``: the
 simulated rig and its three variants, as ``benchmarks/identification.py``
-makes them, whose records it loads; ``arm``: the real DaISy arm), the first 2/3 estimates and
-the last 1/3 validates. ``spiralid.sysid.identify_pareto`` searches orders
-``--orders`` (default 2..12, each ARX(n, n, 0)) against the simulation cost
+makes them, whose records it loads; ``arm``: the real DaISy arm), the first
+2/3 estimates and the last 1/3 validates.
+``spiralid.sysid.identify_pareto`` searches orders ``--orders`` (default
+2..12, each ARX(n, n, 0)) against the simulation cost
 (eq. 2) and the frequency-response error (dB), with the number of
 parameters as a third objective, at ``--budget`` evaluations per order
 (default 5000, 50 points, Eb-SDA, seeded with LS, Steiglitz-McBride and OE,
