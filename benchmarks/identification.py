@@ -45,6 +45,7 @@ points):
 - ``spiral``: the recommended method, ``identify(method="spiral")`` at its
   default budget of 10,000 evaluations: Eb-SDA, modal, VP, memetic,
   restarts, safe starts.
+- ``spiral (learned-metric)``: the same with the learned-metric rule.
 - ``DE``: SciPy's differential evolution over the paper's cost.
 - ``CMA-ES``: pycma (``cma``, the ``bench`` extra) over the paper's cost in
   raw coefficients, started at the stabilised least-squares estimate with
@@ -333,6 +334,11 @@ METHODS = {
         False,
     ),
     "spiral": (_identify("spiral", budget_cap=10_000), True, False),
+    "spiral (learned-metric)": (
+        _identify("spiral", budget_cap=10_000, rule="learned-metric"),
+        True,
+        False,
+    ),
     "DE": (_paper("de"), False, False),
     "CMA-ES": (_cma_coefficients, False, False),
     "CMA-ES (modal+VP)": (_cma_modal, False, False),
