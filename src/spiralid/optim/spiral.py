@@ -15,6 +15,11 @@ The algorithm is the paper's Figure-4 (after Tamura & Yasuda 2011):
 Non-finite costs (NaN, +-inf) rank worst and never become the centre. If
 no initial cost is finite, the first initial point serves as the centre
 until a finite cost turns up (every deviation is then ``inf``).
+
+The learned-metric rule does not move a population: :func:`minimize` drives
+a :class:`~spiralid.optim.LearnedMetricSearch` for it through the same
+calls (``step``, ``restart``, ``collapsed``, ``next_step_cost``,
+``result``), so budget, callback, target and restarts behave alike.
 """
 
 import math
@@ -458,9 +463,14 @@ def minimize(
         (:class:`~spiralid.optim.PeriodicSpiral`,
         :class:`~spiralid.optim.ConvergentSpiral`), whose step rate is
         scheduled over the iteration budget (``max_iter``, or fewer if
-        ``max_nfev`` allows fewer); or any rule object.
+        ``max_nfev`` allows fewer); ``"learned-metric"``: the periodic
+        directions polled from the centre in a learned basis
+        (:class:`~spiralid.optim.LearnedMetricSpiral`, driven by a
+        :class:`~spiralid.optim.LearnedMetricSearch`: an iteration is a
+        period of ``2n`` polls and a model step); or any rule object.
     n_points : int
-        Number of search points ``m >= 2``.
+        Number of search points ``m >= 2`` (for ``"learned-metric"``: the
+        uniform points whose best starts the poll).
     max_iter : int
         Maximum number of iterations ``k_max >= 1``.
     max_nfev : int, optional
@@ -490,7 +500,8 @@ def minimize(
         population, within the same ``max_iter`` and ``max_nfev``; the best
         point of all runs is returned. Off by default (the paper's
         configurations). A restart happens only if its population can still
-        make 10 iterations within the budget.
+        make 10 iterations within the budget. The learned-metric rule
+        alternates fresh polls with population periods (see its module).
     on_iteration : callable, optional
         ``on_iteration(search)`` with the :class:`SpiralSearch` after every
         iteration, before `callback`: a hook that may move the centre
