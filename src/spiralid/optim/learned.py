@@ -268,7 +268,6 @@ class LearnedMetricSearch:
         self._regime = "poll"
         self._flat = False
         self._m = m
-        self._run_start = self.nit
         self._run_nfev = self.nfev - m
         self._run_best = self._f
         self.last_move = self.nit
@@ -285,7 +284,6 @@ class LearnedMetricSearch:
         self._encoding = AdaptiveEncoding.for_population(n, size // 2)
         self._regime = "population"
         self._flat = False
-        self._run_start = self.nit
         self._run_nfev = self.nfev - 1
         self._run_best = self._f
         self.last_move = self.nit
