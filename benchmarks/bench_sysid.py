@@ -32,19 +32,15 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
+import spiralid.datasets
 from spiralid.sysid import ARX, IOData, PaperCost, identify, validate
 from spiralid.sysid.estimation.parametrizations import (
     default_bounds,
     feasible_initial_points,
 )
 
-ARM = (
-    Path(__file__).resolve().parents[1]
-    / ".."
-    / "shared"
-    / "data"
-    / "daisy_robot_arm.csv"
-)
+# The DaISy arm record shipped with the package (spiralid.datasets).
+ARM = Path(spiralid.datasets.__file__).with_name("daisy_robot_arm.csv")
 
 
 def record() -> tuple[IOData, str]:

@@ -100,9 +100,6 @@ from spiralid.sysid.models.polynomials import fold_reflection, step_up
 from spiralid.sysid.validation.validate import fit_percent
 
 ARX_8 = ARX(8, 8, 0)
-ARM_CSV = (
-    Path(__file__).resolve().parents[2] / "shared" / "data" / "daisy_robot_arm.csv"
-)
 RECORDS = ("rig", "rig-long", "rig-payload", "rig-noisy", "arm", "rig-8000")
 SCALING_ORDERS = (2, 4, 8, 12, 16, 24, 32)
 
@@ -137,13 +134,11 @@ def load_record(name: str, arm_csv: str | None = None) -> IOData:
         exp = dataclasses.replace(paper_experiment(), accel_noise=5.0)
         return exp.run(rng=0).iodata("end_acceleration")
     if name == "arm":
-        try:
-            from spiralid.datasets import robot_arm
+        if arm_csv is not None:
+            return IOData.from_csv(arm_csv, input="u", output="y", ts=0.01)
+        from spiralid.datasets import robot_arm
 
-            return robot_arm()
-        except ImportError:
-            path = arm_csv or ARM_CSV
-            return IOData.from_csv(path, input="u", output="y", ts=0.01)
+        return robot_arm()
     raise ValueError(f"`record` must be one of {RECORDS}; got {name!r}")
 
 
@@ -472,7 +467,9 @@ def main(argv=None):
     ap.add_argument("--records", default=",".join(RECORDS))
     ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--arm", default=None, help="path of daisy_robot_arm.csv")
+    ap.add_argument(
+        "--arm", default=None, help="a CSV (u, y) to use instead of the shipped arm"
+    )
     ap.add_argument(
         "--jsonl", default=None, help="append every run here as it finishes"
     )
