@@ -406,6 +406,105 @@ def _polish_extremes(evaluate, archive: _Archive, box: np.ndarray, budget: int):
     return np.array(points), used
 
 
+@dataclass
+class _StructureRun:
+    """One structure's search: its candidates (theta, objectives, origin)."""
+
+    arx: ARX
+    res: object
+    cost: PaperCost
+    box: np.ndarray
+    thetas: list = field(default_factory=list)
+    rows: list = field(default_factory=list)
+    starts: list = field(default_factory=list)
+    nfev: int = 0
+
+
+def _search_structure(
+    data, arx, error, searched, method, gen, *, parametrization, cost,
+    seed_estimates, polish_nfev, initial, n_points, max_nfev, neighbours, gain,
+) -> _StructureRun:  # fmt: skip
+    """Search one structure's front; collect the seeds, the archive of the
+    search's incumbents and the polished extremes as candidates."""
+    par = make_parametrization(parametrization, data, arx)
+    evaluate = _objective_function(par, cost, error, searched, gain)
+    box = par.default_bounds()
+    seeds = _seed_thetas(data, arx, par, initial) if seed_estimates else {}
+    x0 = np.array([par.from_theta(t) for t in seeds.values()]) if seeds else None
+    archive = _Archive()
+    res = minimize_pareto(
+        lambda x: evaluate(x)[1],
+        box,
+        method,
+        n_points=n_points,
+        max_nfev=max_nfev,
+        neighbours=neighbours,
+        rng=gen,
+        vectorized=True,
+        x0=x0,
+        callback=archive.add,
+    )
+    archive.add(res)
+    run = _StructureRun(arx, res, cost, box, nfev=res.nfev)
+    # Seeds first: of exact twins the first is kept, with its origin.
+    points = [] if x0 is None else [(np.clip(x0, box[:, 0], box[:, 1]), list(seeds))]
+    points.append((archive.x, ["search"] * archive.x.shape[0]))
+    if polish_nfev:
+        polished, used = _polish_extremes(evaluate, archive, box, polish_nfev)
+        points.append((polished, ["polish"] * polished.shape[0]))
+        run.nfev += used
+    for x, origin in points:
+        # Evaluated again for their theta (counted).
+        theta, f = evaluate(x)
+        run.nfev += x.shape[0]
+        run.thetas.extend(theta)
+        run.rows.extend(f)
+        run.starts.extend(origin)
+    return run
+
+
+def _front_model(
+    run: _StructureRun, i: int, objectives, names, data, method, parametrization,
+    initial,
+) -> IdentifiedModel:  # fmt: skip
+    """Candidate `i` of `run` as an IdentifiedModel."""
+    theta = np.asarray(run.thetas[i])
+    fun = float(run.cost(theta))
+    res = run.res
+    result = EstimatorResult(
+        x=theta,
+        fun=fun,
+        status=int(res.status),
+        success=True,
+        message=str(res.message),
+        nfev=int(res.nfev),
+        nit=int(res.nit),
+        start=run.starts[i],
+        objectives=dict(zip(names, (float(v) for v in objectives), strict=True)),
+        raw=res,
+    )
+    return IdentifiedModel(
+        theta,
+        arx=run.arx,
+        ts=data.ts,
+        method=f"pareto-{method}",
+        parametrization=parametrization,
+        initial=initial,
+        gain=run.cost.w,
+        penalty=run.cost.penalty,
+        cost=fun,
+        result=result,
+        timings={"search": float(res.elapsed)},
+        bounds=run.box,
+        input_name=data.input_name,
+        output_name=data.output_name,
+        input_unit=data.input_unit,
+        output_unit=data.output_unit,
+        u_offset=data.u_offset,
+        y_offset=data.y_offset,
+    )
+
+
 def identify_pareto(
     data: IOData,
     orders,
@@ -512,60 +611,34 @@ def identify_pareto(
         data, nperseg=nperseg, fmin=fmin, fmax=fmax, min_coherence=min_coherence
     )
     searched = [n for n in names if n != "order"]
-    thetas, rows, starts, arxs = [], [], [], []
-    histories: dict[str, np.ndarray] = {}
-    meta: dict[str, tuple] = {}
-    nfev = 0
+    runs = []
     for arx in structures:
         arx.check_length(data)
-        par = make_parametrization(parametrization, data, arx)
-        cost = PaperCost(arx, data, gain=gain, penalty=penalty, initial=initial)
-        evaluate = _objective_function(
-            par, cost, FrequencyError(arx, estimate), searched, gain
+        runs.append(
+            _search_structure(
+                data,
+                arx,
+                FrequencyError(arx, estimate),
+                searched,
+                method,
+                gen,
+                parametrization=parametrization,
+                cost=PaperCost(arx, data, gain=gain, penalty=penalty, initial=initial),
+                seed_estimates=seed_estimates,
+                polish_nfev=polish_nfev,
+                initial=initial,
+                n_points=n_points,
+                max_nfev=max_nfev,
+                neighbours=neighbours,
+                gain=gain,
+            )
         )
-        box = par.default_bounds()
-        seeds = _seed_thetas(data, arx, par, initial) if seed_estimates else {}
-        x0 = np.array([par.from_theta(t) for t in seeds.values()]) if seeds else None
-        archive = _Archive()
-        res = minimize_pareto(
-            lambda x, evaluate=evaluate: evaluate(x)[1],
-            box,
-            method,
-            n_points=n_points,
-            max_nfev=max_nfev,
-            neighbours=neighbours,
-            rng=gen,
-            vectorized=True,
-            x0=x0,
-            callback=archive.add,
-        )
-        archive.add(res)
-        nfev += res.nfev
-        label = str(arx)
-        histories[label] = np.asarray(res.history)
-        meta[label] = (res, cost, box)
-        # Seeds first: of exact twins the first is kept, with its origin.
-        points = (
-            [] if x0 is None else [(np.clip(x0, box[:, 0], box[:, 1]), list(seeds))]
-        )
-        points.append((archive.x, ["search"] * archive.x.shape[0]))
-        if polish_nfev:
-            polished, used = _polish_extremes(evaluate, archive, box, polish_nfev)
-            points.append((polished, ["polish"] * polished.shape[0]))
-            nfev += used
-        for x, origin in points:
-            # Evaluated again for their theta (counted).
-            theta, f = evaluate(x)
-            nfev += x.shape[0]
-            thetas.extend(theta)
-            rows.extend(f)
-            starts.extend(origin)
-            arxs.extend([arx] * len(origin))
-    f = np.asarray(rows)
+    candidates = [(run, i) for run in runs for i in range(len(run.starts))]
+    f = np.array([run.rows[i] for run, i in candidates])
     if "order" in names:
-        order = np.array([a.n_params for a in arxs], dtype=float)
+        order = np.array([run.arx.n_params for run, _ in candidates], dtype=float)
         f = np.insert(f, names.index("order"), order, axis=1)
-    stable = np.array([a.is_stable(t) for a, t in zip(arxs, thetas, strict=True)])
+    stable = np.array([run.arx.is_stable(run.thetas[i]) for run, i in candidates])
     keep = np.flatnonzero(non_dominated(f))
     n_unstable = int(np.sum(~stable[keep]))
     keep = keep[stable[keep]]
@@ -573,50 +646,18 @@ def identify_pareto(
     # leave what it dominated), sorted by the first objective.
     keep = keep[non_dominated(f[keep])]
     keep = keep[np.lexsort(f[keep].T[::-1])]
-    models = []
-    for i in keep:
-        arx = arxs[i]
-        res, cost, box = meta[str(arx)]
-        theta = np.asarray(thetas[i])
-        fun = float(cost(theta))
-        result = EstimatorResult(
-            x=theta,
-            fun=fun,
-            status=int(res.status),
-            success=True,
-            message=str(res.message),
-            nfev=int(res.nfev),
-            nit=int(res.nit),
-            start=starts[i],
-            objectives=dict(zip(names, (float(v) for v in f[i]), strict=True)),
-            raw=res,
+    models = [
+        _front_model(
+            *candidates[i], f[i], names, data, method, parametrization, initial
         )
-        models.append(
-            IdentifiedModel(
-                theta,
-                arx=arx,
-                ts=data.ts,
-                method=f"pareto-{method}",
-                parametrization=parametrization,
-                initial=initial,
-                gain=cost.w,
-                penalty=cost.penalty,
-                cost=fun,
-                result=result,
-                timings={"search": float(res.elapsed)},
-                bounds=box,
-                input_name=data.input_name,
-                output_name=data.output_name,
-                input_unit=data.input_unit,
-                output_unit=data.output_unit,
-                u_offset=data.u_offset,
-                y_offset=data.y_offset,
-            )
-        )
+        for i in keep
+    ]
     if not models:
         raise ValueError(
             "`data` gave no stable model on the front; try parametrization='modal'"
         )
+    histories = {str(run.arx): np.asarray(run.res.history) for run in runs}
+    nfev = sum(run.nfev for run in runs)
     front = f[keep]
     return ParetoIdentification(
         models=models,
