@@ -17,6 +17,7 @@ interrupts in :mod:`spiralid.cli.errors`.
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import warnings
@@ -32,7 +33,7 @@ from .errors import (
     report_bug,
 )
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "console", "main"]
 
 # In the order `spiralid --help` lists them.
 _SUBCOMMANDS = (simulate, identify, pareto, validate, reproduce, study)
@@ -59,6 +60,23 @@ def build_parser() -> argparse.ArgumentParser:
     for command in _SUBCOMMANDS:
         command.add_parser(sub)
     return parser
+
+
+def console() -> None:
+    """The ``spiralid`` executable: :func:`main`, then exit with its status.
+
+    After an interrupt (status 130 or 143) the one line has been said, and
+    what is left is the interpreter's exit, where Dask's atexit hook closes a
+    cluster whose coroutines the signal cut short and may print tracebacks;
+    standard error is pointed at the null device first, so the cleanup
+    still runs and the line stays the only one.
+    """
+    status = main()
+    if status in (130, 143):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stderr.fileno())
+    sys.exit(status)
 
 
 def main(argv: list[str] | None = None) -> int:
