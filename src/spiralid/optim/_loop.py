@@ -103,6 +103,17 @@ def stop_report(status: str, fun: float, target, initial_nonfinite: bool) -> dic
     }
 
 
+def point_in_box(x, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """`x` as a finite vector within ``[lo, hi]`` (a centre moved from
+    outside a search), or a ValueError naming it."""
+    pt = np.asarray(x, dtype=np.float64)
+    if pt.shape != lo.shape or not np.all(np.isfinite(pt)):
+        raise ValueError(f"`x` must be a finite vector of shape {lo.shape}; got {x!r}")
+    if np.any((pt < lo) | (pt > hi)):
+        raise ValueError("`x` must lie within `bounds`")
+    return pt
+
+
 def seed_points(x0, lo: np.ndarray, hi: np.ndarray, m: int) -> np.ndarray:
     """``x0`` as ``(k, n)`` seeds of an ``m``-point population in ``[lo, hi]``."""
     n = lo.size

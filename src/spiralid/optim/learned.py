@@ -62,6 +62,7 @@ from spiralid.optim._loop import (
     check_costs,
     check_objective,
     check_policy,
+    point_in_box,
     seed_points,
     stop_report,
 )
@@ -422,13 +423,7 @@ class LearnedMetricSearch:
     def move_centre(self, x, fun: float, nfev: int = 0) -> bool:
         """Replace the centre by `x` of cost `fun` if that is lower (as
         :meth:`spiralid.optim.SpiralSearch.move_centre`)."""
-        pt = np.asarray(x, dtype=np.float64)
-        if pt.shape != self._lo.shape or not np.all(np.isfinite(pt)):
-            raise ValueError(
-                f"`x` must be a finite vector of shape {self._lo.shape}; got {x!r}"
-            )
-        if np.any((pt < self._lo) | (pt > self._hi)):
-            raise ValueError("`x` must lie within `bounds`")
+        pt = point_in_box(x, self._lo, self._hi)
         self.nfev += integer(nfev, "nfev", 0)
         if not (math.isfinite(fun) and fun < self._f):
             return False
@@ -443,11 +438,9 @@ class LearnedMetricSearch:
     def collapsed(self, restarts: Restarts) -> bool:
         """Whether the current run has collapsed by ``restarts``' criteria
         (see the module's description)."""
-        n = self._lo.size
-        stall = max(30, 4 * n) if restarts.stall is None else restarts.stall
         return (
             self._flat
-            or self.nit - self.last_move >= stall
+            or self.nit - self.last_move >= restarts.stall_for(self._lo.size)
             or float(self._step_lengths().max()) <= restarts.tol_radius
             or self._encoding.condition > _MAX_CONDITION
         )

@@ -66,6 +66,11 @@ class Restarts:
         """Population of the next run."""
         return max(n_points, math.ceil(n_points * self.growth - 1e-9))
 
+    def stall_for(self, n: int) -> int:
+        """Periods without progress that count as a collapse in dimension
+        ``n`` (``stall``, or ``max(30, 4 n)`` by default)."""
+        return max(30, 4 * n) if self.stall is None else self.stall
+
     def collapsed(self, offsets: np.ndarray, width: float, stalled: int) -> bool:
         """Whether a run has collapsed.
 
@@ -78,9 +83,7 @@ class Restarts:
         stalled : int
             Iterations since the centre last moved.
         """
-        n = offsets.shape[1]
-        stall = max(30, 4 * n) if self.stall is None else self.stall
-        if stalled >= stall:
+        if stalled >= self.stall_for(offsets.shape[1]):
             return True
         radius = float(np.abs(offsets).max()) if offsets.size else 0.0
         # NaN offsets (escaped points) are not a collapse.

@@ -36,6 +36,7 @@ from spiralid.optim._loop import (
     check_objective,
     check_policy,
     finite_or_inf,
+    point_in_box,
     seed_points,
     stop_report,
 )
@@ -329,13 +330,7 @@ class SpiralSearch:
         finding it, is added to :attr:`nfev` whether or not it is taken.
         Returns whether it was taken.
         """
-        pt = np.asarray(x, dtype=np.float64)
-        if pt.shape != self._lo.shape or not np.all(np.isfinite(pt)):
-            raise ValueError(
-                f"`x` must be a finite vector of shape {self._lo.shape}; got {x!r}"
-            )
-        if np.any((pt < self._lo) | (pt > self._hi)):
-            raise ValueError("`x` must lie within `bounds`")
+        pt = point_in_box(x, self._lo, self._hi)
         self.nfev += integer(nfev, "nfev", 0)
         if not (math.isfinite(fun) and fun < self._f[0]):
             return False
