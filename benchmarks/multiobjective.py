@@ -20,6 +20,7 @@ Run: ``python benchmarks/multiobjective.py [--seeds 20] [--budgets
 """
 
 import argparse
+import functools
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -43,23 +44,32 @@ def _offline_front(name):
         c = np.cos(t) / np.sqrt(2.0)
         return np.column_stack([c, c, np.sin(t)])
     if name == "dtlz7":
-        from spiralid.optim import non_dominated
+        import moocore
 
         g = np.linspace(0.0, 1.0, 200)
         f1, f2 = (v.ravel() for v in np.meshgrid(g, g))
         h = 3.0 - sum(f / 2.0 * (1.0 + np.sin(3.0 * np.pi * f)) for f in (f1, f2))
         f = np.column_stack([f1, f2, 2.0 * h])
-        return f[non_dominated(f)]
+        return f[moocore.is_nondominated(f)]
     return None
 
 
 def _problem(name):
+    """A fresh pymoo problem (each run times its own evaluations) and the
+    reference front, computed once per process."""
+    from pymoo.problems import get_problem
+
+    return get_problem(name), _reference_front(name)
+
+
+@functools.cache
+def _reference_front(name):
+    front = _offline_front(name)
+    if front is not None:
+        return front
     from pymoo.problems import get_problem
 
     problem = get_problem(name)
-    front = _offline_front(name)
-    if front is not None:
-        return problem, front
     front = problem.pareto_front()
     if front is None or len(front) < 2:
         from pymoo.util.ref_dirs import get_reference_directions
@@ -67,7 +77,7 @@ def _problem(name):
         front = problem.pareto_front(
             get_reference_directions("das-dennis", 3, n_partitions=12)
         )
-    return problem, np.asarray(front, dtype=float)
+    return np.asarray(front, dtype=float)
 
 
 class _Timed:
