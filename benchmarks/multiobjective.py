@@ -15,12 +15,14 @@ time per run and the optimiser's own time per evaluation (wall time minus
 the time inside the problem's evaluation).
 
 Run: ``python benchmarks/multiobjective.py [--seeds 20] [--budgets
-25000,10000] [--problems zdt1,dtlz2] [--workers 2]`` (pymoo and moocore:
+25000,10000] [--problems zdt1,dtlz2] [--methods NSGA-II,MO-Eb-SDA]
+[--workers 2] [--rows runs.jsonl]`` (pymoo and moocore:
 ``pip install pymoo moocore``, in the ``bench`` extra).
 """
 
 import argparse
 import functools
+import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -193,10 +195,14 @@ def _table(rows, problems, budget, seeds) -> int:
     )
     print("|---|---|---|---|---|---|---|---|")
     wins = 0
+    present = [m for m in METHODS if any(r[1] == m for r in rows)]
+    spirals = [m for m in present if m.startswith("MO-")]
     for name in problems:
         hv = {}
-        for method in METHODS:
+        for method in present:
             mine = [r for r in rows if r[0] == name and r[1] == method]
+            if not mine:
+                continue
             hv[method] = np.array([r[4] for r in mine])
             q1, q3 = np.percentile(hv[method], [25, 75])
             p = (
@@ -210,7 +216,7 @@ def _table(rows, problems, budget, seeds) -> int:
                 f"{np.median([r[6] for r in mine]):.2f} | "
                 f"{np.median([r[7] for r in mine]):.1f} |"
             )
-        best = max(np.median(hv["MO-Eb-SDA"]), np.median(hv["MO-SDA"]))
+        best = max(np.median(hv[m]) for m in spirals if m in hv)
         wins += bool(best >= np.median(hv["NSGA-II"]))
     print(
         f"\nbest spiral at or above NSGA-II's median hypervolume on {wins} of "
@@ -219,12 +225,25 @@ def _table(rows, problems, budget, seeds) -> int:
     return wins
 
 
+def _stored(path) -> list:
+    if not path or not os.path.exists(path):
+        return []
+    with open(path) as rows:
+        return [tuple(json.loads(line)) for line in rows if line.strip()]
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--budgets", default="25000,10000")
     ap.add_argument("--problems", default=",".join(PROBLEMS))
+    ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument(
+        "--rows",
+        help="a JSON-lines file of finished runs: those already there are not "
+        "run again, new ones are appended, the tables cover all of them",
+    )
     args = ap.parse_args(argv)
     t_all, load0 = time.perf_counter(), os.getloadavg()[0]
     problems = args.problems.split(",")
@@ -233,15 +252,23 @@ def main(argv=None) -> None:
         (name, method, seed, budget)
         for budget in budgets
         for name in problems
-        for method in METHODS
+        for method in args.methods.split(",")
         for seed in range(args.seeds)
     ]
+    rows = _stored(args.rows)
+    done = {tuple(r[:4]) for r in rows}
+    todo = [t for t in tasks if t not in done]
     with ProcessPoolExecutor(args.workers) as pool:
-        rows = list(pool.map(run_one, tasks, chunksize=4))
+        for row in pool.map(run_one, todo, chunksize=4):
+            rows.append(row)
+            if args.rows:
+                with open(args.rows, "a") as out:
+                    out.write(json.dumps(row) + "\n")
+    rows = [r for r in rows if tuple(r[:4]) in set(tasks)]
     for budget in budgets:
         _table([r for r in rows if r[3] == budget], problems, budget, args.seeds)
     print(
-        f"\n{len(tasks)} runs in {time.perf_counter() - t_all:.0f} s with "
+        f"\n{len(todo)} runs in {time.perf_counter() - t_all:.0f} s with "
         f"{args.workers} worker(s), load {load0:.2f} -> {os.getloadavg()[0]:.2f}"
     )
 
