@@ -10,7 +10,12 @@ from spiralid.optim import testfunctions
 from spiralid.optim.encoding import AdaptiveEncoding
 from spiralid.optim.evolution import differential_evolution
 from spiralid.optim.learned import LearnedMetricSearch, LearnedMetricSpiral
-from spiralid.optim.pareto import hypervolume, minimize_pareto, non_dominated
+from spiralid.optim.pareto import (
+    hypervolume,
+    minimize_pareto,
+    non_dominated,
+    thin_front,
+)
 from spiralid.optim.restarts import Restarts
 from spiralid.optim.result import STATUS, OptimiserResult
 from spiralid.optim.rotation import planes, rotate, rotation_matrix
@@ -57,4 +62,5 @@ __all__ = [
     "rotate",
     "rotation_matrix",
     "testfunctions",
+    "thin_front",
 ]

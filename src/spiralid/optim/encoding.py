@@ -106,9 +106,13 @@ class AdaptiveEncoding:
         self.mean = mean
         self.learn(mean - old, x - old)
 
-    def learn(self, shift, steps, *, normalise: bool = True) -> None:
+    def learn(self, shift, steps, *, normalise: bool = True, weights=None) -> None:
         """Update the metric from the mean's `shift` (the path's step) and
         the selected `steps`, best first (the rank-``mu`` term).
+
+        `weights` (summing to one) replace the ``mu`` log-decreasing
+        weights for a number of steps that varies from update to update
+        (the multi-objective poll's successes).
 
         With `normalise` (Adaptive Encoding), each is first scaled to length
         ``sqrt(n)`` in the current metric, so only directions count;
@@ -120,7 +124,8 @@ class AdaptiveEncoding:
         if normalise:
             z = self._normalised(z)
         self.path = (1.0 - c_p) * self.path + math.sqrt(c_p * (2.0 - c_p)) * z[0]
-        rank_mu = (z[1:].T * self.weights) @ z[1:]
+        w = self.weights if weights is None else np.asarray(weights, dtype=float)
+        rank_mu = (z[1:].T * w) @ z[1:]
         C = (1.0 - c_1 - c_mu) * self.covariance
         C += c_1 * np.outer(self.path, self.path) + c_mu * rank_mu
         C = 0.5 * (C + C.T)

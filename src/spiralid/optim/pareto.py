@@ -1,4 +1,5 @@
-"""Multi-objective spiral search: SDA and Eb-SDA by decomposition.
+"""Multi-objective spiral search by decomposition: SDA, Eb-SDA and the
+learned-metric poll.
 
 The paper's closing future work is a multi-objective Eb-SDA. Here the
 search follows MOEA/D (Zhang and Li, IEEE TEVC 11(6), 2007): the front is
@@ -8,16 +9,23 @@ Tchebycheff distance to the ideal point ``z*``,
     g_i(f) = max_j w_ij (f_j - z*_j) / s_j,
 
 with ``s_j`` the current spread of objective ``j`` (so objectives of
-different units weigh alike). Point ``i`` of the spiral population belongs
-to subproblem ``i``; its spiral centre ``x*_i`` is the best incumbent for
-``g_i`` among the subproblems of the ``neighbours`` nearest weight vectors,
-and it moves as in the single-objective search,
-``x_i <- x*_i + r_i R(theta_i) (x_i - x*_i)``, with ``r_i, theta_i`` from
-the rule. Eb-SDA's deviation ``d = |f(x_i) - min J|`` (eq. (4), (7), (8))
-is read as ``d_i = g_i(f(x_i)) - g_i(f(x*_i))``: how far the point is, in
-its own subproblem's scalar cost, from the centre it turns about. Each new
-point replaces at most two neighbouring incumbents it improves (MOEA/D's
+different units weigh alike). Subproblem ``i``'s centre ``x*_i`` is the best
+incumbent for ``g_i`` among the subproblems of the ``neighbours`` nearest
+weight vectors. With SDA or Eb-SDA its point moves as in the
+single-objective search, ``x_i <- x*_i + r_i R(theta_i) (x_i - x*_i)``, with
+``r_i, theta_i`` from the rule. Eb-SDA's deviation ``d = |f(x_i) - min J|``
+(eq. (4), (7), (8)) is read as ``d_i = g_i(f(x_i)) - g_i(f(x*_i))``: how far
+the point is, in its own subproblem's scalar cost, from the centre it turns
+about. With the learned-metric rule each subproblem polls an opposite pair
+of directions about its centre instead, with a step per direction from
+success (:class:`~spiralid.optim._decomposition.PollMoves`). Each new point
+replaces at most two neighbouring incumbents it improves (MOEA/D's
 ``n_r = 2``, which keeps the front spread).
+
+Every evaluated point also enters an archive of the non-dominated points
+(thinned by SPEA2's truncation when it grows past four populations); the
+result is the archive thinned to ``n_points``, or with ``archive=False`` the
+non-dominated incumbents.
 
 The paper's rule constants are kept (``method="sda"``: ``r = 0.95``,
 ``theta = pi/4``; ``"ebsda"``: eq. (4), (7), (8)).
@@ -31,139 +39,29 @@ from collections.abc import Callable
 import numpy as np
 
 from spiralid._checks import box_bounds, generator, integer
+from spiralid.optim._decomposition import (
+    Archive,
+    PollMoves,
+    SpiralMoves,
+    Subproblems,
+)
+from spiralid.optim.front import (
+    hypervolume,
+    non_dominated,
+    thin_front,
+    weight_vectors,
+)
+from spiralid.optim.learned import LearnedMetricSpiral
 from spiralid.optim.result import OptimiserResult
-from spiralid.optim.rotation import rotate
 from spiralid.optim.rules import SpiralRule
 
 __all__ = [
     "hypervolume",
     "minimize_pareto",
     "non_dominated",
+    "thin_front",
     "weight_vectors",
 ]
-
-# Replacements per new point (MOEA/D's n_r) and the smallest weight (a zero
-# weight would make a subproblem blind to an objective).
-_REPLACE = 2
-_MIN_WEIGHT = 1e-6
-# A point within this share of the box's width of its centre (every
-# coordinate) has converged onto it.
-_SPENT = 1e-3
-
-
-def non_dominated(objectives) -> np.ndarray:
-    """Mask of the non-dominated rows of `objectives` (minimisation).
-
-    Row ``a`` dominates row ``b`` when it is nowhere larger and somewhere
-    smaller. Of rows that are exactly equal, only the first is kept.
-
-    Parameters
-    ----------
-    objectives : array_like, shape (N, k)
-
-    Returns
-    -------
-    ndarray of bool, shape (N,)
-
-    Examples
-    --------
-    >>> non_dominated([[1, 3], [2, 2], [2, 3], [1, 3]]).tolist()
-    [True, True, False, False]
-    """
-    f = _objective_array(objectives, "objectives")
-    le = np.all(f[:, None, :] <= f[None, :, :], axis=2)  # le[a, b]: a <= b
-    lt = np.any(f[:, None, :] < f[None, :, :], axis=2)
-    dominated = np.any(le & lt, axis=0)
-    equal = le & le.T
-    earlier_twin = np.any(np.triu(equal, k=1), axis=0)
-    return ~(dominated | earlier_twin)
-
-
-def hypervolume(objectives, ref) -> float:
-    """Volume dominated by `objectives` and bounded by `ref` (minimisation).
-
-    Exact for 2 objectives (a sweep) and 3 (slices along the third, each a
-    2-objective sweep). Points not strictly below `ref` in every objective
-    add nothing.
-
-    Parameters
-    ----------
-    objectives : array_like, shape (N, k), k in {2, 3}
-    ref : array_like, shape (k,)
-
-    Returns
-    -------
-    float
-
-    Examples
-    --------
-    >>> hypervolume([[1, 3], [2, 2], [3, 1]], [4, 4])
-    6.0
-    """
-    f = _objective_array(objectives, "objectives")
-    r = np.asarray(ref, dtype=float)
-    k = f.shape[1]
-    if k not in (2, 3):
-        raise ValueError(f"`objectives` must have 2 or 3 columns; got {k}")
-    if r.shape != (k,) or not np.all(np.isfinite(r)):
-        raise ValueError(f"`ref` must be a finite vector of length {k}; got {ref!r}")
-    f = f[np.all(f < r, axis=1)]
-    if f.shape[0] == 0:
-        return 0.0
-    f = f[non_dominated(f)]
-    if k == 2:
-        return _hypervolume_2d(f, r)
-    order = np.argsort(f[:, 2], kind="stable")
-    f = f[order]
-    levels = np.r_[f[:, 2], r[2]]
-    return float(
-        sum(
-            (levels[i + 1] - levels[i]) * _hypervolume_2d(f[: i + 1, :2], r[:2])
-            for i in range(f.shape[0])
-        )
-    )
-
-
-def _hypervolume_2d(f: np.ndarray, r: np.ndarray) -> float:
-    f = f[non_dominated(f)]
-    f = f[np.argsort(f[:, 0], kind="stable")]
-    right = np.r_[f[1:, 0], r[0]]
-    return float(np.sum((right - f[:, 0]) * (r[1] - f[:, 1])))
-
-
-def weight_vectors(k: int, m: int) -> np.ndarray:
-    """Evenly spread weight vectors on the simplex (Das and Dennis): for 2
-    objectives `m` of them; for 3 the largest lattice with at most `m`.
-
-    Examples
-    --------
-    >>> weight_vectors(2, 3).tolist()
-    [[0.0, 1.0], [0.5, 0.5], [1.0, 0.0]]
-    """
-    k = integer(k, "k", 2)
-    m = integer(m, "m", 2)
-    if k == 2:
-        a = np.linspace(0.0, 1.0, m)
-        return np.column_stack([a, 1.0 - a])
-    if k != 3:
-        raise ValueError(f"`k` must be 2 or 3; got {k}")
-    h = 1
-    while (h + 2) * (h + 3) // 2 <= m:
-        h += 1
-    rows = [(i, j, h - i - j) for i in range(h + 1) for j in range(h + 1 - i)]
-    return np.array(rows, dtype=float) / h
-
-
-def _objective_array(value, name: str) -> np.ndarray:
-    try:
-        f = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"`{name}` must be an (N, k) array of numbers") from None
-    if f.ndim != 2 or f.shape[1] < 1:
-        raise ValueError(f"`{name}` must have shape (N, k); got shape {f.shape}")
-    if not np.all(np.isfinite(f)):
-        raise ValueError(f"`{name}` must be finite; got NaN or infinite values")
-    return f
 
 
 def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray:
@@ -194,9 +92,45 @@ def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray
     return f
 
 
-def _tchebycheff(f: np.ndarray, w: np.ndarray, z: np.ndarray, s: np.ndarray):
-    """``g(f | w) = max_j w_j (f_j - z_j) / s_j``; f (..., k), w (..., k)."""
-    return np.max(w * (f - z) / s, axis=-1)
+def _parse_rule(method) -> SpiralRule | LearnedMetricSpiral:
+    from spiralid.optim.spiral import _parse_method
+
+    rule = _parse_method(method)
+    if not isinstance(rule, SpiralRule | LearnedMetricSpiral):
+        raise ValueError(
+            "`method` must be a rule that sets each point's radius and angle "
+            "(sda, ebsda, lasda, ebsda-scaled or a SpiralRule) or the "
+            f"learned-metric rule; got {method!r}"
+        )
+    return rule
+
+
+def _initial_points(gen, lo, hi, m: int, x0) -> np.ndarray:
+    """`m` uniform draws, the first ones replaced by the seeds `x0`."""
+    n = lo.size
+    x = gen.uniform(lo, hi, size=(m, n))
+    if x0 is not None:
+        seeds = np.atleast_2d(np.asarray(x0, dtype=float))
+        if seeds.ndim != 2 or seeds.shape[1] != n or not np.all(np.isfinite(seeds)):
+            raise ValueError(
+                f"`x0` must be finite points of shape (q, {n}); got shape {seeds.shape}"
+            )
+        q = min(seeds.shape[0], m)
+        x[:q] = np.clip(seeds[:q], lo, hi)
+    return x
+
+
+def _reference_point(ref_point, f: np.ndarray) -> np.ndarray:
+    k = f.shape[1]
+    if ref_point is None:
+        spread = f.max(axis=0) - f.min(axis=0)
+        return f.max(axis=0) + 0.1 * np.where(spread > 0, spread, 1.0)
+    ref = np.asarray(ref_point, dtype=float)
+    if ref.shape != (k,) or not np.all(np.isfinite(ref)):
+        raise ValueError(
+            f"`ref_point` must be a finite vector of length {k}; got {ref_point!r}"
+        )
+    return ref
 
 
 def minimize_pareto(
@@ -207,6 +141,7 @@ def minimize_pareto(
     n_points: int = 100,
     max_nfev: int = 10_000,
     neighbours: int = 10,
+    archive: bool = True,
     ref_point=None,
     rng=None,
     vectorized: bool = False,
@@ -223,17 +158,26 @@ def minimize_pareto(
         shape (m, n); ``k`` is 2 or 3. A non-finite value is an error.
     bounds : sequence of (low, high), (n, 2) array or scipy.optimize.Bounds
         The search box; points are kept inside it.
-    method : {"ebsda", "sda", "lasda", "ebsda-scaled"} or SpiralRule
-        The spiral rule (see :func:`spiralid.optim.minimize`), with the
-        paper's constants.
+    method : str, SpiralRule or LearnedMetricSpiral
+        ``"ebsda"``, ``"sda"``, ``"lasda"`` or ``"ebsda-scaled"``: the
+        spiral rule (see :func:`spiralid.optim.minimize`), with the paper's
+        constants; ``"learned-metric"`` polls a pair of directions
+        per subproblem with a step per direction from success (its
+        ``basis``, ``grow`` and ``shrink`` options apply; the others belong
+        to the single-objective search).
     n_points : int
         Population size: one subproblem each (for 3 objectives the largest
-        simplex lattice that fits).
+        simplex lattice that fits), and the most points the result holds.
     max_nfev : int
         Budget of objective evaluations (at least two populations).
     neighbours : int
         Subproblems whose incumbents a point may take as its centre and
         replace.
+    archive : bool
+        Keep every evaluated non-dominated point and return that archive
+        thinned to at most `n_points` evenly spread points (SPEA2's
+        truncation, :func:`~spiralid.optim.front.thin_front`; default);
+        False returns the non-dominated incumbents of the subproblems.
     ref_point : array_like, shape (k,), optional
         Reference point of the hypervolume ``history``; default the initial
         population's worst value of each objective plus a tenth of its range.
@@ -242,7 +186,8 @@ def minimize_pareto(
         Whether `fun` takes a batch of points.
     callback : callable, optional
         ``callback(intermediate)`` after every iteration with the result so
-        far; returning True stops the search.
+        far (``x`` and ``fun`` of the non-dominated incumbents, ``nit``);
+        returning True stops the search.
     x0 : array_like, shape (q, n) or (n,), optional
         Known points (e.g. a single-objective estimate) that take the place
         of the first ``q`` uniform draws of the initial population (clipped
@@ -252,13 +197,13 @@ def minimize_pareto(
     Returns
     -------
     OptimiserResult
-        ``x`` the non-dominated incumbents (shape (p, n)), ``fun`` their
-        objective vectors (p, k), ``population`` and ``population_fun`` every
+        ``x`` the front's points (shape (p, n)), ``fun`` their objective
+        vectors (p, k), ``population`` and ``population_fun`` every
         subproblem's incumbent, ``weights``, ``ref_point``, ``history`` (the
-        hypervolume of the non-dominated incumbents after the initial
-        population and each iteration), ``status`` (1 when the budget ended
-        it, 0 the callback), ``nit``, ``nfev``, ``n_restarts`` (0),
-        ``elapsed``.
+        hypervolume of the archive, or of the non-dominated incumbents,
+        after the initial population and each iteration), ``status`` (1
+        when the budget ended it, 0 the callback), ``nit``, ``nfev``,
+        ``n_restarts`` (points, or polls, started again), ``elapsed``.
 
     Examples
     --------
@@ -272,100 +217,64 @@ def minimize_pareto(
     """
     t_start = time.perf_counter()
     lo, hi = box_bounds(bounds)
-    from spiralid.optim.spiral import _parse_method
-
-    rule = _parse_method(method)
-    if not isinstance(rule, SpiralRule):
-        raise ValueError(
-            "`method` must be a rule that sets each point's radius and angle "
-            f"(sda, ebsda, lasda, ebsda-scaled or a SpiralRule); got {method!r}"
-        )
+    rule = _parse_rule(method)
     m = integer(n_points, "n_points", 4)
     max_nfev = integer(max_nfev, "max_nfev", 2 * m)
     neighbours = integer(neighbours, "neighbours", 2)
+    if not isinstance(archive, bool):
+        raise ValueError(f"`archive` must be True or False; got {archive!r}")
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
-    n = lo.size
+    vectorized = bool(vectorized)
 
-    x = gen.uniform(lo, hi, size=(m, n))
-    if x0 is not None:
-        seeds = np.atleast_2d(np.asarray(x0, dtype=float))
-        if seeds.ndim != 2 or seeds.shape[1] != n or not np.all(np.isfinite(seeds)):
-            raise ValueError(
-                f"`x0` must be finite points of shape (q, {n}); got shape {seeds.shape}"
-            )
-        q = min(seeds.shape[0], m)
-        x[:q] = np.clip(seeds[:q], lo, hi)
-    f = _evaluate(fun, x, bool(vectorized), None)
+    x = _initial_points(gen, lo, hi, m, x0)
+    f = _evaluate(fun, x, vectorized, None)
     k = f.shape[1]
     if k not in (2, 3):
         raise ValueError(f"`fun` must return 2 or 3 objectives; got {k}")
-    weights = np.maximum(weight_vectors(k, m), _MIN_WEIGHT)
-    m = weights.shape[0]
-    x, f = x[:m], f[:m]
+    sub = Subproblems(k, m, neighbours, x, f)
+    m = sub.size
     nfev = m
-    if ref_point is None:
-        spread = f.max(axis=0) - f.min(axis=0)
-        ref = f.max(axis=0) + 0.1 * np.where(spread > 0, spread, 1.0)
+    ref = _reference_point(ref_point, sub.f)
+    store = Archive(sub.x, sub.f, m) if archive else None
+    if isinstance(rule, LearnedMetricSpiral):
+        moves = PollMoves(rule, sub, lo, hi, gen)
     else:
-        ref = np.asarray(ref_point, dtype=float)
-        if ref.shape != (k,) or not np.all(np.isfinite(ref)):
-            raise ValueError(
-                f"`ref_point` must be a finite vector of length {k}; got {ref_point!r}"
-            )
-    distance = np.linalg.norm(weights[:, None] - weights[None], axis=2)
-    near = np.argsort(distance, axis=1, kind="stable")[:, : min(neighbours, m)]
+        moves = SpiralMoves(rule, sub, lo, hi)
 
-    incumbent, incumbent_f = x.copy(), f.copy()
-    ideal = f.min(axis=0)
-    history = [hypervolume(incumbent_f[non_dominated(incumbent_f)], ref)]
-    nit, status, n_restarts = 0, 1, 0
-    while nfev + m <= max_nfev:
-        scale = np.maximum(incumbent_f.max(axis=0) - ideal, 1e-12)
-        # Each point's centre: the best incumbent for its subproblem among
-        # its neighbours'.
-        g_near = _tchebycheff(incumbent_f[near], weights[:, None], ideal, scale)
-        centre = near[np.arange(m), np.argmin(g_near, axis=1)]
-        g_point = _tchebycheff(f, weights, ideal, scale)
-        g_centre = _tchebycheff(incumbent_f[centre], weights, ideal, scale)
-        r, theta = rule(np.maximum(g_point - g_centre, 0.0), gen)
-        offset = x - incumbent[centre]
-        theta = np.broadcast_to(np.asarray(theta, dtype=float), (m,))
-        x = incumbent[centre] + np.reshape(r, (-1, 1)) * rotate(offset, theta)
-        # A point that has reached its centre has nothing left to explore:
-        # it starts again from a uniform draw (a restart per point).
-        spent = np.max(np.abs(x - incumbent[centre]) / (hi - lo), axis=1) < _SPENT
-        if spent.any():
-            x[spent] = gen.uniform(lo, hi, size=(int(spent.sum()), n))
-            n_restarts += int(spent.sum())
-        np.clip(x, lo, hi, out=x)
-        f = _evaluate(fun, x, bool(vectorized), k)
-        nfev += m
+    def front() -> tuple[np.ndarray, np.ndarray]:
+        if store is not None:
+            return store.x, store.f
+        keep = non_dominated(sub.f)
+        return sub.x[keep], sub.f[keep]
+
+    history = [hypervolume(front()[1], ref)]
+    nit, status = 0, 1
+    while nfev + moves.batch <= max_nfev:
+        y = moves.propose(sub, gen)
+        fy = _evaluate(fun, y, vectorized, k)
+        nfev += y.shape[0]
         nit += 1
-        ideal = np.minimum(ideal, f.min(axis=0))
-        scale = np.maximum(incumbent_f.max(axis=0) - ideal, 1e-12)
-        for i in gen.permutation(m):
-            pool = near[i]
-            better = _tchebycheff(f[i], weights[pool], ideal, scale) < _tchebycheff(
-                incumbent_f[pool], weights[pool], ideal, scale
-            )
-            for j in pool[better][:_REPLACE]:
-                incumbent[j], incumbent_f[j] = x[i], f[i]
-        front = non_dominated(incumbent_f)
-        history.append(hypervolume(incumbent_f[front], ref))
+        sub.ideal = np.minimum(sub.ideal, fy.min(axis=0))
+        moves.learn(sub, y, fy)
+        sub.offer(y, fy, moves.owners, gen)
+        if store is not None:
+            store.add(y, fy)
+        history.append(hypervolume(front()[1], ref))
+        keep = non_dominated(sub.f)
         if callback is not None and callback(
-            OptimiserResult(x=incumbent[front], fun=incumbent_f[front], nit=nit)
+            OptimiserResult(x=sub.x[keep], fun=sub.f[keep], nit=nit)
         ):
             status = 0
             break
-    front = non_dominated(incumbent_f)
+    x_front, f_front = store.final() if store is not None else front()
     return OptimiserResult(
-        x=incumbent[front],
-        fun=incumbent_f[front],
-        population=incumbent,
-        population_fun=incumbent_f,
-        weights=weights,
+        x=x_front,
+        fun=f_front,
+        population=sub.x,
+        population_fun=sub.f,
+        weights=sub.weights,
         ref_point=ref,
         status=status,
         success=True,
@@ -376,7 +285,7 @@ def minimize_pareto(
         ),
         nit=nit,
         nfev=nfev,
-        n_restarts=n_restarts,
+        n_restarts=moves.n_restarts,
         history=np.asarray(history),
         elapsed=time.perf_counter() - t_start,
     )

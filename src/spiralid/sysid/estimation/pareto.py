@@ -442,6 +442,9 @@ def _search_structure(
         rng=gen,
         vectorized=True,
         x0=x0,
+        # Every incumbent is a candidate model: this search keeps its own
+        # unbounded archive, so the thinned one is not needed.
+        archive=False,
         callback=archive.add,
     )
     archive.add(res)

@@ -1,0 +1,223 @@
+"""The machinery of :func:`~spiralid.optim.minimize_pareto`: Tchebycheff
+subproblems (MOEA/D), the archive of non-dominated points, and the two ways
+of proposing new points, a spiral about each subproblem's centre
+(:class:`SpiralMoves`) and the learned-metric poll (:class:`PollMoves`).
+"""
+
+import numpy as np
+
+from spiralid.optim.encoding import AdaptiveEncoding
+from spiralid.optim.front import non_dominated, thin_front, weight_vectors
+from spiralid.optim.learned import LearnedMetricSpiral
+from spiralid.optim.rotation import rotate
+from spiralid.optim.rules import SpiralRule
+
+# Replacements per new point (MOEA/D's n_r) and the smallest weight (a zero
+# weight would make a subproblem blind to an objective).
+_REPLACE = 2
+_MIN_WEIGHT = 1e-6
+# A point within this share of the box's width of its centre (every
+# coordinate) has converged onto it.
+_SPENT = 1e-3
+# The poll's first step and largest step, and the step below which a
+# subproblem's poll starts again from the first, in the unit cube.
+_POLL_STEP = 0.25
+_POLL_TOL = 1e-3
+# The archive is thinned to twice the population when it grows past four.
+_ARCHIVE_SLACK = 4
+
+
+def tchebycheff(f: np.ndarray, w: np.ndarray, z: np.ndarray, s: np.ndarray):
+    """``g(f | w) = max_j w_j (f_j - z_j) / s_j``; f (..., k), w (..., k)."""
+    return np.max(w * (f - z) / s, axis=-1)
+
+
+class Subproblems:
+    """One Tchebycheff subproblem per weight vector, each with its
+    incumbent, and the neighbourhoods they share points in."""
+
+    def __init__(self, k: int, m: int, neighbours: int, x, f):
+        self.weights = np.maximum(weight_vectors(k, m), _MIN_WEIGHT)
+        m = self.weights.shape[0]
+        w = self.weights
+        distance = np.linalg.norm(w[:, None] - w[None], axis=2)
+        order = np.argsort(distance, axis=1, kind="stable")
+        self.near = order[:, : min(neighbours, m)]
+        self.x, self.f = x[:m].copy(), f[:m].copy()
+        self.ideal = self.f.min(axis=0)
+
+    @property
+    def size(self) -> int:
+        return self.weights.shape[0]
+
+    def scale(self) -> np.ndarray:
+        """Each objective's spread, so objectives of any unit weigh alike."""
+        return np.maximum(self.f.max(axis=0) - self.ideal, 1e-12)
+
+    def g(self, f: np.ndarray, rows=slice(None)) -> np.ndarray:
+        """Subproblem ``rows``' scalar costs of the objective vectors `f`."""
+        return tchebycheff(f, self.weights[rows], self.ideal, self.scale())
+
+    def centres(self) -> np.ndarray:
+        """Each subproblem's centre: the best incumbent for it among its
+        neighbours'."""
+        near, w = self.near, self.weights[:, None]
+        g_near = tchebycheff(self.f[near], w, self.ideal, self.scale())
+        return near[np.arange(self.size), np.argmin(g_near, axis=1)]
+
+    def offer(self, y, fy, owners, gen) -> None:
+        """Each new point replaces at most ``_REPLACE`` incumbents of its
+        owner's neighbourhood that it improves, in random order."""
+        self.ideal = np.minimum(self.ideal, fy.min(axis=0))
+        scale = self.scale()
+        for q in gen.permutation(y.shape[0]):
+            pool = self.near[owners[q]]
+            w = self.weights[pool]
+            better = tchebycheff(fy[q], w, self.ideal, scale) < tchebycheff(
+                self.f[pool], w, self.ideal, scale
+            )
+            for j in pool[better][:_REPLACE]:
+                self.x[j], self.f[j] = y[q], fy[q]
+
+
+class Archive:
+    """The non-dominated points of every evaluation, thinned by
+    :func:`~spiralid.optim.front.thin_front` to ``2 m`` whenever they
+    exceed ``4 m``."""
+
+    def __init__(self, x, f, m: int):
+        self.m = m
+        keep = non_dominated(f)
+        self.x, self.f = x[keep], f[keep]
+
+    def add(self, y, fy) -> None:
+        # The archive is non-dominated already: compare the new points among
+        # themselves and against it, O(A B) rather than O((A + B)^2). A new
+        # point equal to an archived one counts as dominated (the first kept).
+        fresh = non_dominated(fy)
+        y, fy = y[fresh], fy[fresh]
+        old, new_f = self.f[:, None, :], fy[None, :, :]
+        beaten = np.any(np.all(old <= new_f, axis=2), axis=0)
+        dominated = np.all(old >= new_f, axis=2) & np.any(old > new_f, axis=2)
+        dropped = np.any(dominated, axis=1)
+        x = np.concatenate([self.x[~dropped], y[~beaten]])
+        f = np.concatenate([self.f[~dropped], fy[~beaten]])
+        if f.shape[0] > _ARCHIVE_SLACK * self.m:
+            keep = thin_front(f, 2 * self.m)
+            x, f = x[keep], f[keep]
+        self.x, self.f = x, f
+
+    def final(self) -> tuple[np.ndarray, np.ndarray]:
+        """At most ``m`` points, evenly spread."""
+        keep = thin_front(self.f, self.m)
+        return self.x[keep], self.f[keep]
+
+
+class SpiralMoves:
+    """SDA's or Eb-SDA's move of each subproblem's point about its centre.
+
+    ``x_i <- x*_i + r_i R(theta_i) (x_i - x*_i)`` with ``r_i, theta_i`` from
+    the rule, fed Eb-SDA's deviation as ``g_i(f(x_i)) - g_i(f(x*_i))``. A
+    point that reaches its centre starts again from a uniform draw.
+    """
+
+    def __init__(self, rule: SpiralRule, sub: Subproblems, lo, hi):
+        self.rule, self.lo, self.hi = rule, lo, hi
+        self.x, self.f = sub.x.copy(), sub.f.copy()
+        self.owners = np.arange(sub.size)
+        self.batch = sub.size
+        self.n_restarts = 0
+
+    def propose(self, sub: Subproblems, gen) -> np.ndarray:
+        lo, hi = self.lo, self.hi
+        m = sub.size
+        centre = sub.centres()
+        deviation = sub.g(self.f) - sub.g(sub.f[centre])
+        r, theta = self.rule(np.maximum(deviation, 0.0), gen)
+        theta = np.broadcast_to(np.asarray(theta, dtype=float), (m,))
+        x = sub.x[centre] + np.reshape(r, (-1, 1)) * rotate(
+            self.x - sub.x[centre], theta
+        )
+        spent = np.max(np.abs(x - sub.x[centre]) / (hi - lo), axis=1) < _SPENT
+        if spent.any():
+            x[spent] = gen.uniform(lo, hi, size=(int(spent.sum()), lo.size))
+            self.n_restarts += int(spent.sum())
+        return np.clip(x, lo, hi)
+
+    def learn(self, sub: Subproblems, y, fy) -> None:
+        self.x, self.f = y, fy
+
+
+class PollMoves:
+    """The learned-metric rule's poll, one per subproblem.
+
+    Subproblem ``i`` polls the opposite pair ``x*_i +- u s_ij b_j`` about
+    its centre, one direction ``j`` of the basis per iteration in turn; the
+    step ``s_ij`` (of the unit cube) grows by the rule's ``grow`` when the
+    better of the pair improves the subproblem's cost over the centre's and
+    shrinks by ``shrink`` otherwise. ``u`` is uniform in [0.5, 1.5]: a
+    ladder of steps in powers of two alone misses basins spaced otherwise
+    (ZDT4). A subproblem whose steps have all shrunk below ``1e-3`` starts
+    its steps again. With the rule's ``basis`` the directions are a basis
+    learned by Adaptive Encoding from every successful step of the
+    population; without, the box's axes.
+    """
+
+    def __init__(self, rule: LearnedMetricSpiral, sub: Subproblems, lo, hi, gen):
+        self.rule, self.lo, self.hi = rule, lo, hi
+        n, m = lo.size, sub.size
+        self.steps = np.full((m, n), _POLL_STEP)
+        self.direction = gen.integers(n, size=m)
+        self.encoding = AdaptiveEncoding(n, 1) if rule.basis else None
+        self.basis = np.eye(n)
+        self.owners = np.tile(np.arange(m), 2)
+        self.batch = 2 * m
+        self.n_restarts = 0
+        self._centre = None
+
+    def propose(self, sub: Subproblems, gen) -> np.ndarray:
+        m = sub.size
+        self._centre = sub.centres()
+        step = self.steps[np.arange(m), self.direction]
+        step = step * gen.uniform(0.5, 1.5, size=m)
+        offset = (self.basis[:, self.direction] * step).T * (self.hi - self.lo)
+        centre = sub.x[self._centre]
+        return np.vstack(
+            [
+                np.clip(centre + offset, self.lo, self.hi),
+                np.clip(centre - offset, self.lo, self.hi),
+            ]
+        )
+
+    def learn(self, sub: Subproblems, y, fy) -> None:
+        m = sub.size
+        rows = np.arange(m)
+        g_centre = sub.g(sub.f[self._centre])
+        g_pair = np.column_stack([sub.g(fy[:m]), sub.g(fy[m:])])
+        better = np.argmin(g_pair, axis=1)
+        success = g_pair[rows, better] < g_centre
+        j = self.direction
+        self.steps[rows, j] = np.where(
+            success,
+            np.minimum(self.steps[rows, j] * self.rule.grow, 1.0),
+            self.steps[rows, j] * self.rule.shrink,
+        )
+        if self.encoding is not None and success.any():
+            moved = (y[rows + m * better] - sub.x[self._centre])[success]
+            self._learn_basis(moved / (self.hi - self.lo))
+        self.direction = (j + 1) % self.lo.size
+        stuck = self.steps.max(axis=1) < _POLL_TOL
+        if stuck.any():
+            self.steps[stuck] = _POLL_STEP
+            self.n_restarts += int(stuck.sum())
+
+    def _learn_basis(self, moved: np.ndarray) -> None:
+        moved = moved[np.any(moved != 0.0, axis=1)]
+        if moved.shape[0] == 0:
+            return
+        weights = np.full(moved.shape[0], 1.0 / moved.shape[0])
+        self.encoding.learn(np.zeros(moved.shape[1]), moved, weights=weights)
+        if np.isfinite(self.encoding.condition):
+            # The steps carry the scale; the basis only the directions.
+            basis = self.encoding.basis
+            self.basis = basis / np.linalg.norm(basis, axis=0)
