@@ -83,7 +83,11 @@ class Subproblems:
 class Archive:
     """The non-dominated points of every evaluation, thinned by
     :func:`~spiralid.optim.front.thin_front` to ``2 m`` whenever they
-    exceed ``4 m``."""
+    exceed ``4 m``.
+
+    Like every bounded archive it can deteriorate (Laumanns et al., 2002): a
+    point thinned away no longer keeps out a later point it dominates.
+    """
 
     def __init__(self, x, f, m: int):
         self.m = m
