@@ -66,9 +66,27 @@ def test_orders_and_a_frequency_bound(tmp_path):
     assert "lowest cost with frequency error <= 30 dB" in proc.stdout
 
 
+def test_choosing_the_order_by_validation_fit(tmp_path):
+    proc = run("pareto", "robot_arm", "--orders", "2:4", "--by-fit", "1", *SMALL,
+               "--out", "o", cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "lowest order within 1 points of the best validation fit" in proc.stdout
+    written = sid.IdentifiedModel.from_dict(
+        json.loads((tmp_path / "o" / "model.json").read_text())
+    )
+    # The same front in the library, and the same choice on it.
+    est, val = sid.datasets.robot_arm().split(2 / 3)
+    front = sid.identify_pareto(est, [2, 3, 4], rng=0, max_nfev=300, n_points=12,
+                                polish_nfev=20)  # fmt: skip
+    chosen = front.models[sid.choose_order(front, val, warmup=est)]
+    np.testing.assert_allclose(written.theta, chosen.theta, rtol=1e-12)
+
+
 @pytest.mark.parametrize(
     "args, match",
     [
+        (["--by-fit", "1"], "--by-fit chooses among orders"),
+        (["--orders", "2:3", "--by-fit", "1", "--max-frequency", "9"], "not both"),
         (["--objectives", "cost,gain"], "--objectives must be among"),
         (["--objectives", "cost,frequency,order"], "needs several orders"),
         (["--orders", "5:2"], "--orders"),

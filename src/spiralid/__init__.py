@@ -30,6 +30,7 @@ _NAMES = {
     "steiglitz_mcbride": "sysid",
     "identify": "sysid",
     "identify_pareto": "sysid",
+    "choose_order": "sysid",
     "validate": "sysid",
 }
 __all__ = ["__version__", *_SUBPACKAGES, *_NAMES]

@@ -1,5 +1,7 @@
 """identify_pareto: a front of stable, validatable ARX models."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -165,3 +167,37 @@ def test_choose_the_lowest_cost_under_a_bound(front):
         front.choose("order")
     with pytest.raises(ValueError, match="`max_cost`"):
         front.choose(max_cost="a lot")
+
+
+def _synthetic_front():
+    # A known ARX(2, 2, 0) plant with a little equation noise (least squares
+    # is then consistent); the "front" holds least-squares models of orders
+    # 1..4 with their costs.
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(1500)
+    e = 0.05 * rng.standard_normal(u.size)
+    y = np.zeros_like(u)
+    for t in range(2, u.size):
+        y[t] = 1.5 * y[t - 1] - 0.7 * y[t - 2] + u[t] + 0.5 * u[t - 1] + e[t]
+    est, val = sid.IOData(u, y, ts=0.01).split(2 / 3)
+    models = [sid.identify(est, ARX(n, n, 0), method="ls") for n in (1, 2, 3, 4)]
+    objectives = np.array([[m.cost, 2 * m.arx.na] for m in models])
+    return SimpleNamespace(models=models, objectives=objectives), est, val
+
+
+def test_choose_order_takes_the_lowest_order_that_fits_as_well():
+    front, est, val = _synthetic_front()
+    fits = sid.sysid.fits_by_order(front, val, warmup=est)
+    by_hand = {
+        2 * n: (i, sid.validate(front.models[i], val, warmup=est).fit_percent)
+        for i, n in enumerate((1, 2, 3, 4))
+    }
+    assert fits == by_hand
+    # ARX(1, 1) cannot follow a second-order plant; ARX(2, 2) is the plant.
+    assert fits[2][1] < fits[4][1] - 10
+    assert sid.choose_order(front, val, warmup=est) == 1
+    # With no tolerance the best-fitting order wins, whichever it is.
+    best = max(fits.values(), key=lambda pair: pair[1])[0]
+    assert sid.choose_order(front, val, warmup=est, tolerance=0.0) == best
+    with pytest.raises(ValueError, match="`tolerance`"):
+        sid.choose_order(front, val, tolerance=-1.0)

@@ -77,7 +77,7 @@ def _write_front(staged, front) -> None:
 
 def run(args, argv: list[str]) -> int:
     from spiralid.report.pareto_figures import front_figure
-    from spiralid.sysid import ARX, identify_pareto
+    from spiralid.sysid import ARX, choose_order, identify_pareto
 
     if args.orders is not None and any(_given(argv, flag) for flag in ("--na", "--nb")):
         raise UsageError("--orders replaces --na and --nb (each order n is ARX(n, n))")
@@ -108,11 +108,21 @@ def run(args, argv: list[str]) -> int:
             polish_nfev=args.polish,
             min_coherence=args.min_coherence,
         )
+        if args.max_frequency is not None and args.by_fit is not None:
+            raise UsageError("give --max-frequency or --by-fit, not both")
         if args.max_frequency is not None:
             if "frequency" not in front.names:
                 raise UsageError("--max-frequency needs the frequency objective")
             chosen = front.choose(max_frequency=args.max_frequency)
             why = f"lowest cost with frequency error <= {args.max_frequency:g} dB"
+        elif args.by_fit is not None:
+            if len(structures) < 2:
+                raise UsageError("--by-fit chooses among orders: give --orders")
+            chosen = choose_order(front, val, warmup=est, tolerance=args.by_fit)
+            why = (
+                f"lowest order within {args.by_fit:g} points of the best validation "
+                "fit, chosen on the validation part (its fit is optimistic)"
+            )
         else:
             chosen, why = front.knee, "the knee"
         staged = folder.path
@@ -225,6 +235,14 @@ def add_parser(sub) -> None:
         default=None,
         help="validate the lowest-cost point with a frequency error at most this "
         "many dB instead of the knee",
+    )
+    p.add_argument(
+        "--by-fit",
+        type=_nonneg_float,
+        default=None,
+        metavar="POINTS",
+        help="validate the lowest order whose lowest-cost model's validation fit "
+        "is within POINTS of the best order's, instead of the knee (with --orders)",
     )
     p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
     p.add_argument(

@@ -40,6 +40,8 @@ from .validation.correlation import CorrelationTest as CorrelationTest
 from .validation.correlation import independence_test as independence_test
 from .validation.correlation import whiteness_test as whiteness_test
 from .validation.higher_order import billings_voon as billings_voon
+from .validation.selection import choose_order as choose_order
+from .validation.selection import fits_by_order as fits_by_order
 from .validation.validate import Realization as Realization
 from .validation.validate import Validation as Validation
 from .validation.validate import fit_percent as fit_percent
