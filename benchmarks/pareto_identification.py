@@ -22,7 +22,9 @@ first three natural frequencies within 1 % of the finite-element model's
 (for the arm: the cost test alone), with how many points pass the cost test
 and the best such point; and the order where validation fit stops improving
 (the lowest order whose output-error model validates within one point of the
-best order's) beside the knee's order.
+best order's) beside the knee's order and the order ``choose_order`` picks
+from the front by the same rule, applied to each order's lowest-cost front
+model.
 
 With ``--alone`` each record is run again with the search alone (no seeds,
 no polish), to show what the spiral search itself finds.
@@ -43,7 +45,14 @@ import numpy as np
 from identification import load_record
 
 from spiralid.fms import FlexibleManipulator
-from spiralid.sysid import ARX, identify, identify_pareto, modes_from_poles, validate
+from spiralid.sysid import (
+    ARX,
+    choose_order,
+    identify,
+    identify_pareto,
+    modes_from_poles,
+    validate,
+)
 
 # The rig each simulated record comes from (as load_record builds them).
 RIGS = {
@@ -91,6 +100,8 @@ def one(record, seed, orders, budget, points, seeded=True):
     )
     elapsed = time.perf_counter() - t
     knee = front.knee_model
+    by_fit = front.models[choose_order(front, val, warmup=est, tolerance=1.0)]
+    fit_by_fit = validate(by_fit, val, warmup=est).fit_percent
     variant = "seeded, polished" if seeded else "search alone"
     fit = validate(knee, val, warmup=est).fit_percent
     f_knee, z_knee = _modes(knee)
@@ -109,7 +120,8 @@ def one(record, seed, orders, budget, points, seeded=True):
         f"{front.objectives[front.knee, 1]:.2f} dB, validation fit {fit:.1f} %",
         f"  validation fit stops improving at order {enough} (OE's fit by order: "
         + ", ".join(f"{n}: {oe_fit[n]:.1f}" for n in orders)
-        + f"); the knee is at order {knee.arx.na}",
+        + f"); the knee is at order {knee.arx.na}; choose_order (1 point) picks "
+        f"{by_fit.arx}, validation fit {fit_by_fit:.1f} %",
         f"  knee modes (Hz) {_fmt(f_knee)}, damping {_fmt(z_knee, 4)}"
         + ("" if fem is None else f"; FEM (Hz) {_fmt(fem)}"),
         f"  front points within 1 % of OE's cost at their order: {len(near_oe)}",
@@ -137,7 +149,8 @@ def one(record, seed, orders, budget, points, seeded=True):
     for m in front.models:
         starts[m.result.start] = starts.get(m.result.start, 0) + 1
     lines.append(f"  front points by origin: {starts}")
-    return "\n".join(lines), bool(hits), bool(near_oe)
+    orders_hit = (knee.arx.na == enough, by_fit.arx.na == enough)
+    return "\n".join(lines), bool(hits), orders_hit
 
 
 def _orders(text):
@@ -166,13 +179,20 @@ def main(argv=None):
     )
     for record in args.records.split(","):
         for seeded in (True, False) if args.alone else (True,):
-            passed = 0
+            passed, knee_at, chosen_at = 0, 0, 0
             for seed in range(args.seeds):
-                text, hit, _ = one(
+                text, hit, (knee_hit, chosen_hit) = one(
                     record, seed, args.orders, args.budget, args.points, seeded
                 )
                 print(text, flush=True)
                 passed += hit
+                knee_at += knee_hit
+                chosen_at += chosen_hit
+            print(
+                f"{record}: at the order where validation fit stops improving, "
+                f"the knee in {knee_at} and choose_order in {chosen_at} of "
+                f"{args.seeds} seeds"
+            )
             if record in RIGS:
                 what = "seeded" if seeded else "search alone"
                 print(
