@@ -190,18 +190,21 @@ class IOData:
             f"output_name={self.output_name!r})"
         )
 
-    def _replace(self, u, y, **kw) -> IOData:
-        args = dict(
-            ts=self.ts,
+    def provenance(self) -> dict:
+        """The signals' names, units and removed offsets, which a model
+        estimated on this record carries (:class:`IdentifiedModel`,
+        :class:`NARXModel`) so that it is validated and drawn in them."""
+        return dict(
             input_name=self.input_name,
             output_name=self.output_name,
-            u_offset=self.u_offset,
-            y_offset=self.y_offset,
             input_unit=self.input_unit,
             output_unit=self.output_unit,
+            u_offset=self.u_offset,
+            y_offset=self.y_offset,
         )
-        args.update(kw)
-        return IOData(u, y, **args)
+
+    def _replace(self, u, y, **kw) -> IOData:
+        return IOData(u, y, **{"ts": self.ts, **self.provenance(), **kw})
 
     def __getitem__(self, index: slice) -> IOData:
         """A contiguous part, ``data[a:b]`` (slices with step 1 only)."""

@@ -727,10 +727,5 @@ def identify_narx(
         result=res,
         history=history,
         timings={"total": time.perf_counter() - t_start},
-        input_name=data.input_name,
-        output_name=data.output_name,
-        input_unit=data.input_unit,
-        output_unit=data.output_unit,
-        u_offset=data.u_offset,
-        y_offset=data.y_offset,
+        **data.provenance(),
     )

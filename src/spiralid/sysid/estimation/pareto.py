@@ -499,12 +499,7 @@ def _front_model(
         result=result,
         timings={"search": float(res.elapsed)},
         bounds=run.box,
-        input_name=data.input_name,
-        output_name=data.output_name,
-        input_unit=data.input_unit,
-        output_unit=data.output_unit,
-        u_offset=data.u_offset,
-        y_offset=data.y_offset,
+        **data.provenance(),
     )
 
 
