@@ -193,6 +193,31 @@ def run_one(task):
     return name, method, seed, budget, hv, igd_plus, wall, own_us
 
 
+def _compact(rows, problems, budget) -> None:
+    """One line per problem: every method's median hypervolume, the best
+    spiral's rank-sum p against NSGA-II; then each method's median wall time
+    per run and own time per evaluation over all problems."""
+    present = [m for m in METHODS if any(r[1] == m for r in rows)]
+    spirals = [m for m in present if m.startswith("MO-")]
+    print(f"\nmedian hypervolume, {budget} evaluations\n")
+    print("| problem | " + " | ".join(present) + " | best spiral, p vs NSGA-II |")
+    print("|---" * (len(present) + 2) + "|")
+    for name in problems:
+        hv = {
+            m: np.array([r[4] for r in rows if r[0] == name and r[1] == m])
+            for m in present
+        }
+        best = max(spirals, key=lambda m: np.median(hv[m]))
+        p = rank_sum(hv[best], hv["NSGA-II"])["p_two_sided"]
+        cells = " | ".join(f"{np.median(hv[m]):.4g}" for m in present)
+        print(f"| {name} | {cells} | {best}, {p:.2g} |")
+    for label, col in (("s/run", 6), ("own us/eval", 7)):
+        cells = " | ".join(
+            f"{np.median([r[col] for r in rows if r[1] == m]):.3g}" for m in present
+        )
+        print(f"| {label} (median) | {cells} | |")
+
+
 def _table(rows, problems, budget, seeds) -> int:
     """Print one budget's table; return the problems where the best spiral
     is at or above NSGA-II's median hypervolume."""
@@ -274,7 +299,9 @@ def main(argv=None) -> None:
                     out.write(json.dumps(row) + "\n")
     rows = [r for r in rows if tuple(r[:4]) in set(tasks)]
     for budget in budgets:
-        _table([r for r in rows if r[3] == budget], problems, budget, args.seeds)
+        mine = [r for r in rows if r[3] == budget]
+        _table(mine, problems, budget, args.seeds)
+        _compact(mine, problems, budget)
     print(
         f"\n{len(todo)} runs in {time.perf_counter() - t_all:.0f} s with "
         f"{args.workers} worker(s), load {load0:.2f} -> {os.getloadavg()[0]:.2f}"
