@@ -62,6 +62,8 @@ def test_readme_pareto_example_runs(monkeypatch, tmp_path, capsys):
     # The knee and the choice validate as the comments say (within a point).
     assert abs(float(lines[1].split()[-1]) - 89.6) <= 1.0
     assert abs(float(lines[2].split()[-1]) - 91.2) <= 1.0
+    assert lines[3].startswith("ARX(5, 5, 0)")  # fits by order: 10 params 89.6 %
+    assert abs(float(lines[3].split()[-1]) - 89.6) <= 1.0
 
 
 def test_readme_pareto_command_runs(tmp_path):
