@@ -78,3 +78,15 @@ def test_readme_pareto_command_runs(tmp_path):
     out = tmp_path / command[command.index("--out") + 1]
     assert (out / "front.csv").is_file() and (out / "point-0" / "model.json").is_file()
     assert json.loads((out / "validation.json").read_text())["validation"]
+
+
+def test_readme_pareto_search_example_runs(capsys):
+    text = (ROOT / "README.md").read_text()
+    block = re.search(
+        r"<!-- pareto-search-example -->\n```python\n(.*?)```", text, flags=re.S
+    ).group(1)
+    exec(compile(block, "README.md", "exec"), {})
+    shape, hv = capsys.readouterr().out.strip().split(") ")
+    assert shape == "(100, 2"
+    # Within a hundredth of the printed figure; NSGA-II's median is 0.870.
+    assert abs(float(hv) - 0.871) <= 0.01
