@@ -207,9 +207,12 @@ def _compact(rows, problems, budget) -> None:
             m: np.array([r[4] for r in rows if r[0] == name and r[1] == m])
             for m in present
         }
+        cells = " | ".join(f"{np.median(hv[m]):.4g}" for m in present)
+        if not spirals or "NSGA-II" not in hv:
+            print(f"| {name} | {cells} | |")
+            continue
         best = max(spirals, key=lambda m: np.median(hv[m]))
         p = rank_sum(hv[best], hv["NSGA-II"])["p_two_sided"]
-        cells = " | ".join(f"{np.median(hv[m]):.4g}" for m in present)
         print(f"| {name} | {cells} | {best}, {p:.2g} |")
     for label, col in (("s/run", 6), ("own us/eval", 7)):
         cells = " | ".join(
@@ -240,7 +243,7 @@ def _table(rows, problems, budget, seeds) -> int:
             q1, q3 = np.percentile(hv[method], [25, 75])
             p = (
                 ""
-                if method == "NSGA-II"
+                if method == "NSGA-II" or "NSGA-II" not in hv
                 else f"{rank_sum(hv[method], hv['NSGA-II'])['p_two_sided']:.3g}"
             )
             print(
