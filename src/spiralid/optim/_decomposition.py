@@ -19,8 +19,8 @@ _MIN_WEIGHT = 1e-6
 # A point within this share of the box's width of its centre (every
 # coordinate) has converged onto it.
 _SPENT = 1e-3
-# The poll's first step and largest step, and the step below which a
-# subproblem's poll starts again from the first, in the unit cube.
+# The poll's first step, and the step below which a subproblem's poll starts
+# again from it, in the unit cube (a step never exceeds the cube's width).
 _POLL_STEP = 0.25
 _POLL_TOL = 1e-3
 # The archive is thinned to twice the population when it grows past four.
@@ -54,9 +54,9 @@ class Subproblems:
         """Each objective's spread, so objectives of any unit weigh alike."""
         return np.maximum(self.f.max(axis=0) - self.ideal, 1e-12)
 
-    def g(self, f: np.ndarray, rows=slice(None)) -> np.ndarray:
-        """Subproblem ``rows``' scalar costs of the objective vectors `f`."""
-        return tchebycheff(f, self.weights[rows], self.ideal, self.scale())
+    def g(self, f: np.ndarray) -> np.ndarray:
+        """Each subproblem's scalar cost of its row of `f`."""
+        return tchebycheff(f, self.weights, self.ideal, self.scale())
 
     def centres(self) -> np.ndarray:
         """Each subproblem's centre: the best incumbent for it among its
@@ -220,6 +220,9 @@ class PollMoves:
         if moved.shape[0] == 0:
             return
         weights = np.full(moved.shape[0], 1.0 / moved.shape[0])
+        # There is no moving mean, so the rank-one path gets no step: fed the
+        # successes' mean, it turned the basis towards the direction every
+        # subproblem shares (ZDT's distance variables) and ZDT4 fell to 0.
         self.encoding.learn(np.zeros(moved.shape[1]), moved, weights=weights)
         if np.isfinite(self.encoding.condition):
             # The steps carry the scale; the basis only the directions.
