@@ -243,11 +243,12 @@ def minimize_pareto(
     else:
         moves = SpiralMoves(rule, sub, lo, hi)
 
-    def front() -> tuple[np.ndarray, np.ndarray]:
-        if store is not None:
-            return store.x, store.f
+    def incumbents() -> tuple[np.ndarray, np.ndarray]:
         keep = non_dominated(sub.f)
         return sub.x[keep], sub.f[keep]
+
+    def front() -> tuple[np.ndarray, np.ndarray]:
+        return (store.x, store.f) if store is not None else incumbents()
 
     history = [hypervolume(front()[1], ref)]
     nit, status = 0, 1
@@ -262,12 +263,11 @@ def minimize_pareto(
         if store is not None:
             store.add(y, fy)
         history.append(hypervolume(front()[1], ref))
-        keep = non_dominated(sub.f)
-        if callback is not None and callback(
-            OptimiserResult(x=sub.x[keep], fun=sub.f[keep], nit=nit)
-        ):
-            status = 0
-            break
+        if callback is not None:
+            x_now, f_now = incumbents()
+            if callback(OptimiserResult(x=x_now, fun=f_now, nit=nit)):
+                status = 0
+                break
     x_front, f_front = store.final() if store is not None else front()
     return OptimiserResult(
         x=x_front,
