@@ -118,7 +118,7 @@ def test_a_bad_objective_is_a_clear_error(fun, match):
 
 
 def test_step_rate_rules_are_refused():
-    with pytest.raises(ValueError, match="`method` must be a rule that sets"):
+    with pytest.raises(ValueError, match="`method` must be one of sda, ebsda"):
         minimize_pareto(_zdt1, [(0, 1)] * 2, "periodic", n_points=10, max_nfev=40)
 
 

@@ -104,7 +104,7 @@ def test_the_paper_coefficients_search_keeps_only_stable_models(arm):
         ({"orders": "2:12"}, "`orders` must be"),
         ({"orders": []}, "`orders` must be"),
         ({"orders": [2.5]}, "`orders` must be"),
-        ({"method": "periodic"}, "`method` must be a rule"),
+        ({"method": "periodic"}, "`method` must be one of"),
         ({"seed_estimates": "yes"}, "`seed_estimates`"),
         ({"polish_nfev": -1}, "`polish_nfev`"),
         ({"max_nfev": 10}, "`max_nfev`"),

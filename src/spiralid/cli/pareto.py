@@ -154,7 +154,7 @@ def run(args, argv: list[str]) -> int:
 
 
 def add_parser(sub) -> None:
-    from spiralid.optim import RULES
+    from spiralid.optim.pareto import PARETO_METHODS
     from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS
     from spiralid.sysid.estimation.pareto import OBJECTIVES
 
@@ -191,9 +191,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--method",
         type=str.lower,
-        choices=[
-            name for name in RULES if name in ("sda", "ebsda", "lasda", "ebsda-scaled")
-        ],
+        choices=PARETO_METHODS,
         default="ebsda",
         help="spiral rule of the search",
     )

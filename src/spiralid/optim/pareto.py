@@ -54,8 +54,10 @@ from spiralid.optim.front import (
 from spiralid.optim.learned import LearnedMetricSpiral
 from spiralid.optim.result import OptimiserResult
 from spiralid.optim.rules import SpiralRule
+from spiralid.optim.spiral import RULES, _parse_method
 
 __all__ = [
+    "PARETO_METHODS",
     "hypervolume",
     "minimize_pareto",
     "non_dominated",
@@ -93,16 +95,23 @@ def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray
 
 
 def _parse_rule(method) -> SpiralRule | LearnedMetricSpiral:
-    from spiralid.optim.spiral import _parse_method
-
     rule = _parse_method(method)
     if not isinstance(rule, SpiralRule | LearnedMetricSpiral):
         raise ValueError(
-            "`method` must be a rule that sets each point's radius and angle "
-            "(sda, ebsda, lasda, ebsda-scaled or a SpiralRule) or the "
-            f"learned-metric rule; got {method!r}"
+            f"`method` must be one of {', '.join(PARETO_METHODS)}, a SpiralRule "
+            f"or a LearnedMetricSpiral; got {method!r}"
         )
     return rule
+
+
+# The rules a multi-objective search can drive (by name): those that set each
+# point's radius and angle, and the learned-metric poll; not the step-rate
+# rules, whose step schedule belongs to a single centre.
+PARETO_METHODS = tuple(
+    name
+    for name in RULES
+    if isinstance(_parse_method(name), SpiralRule | LearnedMetricSpiral)
+)
 
 
 def _initial_points(gen, lo, hi, m: int, x0) -> np.ndarray:

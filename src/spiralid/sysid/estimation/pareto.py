@@ -1,11 +1,11 @@
 """identify_pareto(): a Pareto front of ARX models, and choosing one from it.
 
-The spiral search of :func:`spiralid.optim.minimize_pareto` (SDA or Eb-SDA by
-Tchebycheff decomposition) runs over the same coordinates and box as
-``identify``'s search methods (default ``"modal"``: the denominator's modes
-in natural frequency and log damping ratio, the numerator projected out by
-least squares on the simulation error, every candidate stable), against
-two or three of these objectives, all minimised:
+The spiral search of :func:`spiralid.optim.minimize_pareto` (SDA, Eb-SDA or
+the learned-metric poll, by Tchebycheff decomposition) runs over the same
+coordinates and box as ``identify``'s search methods (default ``"modal"``:
+the denominator's modes in natural frequency and log damping ratio, the
+numerator projected out by least squares on the simulation error, every
+candidate stable), against two or three of these objectives, all minimised:
 
 ``"cost"``
     The paper's cost, eq. (2)-(3): the free-run simulation error as a
@@ -538,9 +538,10 @@ def identify_pareto(
         (several add the ``"order"`` objective).
     objectives : sequence of str, default ("cost", "frequency")
         Names from :data:`OBJECTIVES` (see the module docstring).
-    method : {"ebsda", "sda"} or another rule of
-        :func:`~spiralid.optim.pareto.minimize_pareto`
-        The spiral rule.
+    method : str or rule
+        A name of :data:`~spiralid.optim.pareto.PARETO_METHODS` (``"ebsda"``,
+        ``"sda"``, ``"learned-metric"``, ...) or a rule object, as
+        :func:`~spiralid.optim.pareto.minimize_pareto` takes.
     rng : None, int or numpy.random.Generator
         Seed of the searches (one generator, orders in the given order).
     max_nfev : int, default 5000
