@@ -111,7 +111,7 @@ def _hypervolume_3d(f: np.ndarray, r: np.ndarray) -> float:
 def _hypervolume_2d(f: np.ndarray, r: np.ndarray) -> float:
     # Sorted by the first objective (ties by the second), a point is on the
     # front when it improves on every earlier point's second objective: an
-    # O(N log N) sweep, since the 3-objective slices call this N times.
+    # O(N log N) sweep (the search's history calls it every iteration).
     f = f[np.lexsort((f[:, 1], f[:, 0]))]
     earlier = np.minimum.accumulate(np.r_[np.inf, f[:-1, 1]])
     f = f[f[:, 1] < earlier]
