@@ -46,6 +46,11 @@ class Subproblems:
         self.x, self.f = x[:m].copy(), f[:m].copy()
         self.ideal = self.f.min(axis=0)
 
+    def see(self, fy) -> None:
+        """Move the ideal point to new objective vectors `fy`, before the
+        moves learn from them and they are offered."""
+        self.ideal = np.minimum(self.ideal, fy.min(axis=0))
+
     @property
     def size(self) -> int:
         return self.weights.shape[0]
@@ -67,8 +72,8 @@ class Subproblems:
 
     def offer(self, y, fy, owners, gen) -> None:
         """Each new point replaces at most ``_REPLACE`` incumbents of its
-        owner's neighbourhood that it improves, in random order."""
-        self.ideal = np.minimum(self.ideal, fy.min(axis=0))
+        owner's neighbourhood that it improves, in random order (against the
+        ideal point as :meth:`see` left it)."""
         scale = self.scale()
         for q in gen.permutation(y.shape[0]):
             pool = self.near[owners[q]]

@@ -45,8 +45,7 @@ def hypervolume(objectives, ref) -> float:
 
     Exact for 2 objectives (a sweep) and 3 (slices along the third, each
     slice's area grown by the points in the order of the third objective).
-    Points not strictly below `ref` in every objective
-    add nothing.
+    Points not strictly below `ref` in every objective add nothing.
 
     Parameters
     ----------

@@ -266,7 +266,7 @@ def minimize_pareto(
         fy = _evaluate(fun, y, vectorized, k)
         nfev += y.shape[0]
         nit += 1
-        sub.ideal = np.minimum(sub.ideal, fy.min(axis=0))
+        sub.see(fy)
         moves.learn(sub, y, fy)
         sub.offer(y, fy, moves.owners, gen)
         if store is not None:
