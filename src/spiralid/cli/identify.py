@@ -223,8 +223,9 @@ def run(args, argv: list[str]) -> int:
 
 
 def add_parser(sub) -> None:
-    from spiralid.sysid.estimation.estimators import DEFAULT_METHOD, METHODS
-    from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS
+    # Names only: building the parser loads no estimator (`spiralid --help`
+    # stays quick).
+    from spiralid.choices import DEFAULT_METHOD, METHOD_NAMES, PARAMETRIZATION_NAMES
 
     p = sub.add_parser(
         "identify",
@@ -271,7 +272,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--method",
         type=str.lower,
-        choices=list(METHODS),
+        choices=METHOD_NAMES,
         default=DEFAULT_METHOD,
         help="estimator: a search over the paper's cost, least squares or output error",
     )
@@ -283,7 +284,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--parametrization",
-        choices=list(PARAMETRIZATIONS),
+        choices=PARAMETRIZATION_NAMES,
         default=None,
         help="what a search moves: the ARX coefficients (the paper), the "
         "denominator's reflection coefficients or modal frequencies and dampings "

@@ -154,9 +154,7 @@ def run(args, argv: list[str]) -> int:
 
 
 def add_parser(sub) -> None:
-    from spiralid.optim.pareto import PARETO_METHODS
-    from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS
-    from spiralid.sysid.estimation.pareto import OBJECTIVES
+    from spiralid.choices import OBJECTIVES, PARAMETRIZATION_NAMES, PARETO_METHOD_NAMES
 
     p = sub.add_parser(
         "pareto",
@@ -191,13 +189,13 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--method",
         type=str.lower,
-        choices=PARETO_METHODS,
+        choices=PARETO_METHOD_NAMES,
         default="ebsda",
         help="spiral rule of the search",
     )
     p.add_argument(
         "--parametrization",
-        choices=list(PARAMETRIZATIONS),
+        choices=PARAMETRIZATION_NAMES,
         default="modal",
         help="what the search moves (modal: the denominator's modes, numerator "
         "projected out)",

@@ -39,6 +39,7 @@ from collections.abc import Callable
 import numpy as np
 
 from spiralid._checks import box_bounds, generator, integer
+from spiralid.choices import PARETO_METHOD_NAMES, require_names
 from spiralid.optim._decomposition import (
     Archive,
     PollMoves,
@@ -107,11 +108,16 @@ def _parse_rule(method) -> SpiralRule | LearnedMetricSpiral:
 # The rules a multi-objective search can drive (by name): those that set each
 # point's radius and angle, and the learned-metric poll; not the step-rate
 # rules, whose step schedule belongs to a single centre.
-PARETO_METHODS = tuple(
-    name
-    for name in RULES
-    if isinstance(_parse_method(name), SpiralRule | LearnedMetricSpiral)
+require_names(
+    (
+        name
+        for name in RULES
+        if isinstance(_parse_method(name), SpiralRule | LearnedMetricSpiral)
+    ),
+    PARETO_METHOD_NAMES,
+    "spiralid.optim.pareto.PARETO_METHODS",
 )
+PARETO_METHODS = PARETO_METHOD_NAMES
 
 
 def _initial_points(gen, lo, hi, m: int, x0) -> np.ndarray:

@@ -29,6 +29,7 @@ from collections.abc import Callable
 import numpy as np
 
 from spiralid._checks import box_bounds, generator, integer, real_array
+from spiralid.choices import RULE_NAMES, require_names
 from spiralid.optim import _kernels
 from spiralid.optim._loop import (
     apply_bounds,
@@ -68,8 +69,9 @@ _METHODS = {
 # Rules whose output is right by construction (exact types: a subclass may
 # override __call__).
 _BUILTIN = (ConstantSpiral, ExponentialSpiral, LinearSpiral)
-# The one list of rule names: minimize() accepts them, and
-# spiralid.sysid.identify() offers each as an identification method.
+require_names(_METHODS, RULE_NAMES, "spiralid.optim.RULES")
+# The rules by name: minimize() accepts them, and spiralid.sysid.identify()
+# offers each as an identification method.
 RULES = _METHODS
 
 

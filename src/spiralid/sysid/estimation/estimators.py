@@ -81,6 +81,7 @@ from functools import partial
 import numpy as np
 
 from spiralid._checks import integer
+from spiralid.choices import DEFAULT_METHOD, METHOD_NAMES, require_names
 from spiralid.optim import RULES, differential_evolution, minimize
 from spiralid.optim.result import STATUS, OptimiserResult
 
@@ -599,4 +600,4 @@ METHODS: dict[str, Method] = {
     "oe": Method(_estimate_oe, search=False, narx=_narx.estimate_oe),
 }
 
-DEFAULT_METHOD = "spiral"
+require_names(METHODS, METHOD_NAMES, "spiralid.sysid.METHODS")

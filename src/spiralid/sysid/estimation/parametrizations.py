@@ -57,6 +57,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from spiralid.choices import PARAMETRIZATION_NAMES, require_names
+
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
 from ..models.polynomials import fold_reflection, step_down, step_up
@@ -276,6 +278,9 @@ PARAMETRIZATIONS: dict[str, type[Parametrization]] = {
     Reflection.name: Reflection,
     Modal.name: Modal,
 }
+require_names(
+    PARAMETRIZATIONS, PARAMETRIZATION_NAMES, "spiralid.sysid.PARAMETRIZATIONS"
+)
 
 
 def make_parametrization(name, data: IOData, arx: ARX) -> Parametrization:

@@ -64,6 +64,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spiralid._checks import generator, integer
+from spiralid.choices import OBJECTIVES
 from spiralid.optim.pareto import minimize_pareto, non_dominated
 
 from ..data import IOData
@@ -88,13 +89,6 @@ __all__ = [
     "knee_point",
 ]
 
-# Every objective by name, with its axis label.
-OBJECTIVES: dict[str, str] = {
-    "cost": "simulation cost, eq. (2) (% of rms(y))",
-    "frequency": "frequency-response error (dB, coherence-weighted RMS)",
-    "one-step": "one-step cost, eq. (2) (% of rms(y))",
-    "order": "parameters na + nb",
-}
 _SEEDS = ("ls", "steiglitz-mcbride", "oe")
 
 
