@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from patience import allowance
 
 cocoex = pytest.importorskip(
     "cocoex", reason="the bench extra (coco-experiment) is not installed"
@@ -67,6 +68,7 @@ def test_final_deltas_match_the_evaluated_costs(tmp_path, monkeypatch):
         assert deltas[key] == pytest.approx(value, rel=1e-8)
 
 
+@pytest.mark.slow
 def test_script_runs_at_reduced_size_and_cocopp_reads_its_data(tmp_path):
     out = tmp_path / "bbob"
     args = ["--dims", "2", "--functions", "1", "8", "15", "--instances", "1"]
@@ -76,7 +78,7 @@ def test_script_runs_at_reduced_size_and_cocopp_reads_its_data(tmp_path):
         capture_output=True,
         text=True,
         env=env,
-        timeout=600,
+        timeout=allowance(600),  # a safety net only, see patience.py
         check=False,
     )
     assert proc.returncode == 0, proc.stderr[-3000:]

@@ -75,6 +75,7 @@ def test_simulate_refuses_to_overwrite(rig_csv):
     assert rig_csv.read_bytes() == before
 
 
+@pytest.mark.slow
 def test_identify_then_validate(rig_csv, tmp_path):
     proc = run(
         "identify", rig_csv, "--budget", "400", "--out", tmp_path / "m", cwd=tmp_path
@@ -143,6 +144,7 @@ def test_identify_reads_mat_files(tmp_path):
     np.testing.assert_allclose(model["theta"], [-1.5, 0.7, 1.0, 0.5], atol=1e-9)
 
 
+@pytest.mark.slow
 def test_validate_refuses_data_at_another_sample_time(rig_csv, tmp_path):
     proc = run("identify", rig_csv, "--method", "ls", "--out", "m", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
@@ -154,6 +156,7 @@ def test_validate_refuses_data_at_another_sample_time(rig_csv, tmp_path):
     assert "sample time" in proc.stderr
 
 
+@pytest.mark.slow
 def test_reproduce_force_keeps_the_users_files(tmp_path):
     out = tmp_path / "rep"
     out.mkdir()
@@ -180,6 +183,7 @@ def test_identify_least_squares_on_the_real_arm(tmp_path):
     assert abs(val["fit_percent"] - 95.0) <= 1.0
 
 
+@pytest.mark.slow
 def test_identify_an_fir_model_with_the_default_method(tmp_path):
     # `--na 0` has no denominator for the modal search: the default method
     # solves the FIR model exactly, as output error does.
@@ -223,6 +227,7 @@ def _reproduce_ok(tmp_path, *extra):
     return results
 
 
+@pytest.mark.slow
 def test_reproduce_on_the_simulated_rig(tmp_path):
     results = _reproduce_ok(tmp_path)
     assert results["seeds"] == [0, 1]

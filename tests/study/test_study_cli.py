@@ -18,6 +18,7 @@ def run(*args, cwd):
     )
 
 
+@pytest.mark.slow
 def test_study_writes_store_and_report_then_resumes(small_spec, tmp_path):
     spec = small_spec()
     proc = run("study", spec, "--engine", "processes", "--workers", "2", cwd=tmp_path)
