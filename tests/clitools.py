@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from patience import allowance, slowness
+
 SCRIPT = Path(sys.executable).parent / "spiralid"
 
 
@@ -14,7 +16,11 @@ def cli_env(**extra) -> dict:
 
 
 def run(*args, cwd, env=None, timeout=600):
-    """Run ``spiralid ARGS`` in `cwd`; return the CompletedProcess."""
+    """Run ``spiralid ARGS`` in `cwd`; return the CompletedProcess.
+
+    `timeout` only stops a hang: seconds on an unloaded machine, scaled by
+    the machine's measured slowness (see patience.py)."""
+    timeout = allowance(timeout)
     return subprocess.run(
         [str(SCRIPT), *map(str, args)],
         cwd=cwd,
@@ -37,6 +43,7 @@ def start(*args, cwd, env=None, new_group=False) -> subprocess.Popen:
     """Start ``spiralid ARGS`` in `cwd` without waiting; with `new_group`,
     in a process group of its own (as a shell's job: Ctrl-C signals the
     whole group, workers included)."""
+    slowness()  # measured now, before the run competes with the measurement
     return subprocess.Popen(
         [str(SCRIPT), *map(str, args)],
         cwd=cwd,
