@@ -8,11 +8,11 @@ writes; an unwritable folder is refused before any computation.
 import os
 import signal
 import subprocess
-import time
 from pathlib import Path
 
 import pytest
 from clitools import SCRIPT, cli_env, run, start
+from patience import allowance, until, wait_for
 
 from spiralid import cli
 
@@ -20,16 +20,11 @@ REPRODUCE = ("reproduce", "--seeds", "1", "--budget", "300", "--points", "10")
 REPRODUCE += ("--workers", "1", "--quiet")
 
 
-def _wait_for(predicate, proc: subprocess.Popen, timeout: float = 120.0):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if predicate():
-            return
-        if proc.poll() is not None:
-            pytest.fail(f"the run ended first: {proc.communicate()}")
-        time.sleep(0.005)
-    proc.kill()
-    pytest.fail("timed out waiting")
+def _wait_for(predicate, proc: subprocess.Popen, what: str):
+    # The event, however long the run takes to reach it; the safety net
+    # (patience.py) only stops a run that hangs. The reproductions here take
+    # 5-30 s unloaded, ten times that on a loaded machine.
+    wait_for(predicate, what, proc=proc, seconds=300)
 
 
 def _staged_png(parent: Path) -> bool:
@@ -40,6 +35,11 @@ def _nothing_left(parent: Path) -> bool:
     return sorted(p.name for p in parent.iterdir()) == []
 
 
+def _locked(parent: Path):
+    return lambda: (parent / ".spiralid-lock-rep").exists()
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "sig, status, word",
     [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")],
@@ -48,9 +48,9 @@ def test_signal_while_writing_leaves_nothing_and_rerun_works(
     tmp_path, sig, status, word
 ):
     proc = start(*REPRODUCE, "--out", "rep", cwd=tmp_path)
-    _wait_for(lambda: _staged_png(tmp_path), proc)
+    _wait_for(lambda: _staged_png(tmp_path), proc, "a figure is staged")
     proc.send_signal(sig)
-    _, err = proc.communicate(timeout=120)
+    _, err = proc.communicate(timeout=allowance(120))
     assert proc.returncode == status, err
     assert err.strip().splitlines() == [f"spiralid reproduce: {word}"]
     assert _nothing_left(tmp_path)
@@ -59,25 +59,27 @@ def test_signal_while_writing_leaves_nothing_and_rerun_works(
     assert (tmp_path / "rep" / "report.html").is_file()
 
 
+@pytest.mark.slow
 def test_ctrl_c_while_computing_leaves_nothing(tmp_path):
     proc = start(*REPRODUCE, "--out", "rep", cwd=tmp_path)
-    _wait_for(lambda: (tmp_path / ".spiralid-lock-rep").exists(), proc)
+    _wait_for(_locked(tmp_path), proc, "the output is locked")
     proc.send_signal(signal.SIGINT)
-    proc.communicate(timeout=120)
+    proc.communicate(timeout=allowance(120))
     assert proc.returncode == 130
     assert _nothing_left(tmp_path)
 
 
+@pytest.mark.slow
 def test_two_concurrent_runs_one_writes_the_other_is_refused(tmp_path):
     first = start(*REPRODUCE, "--out", "rep", cwd=tmp_path)
-    _wait_for(lambda: (tmp_path / ".spiralid-lock-rep").exists(), first)
+    _wait_for(_locked(tmp_path), first, "the output is locked")
     second = run(*REPRODUCE, "--out", "rep", cwd=tmp_path)
     assert second.returncode == 2
     assert second.stderr.strip().splitlines() == [
         f"spiralid reproduce: error: another spiralid run is writing to "
         f"{str(tmp_path / 'rep')!r}; wait for it to finish or choose another output"
     ]
-    _, err = first.communicate(timeout=300)
+    _, err = first.communicate(timeout=allowance(600))
     assert first.returncode == 0, err
     # Done: the folder is full, and a third run needs --force.
     third = run(*REPRODUCE, "--out", "rep", cwd=tmp_path)
@@ -137,15 +139,47 @@ def _group_alive(pgid: int) -> list[int]:
     return [int(p) for p in found.stdout.split()]
 
 
-def _gone(pgid: int, timeout: float = 10.0) -> bool:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if not _group_alive(pgid):
-            return True
-        time.sleep(0.1)
-    return False
+def _gone(pgid: int) -> bool:
+    # The group empties as soon as every worker has noticed: at once for a
+    # worker that is computing (it dies with its parent), after its imports
+    # for one still starting, which a loaded machine stretches to seconds.
+    return until(lambda: not _group_alive(pgid), seconds=60, interval=0.1)
 
 
+def _catches(pid: int, signum: int) -> bool:
+    """Whether the main thread of `pid` has a handler for `signum` and does
+    not block it (its masks in /proc/PID/status)."""
+    try:
+        with open(f"/proc/{pid}/status") as fh:
+            masks = {k: v.strip() for k, _, v in (line.partition(":") for line in fh)}
+    except FileNotFoundError:
+        return False
+    bit = 1 << (signum - 1)
+    return bool(int(masks["SigCgt"], 16) & bit and not int(masks["SigBlk"], 16) & bit)
+
+
+def _in_the_command(pid: int) -> bool:
+    """The command's own code runs, inside its handling of Ctrl-C: its
+    SIGTERM handler is installed (spiralid.cli._interrupts; Python itself
+    does not catch SIGTERM) and it has started importing the library (NumPy
+    is mapped, which building the parser does not import)."""
+    if not _catches(pid, signal.SIGTERM):
+        return False
+    try:
+        return "_multiarray_umath" in Path(f"/proc/{pid}/maps").read_text()
+    except FileNotFoundError:
+        return False
+
+
+def _workers_computing(pid: int) -> bool:
+    """Both pool workers are up and the command has left the moment of
+    spawning them (spiralid.study.runner._children_ignore_sigint blocks and
+    ignores SIGINT meanwhile): the group holds the command, the resource
+    tracker and 2 workers, and the command catches SIGINT again."""
+    return len(_group_alive(pid)) >= 4 and _catches(pid, signal.SIGINT)
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("moment", ["start-up", "computing"])
 def test_ctrl_c_to_the_job_is_one_line_and_stops_every_worker(tmp_path, moment):
     # What a terminal's Ctrl-C does: SIGINT to every process of the job. (In
@@ -156,12 +190,13 @@ def test_ctrl_c_to_the_job_is_one_line_and_stops_every_worker(tmp_path, moment):
         # Importing the library, loading the record. (Before the first line
         # of our code runs, while the interpreter itself starts, a Ctrl-C is
         # Python's to report.)
-        time.sleep(0.3)
+        what = "the command imports the library"
+        _wait_for(lambda: _in_the_command(proc.pid), proc, what)
     else:
-        _wait_for(lambda: len(_group_alive(proc.pid)) >= 3, proc)  # tracker + 2
-        time.sleep(1.5)
+        what = "the workers compute"
+        _wait_for(lambda: _workers_computing(proc.pid), proc, what)
     os.killpg(proc.pid, signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
+    _, err = proc.communicate(timeout=allowance(120))
     assert proc.returncode == 130
     assert err.splitlines() == ["spiralid reproduce: interrupted"]
     assert _gone(proc.pid)
@@ -173,8 +208,7 @@ def test_ctrl_c_after_the_work_is_done_is_still_one_line(monkeypatch, capsys):
     # its way up: the command still ends with one line and status 130.
     def run(args, argv):
         try:
-            os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(0.1)
+            signal.raise_signal(signal.SIGINT)  # handled before it returns
         except KeyboardInterrupt:
             pass
         return 0
@@ -184,9 +218,10 @@ def test_ctrl_c_after_the_work_is_done_is_still_one_line(monkeypatch, capsys):
     assert capsys.readouterr().err.splitlines() == ["spiralid simulate: interrupted"]
 
 
+@pytest.mark.slow
 def test_kill_9_leaves_no_worker_and_the_next_run_tidies_up(tmp_path):
     proc = start(*POOLED, "--out", "rep", cwd=tmp_path, new_group=True)
-    _wait_for(lambda: len(_group_alive(proc.pid)) >= 3, proc)  # tracker + 2
+    _wait_for(lambda: _workers_computing(proc.pid), proc, "the workers compute")
     proc.kill()
     proc.wait()
     assert _gone(proc.pid)
@@ -212,6 +247,7 @@ def _stored_runs(path) -> int:
         return 0
 
 
+@pytest.mark.slow
 def test_study_on_dask_ctrl_c_is_one_line(tmp_path):
     pytest.importorskip("distributed")
     spec = run("study", "--show-default", cwd=tmp_path).stdout
@@ -224,9 +260,10 @@ def test_study_on_dask_ctrl_c_is_one_line(tmp_path):
     # importing is the known gap of spiralid.study.runner (a worker that has
     # not yet started ignoring it prints its own traceback), which a loaded
     # machine widens from milliseconds to seconds.
-    _wait_for(lambda: _stored_runs(tmp_path / "st" / "study.sqlite") > 0, proc)
+    store = tmp_path / "st" / "study.sqlite"
+    _wait_for(lambda: _stored_runs(store) > 0, proc, "a run is stored")
     os.killpg(proc.pid, signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
+    _, err = proc.communicate(timeout=allowance(120))
     assert proc.returncode == 130
     assert err.splitlines() == ["spiralid study: interrupted"]
     assert _gone(proc.pid)
