@@ -10,6 +10,8 @@ import os
 import subprocess
 import sys
 
+from patience import allowance
+
 SCRIPT = """
 import hashlib
 import spiralid as sid
@@ -46,6 +48,7 @@ def _env(threads: int | None) -> dict:
 
 def test_same_seed_same_bits_under_any_thread_setting():
     settings = [1, 2, 4, None]
+    hang = allowance(600)  # a safety net only, see patience.py
     procs = [
         subprocess.Popen(
             [sys.executable, "-c", SCRIPT],
@@ -58,7 +61,7 @@ def test_same_seed_same_bits_under_any_thread_setting():
     ]
     digests = {}
     for t, proc in zip(settings, procs, strict=True):
-        out, err = proc.communicate(timeout=600)
+        out, err = proc.communicate(timeout=hang)
         assert proc.returncode == 0, err
         digests[t] = out.strip()
     assert len(set(digests.values())) == 1, digests

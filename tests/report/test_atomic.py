@@ -7,6 +7,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
+from patience import allowance
 
 from spiralid.report.atomic import OutputError, OutputFile, OutputFolder
 
@@ -81,7 +82,7 @@ def test_lock_taken_in_another_process_is_refused(tmp_path):
         with pytest.raises(OutputError, match="another spiralid run is writing"):
             OutputFolder(tmp_path / "out").open()
     finally:
-        holder.communicate("\n", timeout=30)
+        holder.communicate("\n", timeout=allowance(30))
     assert _leftovers(tmp_path) == []
 
 

@@ -10,6 +10,7 @@ import subprocess
 
 import numpy as np
 import pytest
+from patience import allowance
 
 from spiralid.report import reproduce, write_reproduction
 
@@ -36,7 +37,7 @@ def _screenshot(page, png):
         ],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=allowance(120),  # a safety net only, see patience.py
     )
     assert proc.returncode == 0 and png.is_file(), proc.stderr[-2000:]
     from matplotlib.image import imread
