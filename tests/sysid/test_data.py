@@ -179,5 +179,12 @@ def test_values_that_overflow_or_vanish_when_squared_are_refused(scale):
 def test_non_utf8_csv_is_refused_clearly(tmp_path):
     p = tmp_path / "r.csv"
     p.write_bytes(b"\xff\xfe\x00\x01" * 10)
-    with pytest.raises(ValueError, match="is not a UTF-8 text"):
+    with pytest.raises(ValueError, match="is not a text CSV file"):
+        IOData.from_csv(p, ts=1.0)
+    # Text in another encoding: which byte, and how to convert it.
+    p.write_bytes("u,y\n1,2\n3,4 \u00b0\n".encode("latin-1"))
+    with pytest.raises(ValueError, match="not UTF-8 text \\(byte 0xb0 on line 3"):
+        IOData.from_csv(p, ts=1.0)
+    p.write_bytes("u,y\n1,2\n".encode("utf-16"))
+    with pytest.raises(ValueError, match="is UTF-16 text, not UTF-8"):
         IOData.from_csv(p, ts=1.0)

@@ -13,7 +13,13 @@ from pathlib import Path
 
 import numpy as np
 
-from spiralid.sysid.data import IOData
+from spiralid.sysid.data import (
+    IOData,
+    NoSampleTimeError,
+    _csv_column,
+    _csv_lookup,
+    _csv_table,
+)
 
 __all__ = ["read_record"]
 
@@ -84,8 +90,8 @@ def read_record(
         loader = IOData.from_npz if suffix == ".npz" else IOData.from_mat
         try:
             return loader(file, input=input, output=output, ts=ts)
-        except ValueError:
-            if ts is not None or default_ts is None:
+        except NoSampleTimeError:
+            if default_ts is None:
                 raise
             # The file carries no `ts`: fall back to the caller's default.
             return loader(file, input=input, output=output, ts=default_ts)
@@ -93,17 +99,15 @@ def read_record(
 
 
 def _read_csv(file: Path, input, output, ts, default_ts) -> IOData:
-    try:
-        with file.open(encoding="utf-8-sig") as fh:
-            header = [c.strip() for c in fh.readline().strip().split(",")]
-    except UnicodeDecodeError:
-        raise ValueError(f"data file {str(file)!r} is not a text CSV file") from None
+    header, rows = _csv_table(file)
+    header = header or []
     written_by_us = "torque_Nm" in header
     if input is None:
         input = "torque_Nm" if written_by_us else "u"
     if output is None:
         output = "end_acceleration_m_s2" if written_by_us else "y"
-    ts_file = _csv_sample_time(file, header) if "time_s" in header else None
+    time = _csv_lookup(header, "time_s", repr(str(file)))
+    ts_file = None if time is None else _csv_sample_time(file, rows, time)
     if (
         ts is not None
         and ts_file is not None
@@ -129,17 +133,30 @@ def _read_csv(file: Path, input, output, ts, default_ts) -> IOData:
     return data
 
 
-def _csv_sample_time(file: Path, header: list[str]) -> float:
-    """The step of an evenly spaced ``time_s`` column."""
-    t = np.loadtxt(
-        file,
-        delimiter=",",
-        skiprows=1,
-        usecols=[header.index("time_s")],
-        encoding="utf-8-sig",
-        ndmin=1,
-    )
+def _csv_sample_time(file: Path, rows: list, j: int) -> float:
+    """The step of the evenly spaced ``time_s`` column `j` of `rows`.
+
+    Every way the column can fail is said of the column, not of ``--ts``
+    (which the user did not give) or of IOData's `ts` it would become."""
+    where = f"the time_s column of {str(file)!r}"
+    t = _csv_column(rows, j, "time_s", repr(str(file)))
+    if t.size < 2:
+        raise ValueError(f"{where} needs at least 2 samples to give a sample time")
+    bad = ~np.isfinite(t)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"{where} must be finite; got {float(t[i])!r} on line {rows[i][0]}"
+        )
     steps = np.diff(t)
-    if t.size < 2 or not np.allclose(steps, steps[0], rtol=1e-6):
-        raise ValueError(f"the time_s column of {str(file)!r} is not evenly spaced")
+    back = steps <= 0
+    if back.any():
+        i = int(np.argmax(back))
+        raise ValueError(
+            f"{where} must increase from sample to sample; it goes from "
+            # + 0.0: a -0.0 says "0".
+            f"{t[i] + 0.0:g} to {t[i + 1] + 0.0:g} s on line {rows[i + 1][0]}"
+        )
+    if not np.allclose(steps, steps[0], rtol=1e-6):
+        raise ValueError(f"{where} is not evenly spaced")
     return float(steps.mean())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import codecs
 import csv
 import os
 from dataclasses import dataclass, field
@@ -22,9 +23,20 @@ def check_signal(x, name: str, min_size: int = 1) -> np.ndarray:
     already a float array.
     """
     try:
-        arr = np.asarray(x, dtype=float)
+        arr = np.asarray(x)
+        complex_ = arr.dtype.kind == "c"
+        if not complex_:
+            arr = arr.astype(float, copy=False)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"`{name}` must be a numeric 1-D signal; got {exc}") from None
+    if complex_:
+        # Casting would drop the imaginary part with only a ComplexWarning:
+        # whether the real part, the magnitude or the phase is the signal is
+        # the caller's to say.
+        raise ValueError(
+            f"`{name}` must be real-valued; got complex values (pass its real "
+            "part or magnitude, e.g. np.real(x) or np.abs(x))"
+        )
     if arr.ndim == 2 and arr.shape[1] == 1:
         arr = arr[:, 0]
     if arr.ndim != 1:
@@ -312,21 +324,8 @@ class IOData:
                 "got None"
             )
         where = repr(str(path))
-        try:
-            # utf-8-sig: a file saved by Excel starts with a byte-order mark.
-            with open(path, newline="", encoding="utf-8-sig") as fh:
-                rows = [r for r in csv.reader(fh, delimiter=delimiter) if r]
-        except UnicodeDecodeError:
-            raise ValueError(f"{where} is not a UTF-8 text (CSV) file") from None
-        if not rows:
-            raise ValueError(f"{where} is empty")
-        header = None
-        if not all(_is_number(c) for c in rows[0]):
-            header = [c.strip() for c in rows[0]]
-            rows = rows[1:]
-        ncol = len(header) if header is not None else len(rows[0])
-        # A column is named by its full header or by the name before its unit.
-        names = [_split_unit(h)[0] for h in header] if header else []
+        header, rows = _csv_table(path, delimiter)
+        ncol = len(header) if header is not None else len(rows[0][1])
 
         def column(key, argname):
             if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
@@ -341,36 +340,20 @@ class IOData:
                     f"`{argname}` must be a column index: {where} has no header "
                     f"line; got {key!r}"
                 )
-            elif key in header:
-                j = header.index(key)
-            elif key in names:
-                j = names.index(key)
             else:
-                raise ValueError(
-                    f"`{argname}` must be one of the columns {header}; got {key!r}"
-                )
+                j = _csv_lookup(header, key, where, argname)
+                if j is None:
+                    raise ValueError(
+                        f"`{argname}` must be one of the columns {header}; got {key!r}"
+                    )
             return j, *(_split_unit(header[j]) if header else (f"column {j}", ""))
 
         iu, name_u, unit_u = column(input, "input")
         iy, name_y, unit_y = column(output, "output")
-        first_row = 2 if header is not None else 1
-
-        def values(j, name):
-            out = np.empty(len(rows))
-            for r, row in enumerate(rows):
-                cell = row[j].strip() if j < len(row) else ""
-                try:
-                    out[r] = float(cell)
-                except ValueError:
-                    raise ValueError(
-                        f"column {name!r} of {where} must be numeric; got {cell!r} "
-                        f"on line {r + first_row}"
-                    ) from None
-            return out
 
         return cls(
-            values(iu, name_u),
-            values(iy, name_y),
+            _csv_column(rows, iu, name_u, where),
+            _csv_column(rows, iy, name_y, where),
             ts,
             name_u,
             name_y,
@@ -432,12 +415,34 @@ class IOData:
         ``ts=None`` reads the sample time from a scalar variable named ``ts``.
         """
         from scipy.io import loadmat
+        from scipy.io.matlab import MatReadError
 
+        where = repr(str(path))
+        try:
+            with open(path, "rb"):
+                pass
+        except OSError as exc:
+            raise ValueError(
+                f"{where} is not a readable .mat file ({exc.strerror or exc})"
+            ) from None
         try:
             raw = loadmat(path)
-        except (ValueError, TypeError, NotImplementedError, EOFError) as exc:
+        except NotImplementedError:
+            # What scipy raises for MATLAB's HDF5-based format.
             raise ValueError(
-                f"{str(path)!r} is not a readable .mat file ({exc})"
+                f"{where} is a MATLAB v7.3 file, which spiralid does not read; "
+                "save it with save(..., '-v7')"
+            ) from None
+        except (MatReadError, ValueError) as exc:
+            raise ValueError(
+                f"{where} is not a readable .mat file ({' '.join(str(exc).split())})"
+            ) from None
+        except Exception:
+            # SciPy's reader meets a truncated or corrupt file wherever its
+            # parsing fails (an OSError "could not read bytes", zlib.error,
+            # IndexError, KeyError...): none of them is a bug of ours.
+            raise ValueError(
+                f"{where} is not a readable .mat file (it is truncated or corrupt)"
             ) from None
         mat = {k: v for k, v in raw.items() if not k.startswith("__")}
         return cls._from_mapping(mat, input, output, ts, path)
@@ -452,19 +457,19 @@ class IOData:
                 )
         if ts is None:
             if "ts" not in mapping:
-                raise ValueError(
+                raise NoSampleTimeError(
                     f"`ts` must be given: {str(path)!r} has no variable 'ts' "
                     f"(variables: {names})"
                 )
-            ts = np.asarray(mapping["ts"], dtype=float).ravel()
-            if ts.size != 1:
-                raise ValueError(
-                    f"`ts` variable must be a scalar; got shape {ts.shape}"
-                )
-            ts = float(ts[0])
+            ts = _file_sample_time(mapping["ts"], path)
 
         def arr(key, arg):
             a = np.asarray(mapping[key])
+            if a.dtype.kind == "c":
+                raise ValueError(
+                    f"`{arg}` variable {key!r} of {str(path)!r} must be real-valued; "
+                    "got complex values (save its real part or magnitude instead)"
+                )
             if a.dtype.kind not in "fiub":
                 raise ValueError(
                     f"`{arg}` variable {key!r} must be numeric; got dtype {a.dtype} "
@@ -477,6 +482,135 @@ class IOData:
         return cls(
             arr(input, "input"), arr(output, "output"), ts, str(input), str(output)
         )
+
+
+def _csv_table(path, delimiter: str = ",") -> tuple[list[str] | None, list]:
+    """The header of a delimited text file (None when its first line is all
+    numbers) and its data rows, each as ``(line number, cells)``; blank
+    lines are skipped."""
+    where = repr(str(path))
+    try:
+        # utf-8-sig: a file saved by Excel starts with a byte-order mark.
+        with open(path, newline="", encoding="utf-8-sig") as fh:
+            reader = csv.reader(fh, delimiter=delimiter)
+            rows = [(reader.line_num, r) for r in reader if r]
+    except UnicodeDecodeError:
+        raise ValueError(_not_utf8(path)) from None
+    except csv.Error as exc:  # a NUL byte, a field beyond the csv module's limit
+        raise ValueError(f"{where} is not a text CSV file ({exc})") from None
+    if not rows:
+        raise ValueError(f"{where} is empty")
+    header = None
+    if not all(_is_number(c) for c in rows[0][1]):
+        header = [c.strip() for c in rows[0][1]]
+        rows = rows[1:]
+    return header, rows
+
+
+def _csv_lookup(header: list[str], key, where: str, argname: str = "") -> int | None:
+    """The index of the column `key` names: its whole header, else the name
+    before its unit; None when no column has that name.
+
+    A name that two columns share is refused rather than resolved to the
+    first: which of them the user meant is theirs to say."""
+    for names in (header, [_split_unit(h)[0] for h in header]):
+        found = [j for j, name in enumerate(names) if name == key]
+        if len(found) > 1:
+            how = f", or give `{argname}` as a column index" if argname else ""
+            which = ", ".join(map(str, found[:-1])) + f" and {found[-1]}"
+            raise ValueError(
+                f"{where} has {len(found)} columns named {key!r} (columns "
+                f"{which}, counting from 0): rename them so that each column "
+                f"has its own name{how}"
+            )
+        if found:
+            return found[0]
+    return None
+
+
+def _csv_column(rows: list, j: int, name: str, where: str) -> np.ndarray:
+    """Column `j` of `rows` (from :func:`_csv_table`) as floats; a cell that
+    is not a number is refused with its line."""
+    out = np.empty(len(rows))
+    for r, (line, row) in enumerate(rows):
+        cell = row[j].strip() if j < len(row) else ""
+        try:
+            out[r] = float(cell)
+        except ValueError:
+            raise ValueError(
+                f"column {name!r} of {where} must be numeric; got {cell!r} "
+                f"on line {line}"
+            ) from None
+    return out
+
+
+def _not_utf8(path) -> str:
+    """Why a file that UTF-8 cannot decode is refused, and how to fix it:
+    binary data, UTF-16, or text in a legacy 8-bit encoding."""
+    where = repr(str(path))
+    with open(path, "rb") as fh:
+        if _utf16_text(fh.read(1 << 16)):
+            return (
+                f"{where} is UTF-16 text, not UTF-8: save it as UTF-8 (in Excel: "
+                "'CSV UTF-8'), or convert it with iconv -f utf-16 -t utf-8"
+            )
+        fh.seek(0)
+        decoder = codecs.getincrementaldecoder("utf-8")()
+        line = 1
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            if b"\x00" in chunk:
+                break
+            try:
+                decoder.decode(chunk)
+            except UnicodeDecodeError as exc:
+                # Bytes held over from the previous chunk are part of one
+                # character, never a line break.
+                line += exc.object.count(b"\n", 0, exc.start)
+                return (
+                    f"{where} is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} "
+                    f"on line {line}, perhaps Latin-1 or Windows-1252): save it "
+                    "as UTF-8 (in Excel: 'CSV UTF-8'), or convert it with "
+                    "iconv -f latin1 -t utf-8"
+                )
+            line += chunk.count(b"\n")
+    return f"{where} is not a text CSV file (it holds binary data)"
+
+
+def _utf16_text(head: bytes) -> bool:
+    """Whether `head`, a file's first bytes, is delimited text in UTF-16 (as
+    Excel's "Unicode text" writes it): a byte-order mark, then characters
+    that decode and hold a line break or a delimiter."""
+    if head[:2] not in (b"\xff\xfe", b"\xfe\xff"):
+        return False
+    text = head[: len(head) // 2 * 2].decode("utf-16", errors="replace")
+    return "\ufffd" not in text[:-1] and any(c in text for c in ",;\t\n")
+
+
+class NoSampleTimeError(ValueError):
+    """A record file that carries no sample time, and none was given."""
+
+
+def _file_sample_time(value, path) -> float:
+    """A file's ``ts`` variable as a positive float.
+
+    Checked here rather than by IOData, whose message would blame the `ts`
+    argument for what the file holds."""
+    where = f"the variable 'ts' of {str(path)!r}"
+    a = np.asarray(value)
+    if a.dtype.kind not in "fiub":
+        what = "a complex value" if a.dtype.kind == "c" else "non-numeric data"
+        raise ValueError(
+            f"{where} must be a real number (the sample time in seconds); got {what}"
+        )
+    if a.size != 1:
+        raise ValueError(f"{where} must be a scalar; got shape {a.shape}")
+    ts = float(a.ravel()[0])
+    if not (np.isfinite(ts) and ts > 0):
+        raise ValueError(
+            f"{where} must be a positive number (the sample time in seconds); "
+            f"got {ts!r}"
+        )
+    return ts
 
 
 def _is_number(text: str) -> bool:
