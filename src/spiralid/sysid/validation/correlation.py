@@ -112,6 +112,14 @@ class CorrelationTest:
 def check_lags(lags, n: int) -> int:
     if isinstance(lags, bool) or not isinstance(lags, int | np.integer):
         raise ValueError(f"`lags` must be an integer; got {lags!r}")
+    if lags >= 1 and lags >= n:
+        # The record, not the number of lags, is what a user usually has
+        # wrong: say so first.
+        raise ValueError(
+            f"the record is too short for the residual tests: `lags` must be in "
+            f"[1, N - 1] = [1, {n - 1}] for a record of N = {n} samples; "
+            f"got {lags!r}"
+        )
     if not 1 <= lags < n:
         raise ValueError(
             f"`lags` must be in [1, N - 1] = [1, {n - 1}] for a record of "
