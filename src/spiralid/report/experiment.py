@@ -20,7 +20,14 @@ import numpy as np
 from spiralid.study.runner import execute
 from spiralid.study.spec import BASELINES
 from spiralid.study.tasks import reading_tasks
-from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
+from spiralid.sysid import (
+    ARX,
+    IdentifiedModel,
+    IOData,
+    PaperCost,
+    arx_least_squares,
+    identify,
+)
 from spiralid.sysid.estimation.estimators import search_options
 from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
 from spiralid.sysid.validation.validate import Validation, validate
@@ -341,6 +348,11 @@ def reproduce(
         )
     est, val = data.split(fraction)
     arx.check_length(est, "data")
+    # Every search scales its box from the least-squares estimate, and the
+    # workers' warm-up runs searches: a record that least squares refuses (a
+    # constant input, too little excitation) fails here, in this process,
+    # rather than in the initializer of every worker of a pool.
+    arx_least_squares(est, arx)
     if initial != "rest":
         # The modal parametrisation projects the numerator of the
         # simulation from rest only.
