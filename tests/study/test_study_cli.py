@@ -52,7 +52,8 @@ def test_show_default_prints_the_shipped_grid(tmp_path):
     [
         (
             ("seeds = 2", "seeds = 0"),
-            "seeds must be an integer >= 1",
+            # Quoted as the file writes it: no option of the command.
+            "'seeds' must be an integer >= 1",
         ),
         (('method = "sda"', 'method = "sdb"'), "unknown method 'sdb'"),
         (("[grid]", "[grid]\nspeed = 3"), "unknown key 'speed'"),

@@ -25,10 +25,16 @@ def _cmd_study(args, argv: list[str]) -> int:
     if args.show_default:
         print(DEFAULT_SPEC.read_text(encoding="utf-8"), end="")
         return 0
-    spec = load_spec(args.spec)
+    try:
+        spec = load_spec(args.spec)
+    except ValueError as exc:
+        raise _spec_error(exc) from None
     out = Path(args.out)
     store = Path(args.store) if args.store is not None else out / STUDY_STORE
     _check_study_dir(out, store, args.force)
+    # What the store's opening creates (the file and the folders above it),
+    # removed again if no run finishes.
+    fresh = [p for p in (store, *store.parents) if not p.exists()]
     if args.engine == "dask" and _dask_missing():
         raise UsageError(
             "the study command runs on Dask: pip install 'spiralid[study]' "
@@ -48,30 +54,88 @@ def _cmd_study(args, argv: list[str]) -> int:
         )
     finally:
         bar.close()
+    if run.failures and run.reused + run.computed == 0:
+        # Every run failed: a store of no run is no study, and a report of
+        # nothing would hide the one thing to say, why they failed.
+        _remove_fresh_store(fresh)
+        raise _failures_error(run)
     if not args.quiet:
         print(
             f"{run.total} runs: {run.reused} already in {store}, "
             f"{run.computed} computed now, {len(run.failures)} failed"
         )
     if not args.no_report:
-        _study_report(store, out, args, argv)
+        # The failures are the one line to say: no warning of missing runs.
+        _study_report(store, out, args, argv, warn=not run.failures)
     if run.failures:
-        task, message = run.failures[0]
-        raise UsageError(
-            f"{len(run.failures)} runs failed and were not stored (rerun to retry); "
-            f"first: {task.label} on {task.data}, {task.predictor}, seed "
-            f"{task.seed}: {message}"
-        )
+        raise _failures_error(run)
     return 0
 
 
-def _study_report(store: Path, out: Path, args, argv: list[str]) -> None:
-    from spiralid.report.study_output import study_summary, write_study_report
+def _spec_error(exc: ValueError) -> UsageError:
+    """A specification's error in the file's words: the keys it names are
+    the TOML file's, quoted as written, not the command's options (its
+    `ts` is not --ts)."""
+    return UsageError(str(exc).replace("`", "'"))
+
+
+def _failures_error(run) -> UsageError:
+    """How many runs failed, and the first one's reason."""
+    task, message = run.failures[0]
+    seed = "" if task.seed is None else f", seed {task.seed}"
+    return UsageError(
+        f"{len(run.failures)} of {run.total} runs failed and were not stored "
+        f"(rerun to retry); first: {task.label} on {task.data}, {task.predictor}"
+        f"{seed}: {message}"
+    )
+
+
+def _remove_fresh_store(fresh: list[Path]) -> None:
+    """Remove a store this command created (with SQLite's companions and its
+    lock) and the folders created for it, if they hold nothing else."""
+    if not fresh:
+        return
+    store = fresh[0]
+    for suffix in ("", "-journal", "-wal", "-shm", ".lock"):
+        store.with_name(store.name + suffix).unlink(missing_ok=True)
+    for folder in fresh[1:]:
+        try:
+            folder.rmdir()
+        except OSError:  # not empty: something else is in it now
+            break
+
+
+def _study_report(
+    store: Path, out: Path, args, argv: list[str], warn: bool = True
+) -> None:
+    """Analyse the store and write its report; `warn` says in a warning
+    when runs are missing (the report itself always says so)."""
+    import warnings
+
+    from spiralid.report.study_output import (
+        partial_note,
+        study_summary,
+        write_study_report,
+    )
     from spiralid.study import ResultStore, analyse, parse_spec
 
     with ResultStore.open(store, readonly=True) as db:
         rows, spec_text = db.rows(), db.meta().get("spec", "")
-    res = analyse(rows, parse_spec(spec_text, where=f"the specification in {store}"))
+    try:
+        spec = parse_spec(spec_text, where=f"the specification in {store}")
+    except ValueError as exc:
+        raise _spec_error(exc) from None
+    if not rows:
+        raise UsageError(
+            f"store {str(store)!r} holds no finished run: its study stopped "
+            f"before the first of its {spec.n_runs} runs finished; rerun the "
+            "study to compute them"
+        )
+    res = analyse(rows, spec)
+    # Before anything is written, so that a failure here writes nothing.
+    summary = study_summary(res)
+    if warn and res.missing_runs:
+        warnings.warn(partial_note(res), stacklevel=1)
     written = write_study_report(
         res,
         out,
@@ -80,12 +144,20 @@ def _study_report(store: Path, out: Path, args, argv: list[str]) -> None:
         command="spiralid " + shlex.join(argv),
     )
     if not args.quiet:
-        print(study_summary(res))
+        print(summary)
         print(f"\nwrote {', '.join(p.name for p in written)} in {out}")
 
 
 def _cmd_study_report(args, argv: list[str]) -> int:
     store = Path(args.store)
+    if store.is_dir():
+        inside = store / STUDY_STORE
+        hint = (
+            f"; give the store in it, {str(inside)!r}"
+            if inside.is_file()
+            else " (a study's store is its study.sqlite file)"
+        )
+        raise UsageError(f"store {args.store!r} is a folder, not a store file{hint}")
     if not store.is_file():
         raise UsageError(f"store {args.store!r} does not exist")
     out = Path(args.out) if args.out is not None else store.parent

@@ -46,7 +46,8 @@ def convergence_bands(res: StudyResults) -> Figure:
                 ax.fill_between(k, lo, hi, color=color, alpha=0.25, linewidth=0)
             ax.set_yscale("log")
             ax.set_title(f"{data}, {pred}, {par}", fontsize=9)
-            ax.legend(fontsize=7, loc="upper right")
+            if ax.get_legend_handles_labels()[0]:  # empty in a partial study
+                ax.legend(fontsize=7, loc="upper right")
             if j == 0:
                 ax.set_ylabel("best cost (% RMS error)")
             if i == len(rows) - 1:
@@ -122,9 +123,14 @@ def claim_effects(res: StudyResults) -> Figure:
 
 
 def study_figures(res: StudyResults) -> dict[str, Figure]:
-    """Every study figure by file stem."""
-    return {
-        "study_convergence": convergence_bands(res),
-        "study_claim_a12": claim_effects(res),
-        **({"study_anytime": anytime_ecdf(res)} if res.anytime.get("rows") else {}),
-    }
+    """Every study figure by file stem; those of a partly run study without
+    anything to draw (no search run yet, no reading with both labels of the
+    claim) are left out."""
+    figures = {}
+    if res.readings:
+        figures["study_convergence"] = convergence_bands(res)
+    if res.claims:
+        figures["study_claim_a12"] = claim_effects(res)
+    if res.anytime.get("rows"):
+        figures["study_anytime"] = anytime_ecdf(res)
+    return figures

@@ -16,7 +16,13 @@ from spiralid.report.output import versions
 from spiralid.study import StudyResults
 from spiralid.study.spec import BASELINES
 
-__all__ = ["STUDY_FILES", "study_results_dict", "study_summary", "write_study_report"]
+__all__ = [
+    "STUDY_FILES",
+    "partial_note",
+    "study_results_dict",
+    "study_summary",
+    "write_study_report",
+]
 
 STUDY_FILES = (
     "results.json",
@@ -177,21 +183,43 @@ def anytime_summary(res: StudyResults) -> str:
     return "\n".join(lines)
 
 
+def partial_note(res: StudyResults) -> str:
+    """What a report of a partly run study covers; empty when no run is
+    missing."""
+    if not res.missing_runs:
+        return ""
+    return (
+        f"the store holds {res.stored_runs} of the study's {res.expected_runs} "
+        f"runs ({res.missing_runs} missing: the study stopped early or runs "
+        "failed); this report covers the stored runs only; rerun the study "
+        "to compute the rest"
+    )
+
+
+def _verdict_count(res: StudyResults) -> str:
+    a, b = res.claim
+    if not res.claims:
+        return f"No reading has runs of both {a} and {b} yet: nothing to test."
+    wins = [c for c in res.claims if c["verdict"] == f"{a} better"]
+    return (
+        f"{a} is significantly better than {b} on {len(wins)} of "
+        f"{len(res.claims)} readings."
+    )
+
+
 def study_summary(res: StudyResults) -> str:
     """The "where the claim holds" table as text."""
     a, b = res.claim
-    lines = [
+    note = partial_note(res)
+    lines = [f"Partial study: {note}.", ""] if note else []
+    lines += [
         f"Where the claim holds: {a} against {b}, estimation cost over seeds "
         f"(rank-sum test, Holm-adjusted over {len(res.claims)} readings, "
         f"alpha = {res.alpha:g}; A12 > 0.5 favours {a})",
         "",
         table(_claim_head(res), _claim_rows(res)),
-    ]
-    wins = [c for c in res.claims if c["verdict"] == f"{a} better"]
-    lines += [
         "",
-        f"{a} is significantly better than {b} on {len(wins)} of "
-        f"{len(res.claims)} readings.",
+        _verdict_count(res),
     ]
     anytime = anytime_summary(res)
     if anytime:
@@ -207,6 +235,7 @@ def study_results_dict(res: StudyResults, spec_text: str, command=None) -> dict:
         "specification": spec_text,
         "claim": list(res.claim),
         "alpha": res.alpha,
+        "runs": {"stored": res.stored_runs, "expected": res.expected_runs},
         "claims": res.claims,
         "anytime": {
             "budgets": res.anytime.get("budgets", []),
@@ -272,8 +301,14 @@ def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
         "configurations' costs per reading; the p-values are Holm-adjusted over "
         "all readings; A12 is the probability that a run of "
         f"{e(a)} ends below a run of {e(b)}.</p>",
+    ]
+    note = partial_note(res)
+    if note:
+        parts.append(f"<p><strong>Partial study:</strong> {e(note)}.</p>")
+    parts += [
         "<h2>Where the claim holds</h2>",
         table(_claim_head(res), _claim_rows(res), "html"),
+        f"<p>{e(_verdict_count(res))}</p>",
     ]
     if res.anytime.get("rows"):
         flips = _crossover_lines(res)

@@ -48,6 +48,11 @@ class StudyResults:
         specification.
     claim : (str, str)
     alpha : float
+    stored_runs : int
+        Rows analysed, baselines included.
+    expected_runs : int or None
+        Runs of the specification (None without it); more than
+        `stored_runs` when the study stopped early or runs failed.
     """
 
     readings: list[Reading]
@@ -58,6 +63,15 @@ class StudyResults:
     claim: tuple[str, str] = CLAIM
     alpha: float = 0.05
     anytime: dict = field(default_factory=dict)
+    stored_runs: int = 0
+    expected_runs: int | None = None
+
+    @property
+    def missing_runs(self) -> int:
+        """Runs of the specification that the store does not hold."""
+        if self.expected_runs is None:
+            return 0
+        return max(self.expected_runs - self.stored_runs, 0)
 
     def statistics(self, reading: Reading, label: str) -> dict:
         """Median, best, worst and quartiles of cost; median fit and time."""
@@ -149,7 +163,14 @@ def analyse(
         if r["seed"] is None:
             baselines.setdefault((r["data"], r["predictor"]), {})[r["label"]] = r
     res = StudyResults(
-        readings, labels, cells, baselines, claim=tuple(claim), alpha=alpha
+        readings,
+        labels,
+        cells,
+        baselines,
+        claim=tuple(claim),
+        alpha=alpha,
+        stored_runs=len(rows),
+        expected_runs=None if spec is None else spec.n_runs,
     )
     tested = [
         rd for rd in readings if (rd, claim[0]) in cells and (rd, claim[1]) in cells

@@ -124,6 +124,8 @@ def budget_verdicts(cells: dict, readings, claim, full_budget: int, n_points: in
             )
     return {
         "budgets": ladder,
+        # What the histories' evaluation counts are read with (the figures).
+        "n_points": n_points,
         "family": len(rows),
         "rows": rows,
         "crossovers": crossovers,

@@ -17,6 +17,7 @@ import hashlib
 import json
 import tomllib
 from dataclasses import dataclass, field
+from math import inf
 from pathlib import Path
 from typing import Any
 
@@ -130,6 +131,13 @@ class StudySpec:
     baselines: tuple[str, ...] = _BASELINES
     source: str = ""
 
+    @property
+    def n_runs(self) -> int:
+        """Runs of the study, baselines included (as many as
+        :func:`~spiralid.study.study_tasks` lists)."""
+        searches = len(self.parametrizations) * len(self.optimizers) * len(self.seeds)
+        return len(self.data) * len(self.predictors) * (len(self.baselines) + searches)
+
     def digest(self) -> str:
         """A hash of everything that decides the runs' results."""
         payload = {
@@ -234,6 +242,10 @@ def _data(entry: Any, base: Path | None, where: str) -> DataSpec:
     if not isinstance(name, str) or not name:
         _fail(where, f"[[data]] `name` must be a non-empty string; got {name!r}")
     settings = {k: v for k, v in entry.items() if k not in ("name", "kind")}
+    ts = settings.get("ts", 1.0)
+    if isinstance(ts, bool) or not isinstance(ts, int | float) or not 0 < ts < inf:
+        # Here, naming the record: IOData would blame its own `ts` argument.
+        _fail(where, f"[[data]] {name!r}: `ts` must be a number > 0; got {ts!r}")
     if kind == "csv":
         if "path" not in settings:
             _fail(where, f"[[data]] {name!r} of kind 'csv' needs a `path`")

@@ -66,15 +66,31 @@ class ResultStore:
         if readonly:
             if not self.path.is_file():
                 raise ValueError(f"store {str(self.path)!r} does not exist")
+            if self.path.stat().st_size == 0:
+                raise ValueError(
+                    f"store {str(self.path)!r} is an empty file, not a spiralid store"
+                )
             uri = f"file:{self.path.resolve()}?mode=ro"
             self._db = self._connect(uri, uri=True)
+            if "runs" not in self._tables():
+                self.close()
+                raise ValueError(
+                    f"store {str(self.path)!r} is not a spiralid store: it is an "
+                    "SQLite database without a table of runs"
+                )
             return
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        lock_path = self._lock_path()
+        fresh_lock = not lock_path.exists()
         self._lock()
         try:
             self._db = self._connect(str(self.path))
             self._init(digest, spec_text)
         except BaseException:
+            if fresh_lock:
+                # Refused (a file that is not a store, another
+                # specification's store): leave nothing beside it.
+                lock_path.unlink(missing_ok=True)
             self.close()
             raise
 
@@ -93,8 +109,15 @@ class ResultStore:
             ) from None
         return db
 
+    def _tables(self) -> set[str]:
+        query = "SELECT name FROM sqlite_master WHERE type = 'table'"
+        return {name for (name,) in self._db.execute(query)}
+
+    def _lock_path(self) -> Path:
+        return self.path.with_name(self.path.name + ".lock")
+
     def _lock(self) -> None:
-        lock_path = self.path.with_name(self.path.name + ".lock")
+        lock_path = self._lock_path()
         fh = open(lock_path, "a+")  # held until close()
         try:
             fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -113,6 +136,14 @@ class ResultStore:
         self._lock_file = fh
 
     def _init(self, digest: str, spec_text: str) -> None:
+        tables = self._tables()
+        if tables - {"meta", "runs"}:
+            # Someone else's database: adding our tables to it would be
+            # writing into their file.
+            raise ValueError(
+                f"store {str(self.path)!r} is not a spiralid store: it is an "
+                f"SQLite database of something else (tables: {sorted(tables)})"
+            )
         with self._db:
             self._db.execute(
                 "CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT)"

@@ -109,7 +109,10 @@ def load_records(spec: StudySpec) -> dict:
             est, _ = data.split(spec.fraction)
             arx.check_length(est, f"the estimation part of record {d.name!r}")
         except (ValueError, OSError, TypeError) as exc:
-            message = " ".join(str(exc).split())
+            # The names the reader's message gives are keys of the record's
+            # [[data]] table (input, output, ts, path), quoted as the file
+            # writes them, not arguments of ours.
+            message = " ".join(str(exc).split()).replace("`", "'")
             raise ValueError(f"record {d.name!r} ({d.kind}): {message}") from None
         records[d.name] = data
     return records
