@@ -70,6 +70,7 @@ def files(tmp_path, monkeypatch):
     (tmp_path / "notjson.json").write_text("this is not json")
     bad_theta = {**model.to_dict(), "theta": [1e400, 0, 0, 0]}
     (tmp_path / "inf_theta.json").write_text(json.dumps(bad_theta))
+    _round3_files(tmp_path, u, y)
     # What the user already has: never touched by a failed run.
     (tmp_path / "full").mkdir()
     (tmp_path / "full" / "notes.txt").write_text("mine")
@@ -150,6 +151,51 @@ CASES = [
     ("reproduce --data ok.csv --ts 0.01 --out full", "is not empty"),
     ("reproduce --data missing.csv", "does not exist"),
     ("frobnicate", "invalid choice"),
+    # fault round 3: data, reproduce, study
+    ("identify notmat.mat --ts 0.1", "'notmat.mat' is not a readable .mat file"),
+    ("identify half.mat --ts 0.1", "'half.mat' is not a readable .mat file"),
+    (
+        "identify badtime.csv",
+        "column 'time_s' of 'badtime.csv' must be numeric; got 'abc' on line 5",
+    ),
+    (
+        "identify gaptime.csv",
+        "column 'time_s' of 'gaptime.csv' must be numeric; got '' on line 5",
+    ),
+    ("identify backtime.csv", "the time_s column of 'backtime.csv' must increase"),
+    ("identify flattime.csv", "the time_s column of 'flattime.csv' must increase"),
+    (
+        "reproduce --data const.csv --ts 0.01 --workers 2",
+        "the data has a constant input (1.0)",
+    ),
+    (
+        "reproduce --data const.csv --ts 0.01 --workers 1",
+        "the data has a constant input (1.0)",
+    ),
+    ("study-report folder.csv", "'folder.csv' is a folder, not a store file"),
+    (
+        "study flat.toml --engine local",
+        "3 of 3 runs failed and were not stored (rerun to retry); first: LS on "
+        "flat, simulation-rest: the data has a constant input",
+    ),
+    ("study negts.toml --engine local", "[[data]] 'flat': 'ts' must be a number > 0"),
+    ("study badinput.toml", "record 'flat' (csv): 'input' must be one of the columns"),
+    (
+        "identify latin1.csv --ts 0.01",
+        "'latin1.csv' is not UTF-8 text (byte 0xb0 on line 1, perhaps Latin-1 or "
+        "Windows-1252): save it as UTF-8",
+    ),
+    ("identify three.csv --ts 0.01 --method ls --na 0 --nb 1", "too short"),
+    ("validate model.json three.csv --ts 0.01", "the record is too short"),
+    (
+        "identify dup.csv --ts 0.01",
+        "'dup.csv' has 2 columns named 'u' (columns 0 and 2",
+    ),
+    ("identify dup.csv --ts 0.01 --output 1", "'dup.csv' has 2 columns named 'u'"),
+    (
+        "identify complex.npz",
+        "--input variable 'u' of 'complex.npz' must be real-valued",
+    ),
 ]
 
 
@@ -366,3 +412,175 @@ def test_degenerate_models_get_order_advice():
     plain = IdentifiedModel([-1.5, 0.7, 1.0, 0.5], arx=ARX(2, 2, 1), ts=0.01,
                             method="ls")  # fmt: skip
     assert validate(plain, data).order_advice is None
+
+
+# -- third fault round: data files, reproduce, study stores -------------------
+
+_SPEC = """
+[study]
+seeds = {seeds}
+budget = 40
+points = 10
+na = 2
+nb = 2
+nk = 1
+baselines = {baselines}
+[grid]
+predictors = ["simulation-rest"]
+parametrizations = ["coefficients"]
+[[data]]
+name = "flat"
+kind = "csv"
+path = "{path}"
+{extra}
+{optimizers}
+"""
+_SDA = '[[optimizer]]\nlabel = "SDA"\nmethod = "sda"'
+_EBSDA = '[[optimizer]]\nlabel = "Eb-SDA"\nmethod = "ebsda"'
+
+
+def _spec(seeds=1, baselines='["ls", "oe"]', path="const.csv", extra="ts = 0.01",
+          optimizers=_SDA):  # fmt: skip
+    return _SPEC.format(seeds=seeds, baselines=baselines, path=path, extra=extra,
+                        optimizers=optimizers)  # fmt: skip
+
+
+def _round3_files(folder, u, y):
+    """The records and study files of the third round, in the `files` folder."""
+    import io
+
+    from scipy.io import savemat
+
+    t = [i * 0.02 for i in range(600)]
+    for name, time in {
+        "badtime.csv": [*t[:3], "abc", *t[4:]],
+        "gaptime.csv": [*t[:3], "", *t[4:]],
+        "backtime.csv": [-v for v in t],
+        "flattime.csv": [1.0] * 600,
+    }.items():
+        _csv(folder / name, {"time_s": time, "u": u, "y": y})
+    _csv(folder / "latin1.csv", {"u (\xb0C)": u, "y": y}, encoding="latin-1")
+    _csv(folder / "three.csv", {"u": u[:3], "y": y[:3]})
+    rows = "".join(f"{a},{b},{2 * a}\n" for a, b in zip(u, y, strict=True))
+    (folder / "dup.csv").write_text("u,y,u\n" + rows)
+    np.savez(folder / "complex.npz", u=np.array(u) * (1 + 1j), y=np.array(y), ts=0.1)
+    (folder / "notmat.mat").write_text("not a mat")
+    whole = io.BytesIO()
+    savemat(whole, {"u": np.array(u), "y": np.array(y), "ts": 0.1})
+    (folder / "half.mat").write_bytes(whole.getvalue()[: len(whole.getvalue()) // 2])
+    (folder / "flat.toml").write_text(_spec())
+    (folder / "negts.toml").write_text(_spec(extra="ts = -1"))
+    (folder / "badinput.toml").write_text(_spec(extra='ts = 0.01\ninput = "torque"'))
+
+
+@pytest.fixture
+def stores(files):
+    """A study's complete store (4 runs), copies of it killed at 0 and at 3
+    rows, a SQLite file of something else and an empty file."""
+    import shutil
+    import sqlite3
+
+    from spiralid.study import load_spec, run_study
+
+    both = f"{_EBSDA}\n{_SDA}"
+    (files / "ok.toml").write_text(
+        _spec(seeds=2, baselines="[]", path="ok.csv", optimizers=both)
+    )
+    run = run_study(load_spec(files / "ok.toml"), files / "study" / "study.sqlite",
+                    engine="local")  # fmt: skip
+    assert (run.computed, run.failures) == (4, [])
+    for name, keep in (("killed", 0), ("partial", 3)):
+        (files / name).mkdir()
+        copy = files / name / "study.sqlite"
+        shutil.copy(files / "study" / "study.sqlite", copy)
+        with sqlite3.connect(copy) as db:
+            keys = [k for (k,) in db.execute("SELECT key FROM runs ORDER BY key")]
+            db.executemany(
+                "DELETE FROM runs WHERE key = ?", [(k,) for k in keys[keep:]]
+            )
+        db.close()
+    db = sqlite3.connect(files / "other.sqlite")
+    db.execute("CREATE TABLE notes (text TEXT)")
+    db.close()
+    (files / "empty.sqlite").write_bytes(b"")
+    return files
+
+
+STORE_FAULTS = [
+    ("study-report killed/study.sqlite", "holds no finished run: its study stopped "
+     "before the first of its 4 runs finished"),
+    ("study-report other.sqlite", "'other.sqlite' is not a spiralid store"),
+    ("study-report empty.sqlite", "'empty.sqlite' is an empty file"),
+    ("study-report study", "'study' is a folder, not a store file; give the store "
+     "in it, 'study/study.sqlite'"),
+    ("study ok.toml --store other.sqlite", "'other.sqlite' is not a spiralid store"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("line, words", STORE_FAULTS, ids=[c[0] for c in STORE_FAULTS])
+def test_bad_stores_end_in_one_line_and_write_nothing(stores, capsys, line, words):
+    argv = [*line.split(), "--out", "rep"]
+    if argv[0] == "study":
+        argv += ["--engine", "local"]
+    before = _state(stores)
+    assert cli.main(argv) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"spiralid {argv[0]}: error: ")
+    assert words in lines[0], lines[0]
+    assert "Traceback" not in err and "warning" not in err and out == ""
+    assert _state(stores) == before
+
+
+def test_a_partial_store_is_reported_with_what_is_missing(stores, capsys):
+    argv = ["study-report", "partial/study.sqlite", "--out", "rep"]
+    assert cli.main(argv) == 0
+    out, err = capsys.readouterr()
+    assert err.strip().splitlines() == [
+        "spiralid study-report: warning: the store holds 3 of the study's 4 runs "
+        "(1 missing: the study stopped early or runs failed); this report covers "
+        "the stored runs only; rerun the study to compute the rest"
+    ]
+    assert out.startswith("Partial study: the store holds 3 of the study's 4 runs")
+    results = json.loads((stores / "rep" / "results.json").read_text())
+    assert results["runs"] == {"stored": 3, "expected": 4}
+    assert "Partial study:" in (stores / "rep" / "report.html").read_text()
+    # --quiet: the same files, nothing said.
+    assert cli.main([*argv[:-1], "rep2", "--quiet"]) == 0
+    assert capsys.readouterr() == ("", "")
+    assert {p.name for p in (stores / "rep2").iterdir()} == {
+        p.name for p in (stores / "rep").iterdir()
+    }
+    # The complete store: no word of missing runs.
+    assert cli.main(["study-report", "study/study.sqlite", "--out", "rep3"]) == 0
+    out, err = capsys.readouterr()
+    assert err == "" and "Partial" not in out
+    assert "Partial" not in (stores / "rep3" / "report.html").read_text()
+
+
+def test_library_errors_of_round_3_name_the_argument(files):
+    from spiralid.datasets import read_record
+
+    with pytest.raises(ValueError, match="`u` must be real-valued; got complex"):
+        IOData(np.ones(5) * 1j, np.ones(5), ts=1.0)
+    with pytest.raises(ValueError, match="`y` must be real-valued"):
+        IOData(np.ones(5), np.ones(5, dtype=complex), ts=1.0)
+    with pytest.raises(ValueError, match=r"`input` variable 'u' of .* real-valued"):
+        IOData.from_npz(files / "complex.npz")
+    with pytest.raises(ValueError, match=r"dup.csv' has 2 columns named 'u'.*`input`"):
+        IOData.from_csv(files / "dup.csv", ts=1.0)
+    # By index, the duplicated name is no question.
+    assert IOData.from_csv(files / "dup.csv", input=2, ts=1.0).input_name == "u"
+    with pytest.raises(ValueError, match=r"half.mat' is not a readable .mat file"):
+        IOData.from_mat(files / "half.mat")
+    with pytest.raises(ValueError, match=r"the time_s column of .*must increase"):
+        read_record(files / "flattime.csv")
+    with pytest.raises(ValueError, match=r"not UTF-8 text \(byte 0xb0 on line 1"):
+        IOData.from_csv(files / "latin1.csv", ts=1.0)
+    np.savez(files / "negts.npz", u=np.ones(5), y=np.ones(5), ts=-1.0)
+    with pytest.raises(ValueError, match=r"the variable 'ts' of .*negts.npz' must be"):
+        read_record(files / "negts.npz")
+    # A file's bad ts is refused, not replaced by the caller's default.
+    with pytest.raises(ValueError, match="the variable 'ts'"):
+        read_record(files / "negts.npz", default_ts=0.5)
+    assert read_record(files / "nots.npz", default_ts=0.5).ts == 0.5
