@@ -10,11 +10,14 @@ import math
 
 import numpy as np
 
+from spiralid._checks import positive
+
 # Every stop message comes from here, so `message` is always one of these
 # (plus the notes below).
 STOPS = {
     "max_iter": "Maximum number of iterations reached.",
     "max_nfev": "Maximum number of function evaluations reached.",
+    "max_time": "The time limit (max_time) was passed.",
     "target": "Target cost reached.",
     "callback": "The callback requested a stop.",
     "running": "In progress.",
@@ -28,7 +31,14 @@ NOTES = {
     "target_missed": "The target cost was not reached.",
 }
 # The STATUS key (spiralid.optim.result) of each way a search stops.
-STATUS_CODE = {"max_iter": 2, "max_nfev": 1, "target": 0, "callback": 0, "running": 0}
+STATUS_CODE = {
+    "max_iter": 2,
+    "max_nfev": 1,
+    "max_time": 3,
+    "target": 0,
+    "callback": 0,
+    "running": 0,
+}
 POLICIES = ("none", "clip", "reflect")
 
 
@@ -95,12 +105,21 @@ def stop_report(status: str, fun: float, target, initial_nonfinite: bool) -> dic
         notes.append(NOTES["never_finite"])
     if status != "running" and not reached and finite:
         notes.append(NOTES["target_missed"])
-    success = status in ("max_iter", "max_nfev", "target") and finite and reached
+    # A budget used up (evaluations, iterations or time) is a search that
+    # ended as asked.
+    success = (
+        status in ("max_iter", "max_nfev", "max_time", "target") and finite and reached
+    )
     return {
         "status": STATUS_CODE[status],
         "success": success,
         "message": " ".join(notes),
     }
+
+
+def check_max_time(max_time) -> float | None:
+    """`max_time` in seconds (None: no limit), or a ValueError naming it."""
+    return None if max_time is None else positive(max_time, "max_time")
 
 
 def point_in_box(x, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:

@@ -46,6 +46,7 @@ from spiralid.optim._decomposition import (
     SpiralMoves,
     Subproblems,
 )
+from spiralid.optim._loop import STOPS, check_max_time
 from spiralid.optim.front import (
     hypervolume,
     non_dominated,
@@ -155,6 +156,7 @@ def minimize_pareto(
     *,
     n_points: int = 100,
     max_nfev: int = 10_000,
+    max_time: float | None = None,
     neighbours: int = 10,
     archive: bool = True,
     ref_point=None,
@@ -185,6 +187,11 @@ def minimize_pareto(
         simplex lattice that fits), and the most points the result holds.
     max_nfev : int
         Budget of objective evaluations (at least two populations).
+    max_time : float, optional
+        Wall-time limit in seconds (a finite number > 0; default None, no
+        limit), checked after each iteration as in
+        :func:`spiralid.optim.minimize`: the search ends after the
+        iteration during which it passed.
     neighbours : int
         Subproblems whose incumbents a point may take as its centre and
         replace.
@@ -217,7 +224,8 @@ def minimize_pareto(
         subproblem's incumbent, ``weights``, ``ref_point``, ``history`` (the
         hypervolume of the archive, or of the non-dominated incumbents,
         after the initial population and each iteration), ``status`` (1
-        when the budget ended it, 0 the callback), ``nit``, ``nfev``,
+        when the budget ended it, 3 the time limit, 0 the callback),
+        ``message``, ``nit``, ``nfev``,
         ``n_restarts`` (points, or polls, started again), ``elapsed``.
 
     Examples
@@ -235,6 +243,7 @@ def minimize_pareto(
     rule = _parse_rule(method)
     m = integer(n_points, "n_points", 4)
     max_nfev = integer(max_nfev, "max_nfev", 2 * m)
+    max_time = check_max_time(max_time)
     neighbours = integer(neighbours, "neighbours", 2)
     if not isinstance(archive, bool):
         raise ValueError(f"`archive` must be True or False; got {archive!r}")
@@ -283,6 +292,9 @@ def minimize_pareto(
             if callback(OptimiserResult(x=x_now, fun=f_now, nit=nit)):
                 status = 0
                 break
+        if max_time is not None and time.perf_counter() - t_start > max_time:
+            status = 3
+            break
     x_front, f_front = store.final() if store is not None else front()
     return OptimiserResult(
         x=x_front,
@@ -293,11 +305,7 @@ def minimize_pareto(
         ref_point=ref,
         status=status,
         success=True,
-        message=(
-            "The callback requested a stop."
-            if status == 0
-            else "Maximum number of function evaluations reached."
-        ),
+        message=STOPS[{0: "callback", 1: "max_nfev", 3: "max_time"}[status]],
         nit=nit,
         nfev=nfev,
         n_restarts=moves.n_restarts,

@@ -20,6 +20,7 @@ STATUS = {
     0: "Finished: exact, converged, or stopped by the target or the callback.",
     1: "Stopped at the evaluation cap (max_nfev).",
     2: "Stopped at the iteration cap (max_iter).",
+    3: "Stopped after the iteration that passed the time limit (max_time).",
 }
 
 

@@ -34,6 +34,7 @@ from spiralid.optim import _kernels
 from spiralid.optim._loop import (
     apply_bounds,
     check_costs,
+    check_max_time,
     check_objective,
     check_policy,
     finite_or_inf,
@@ -396,7 +397,7 @@ class SpiralSearch:
         :class:`~spiralid.optim.result.OptimiserResult` (see :func:`minimize`).
 
         ``status`` is a key of the stop-message table: "max_iter",
-        "max_nfev", "target", "callback" or "running".
+        "max_nfev", "max_time", "target", "callback" or "running".
         """
         return OptimiserResult(
             x=self.x,
@@ -430,6 +431,7 @@ def minimize(
     n_points: int = 50,
     max_iter: int = 500,
     max_nfev: int | None = None,
+    max_time: float | None = None,
     target: float | None = None,
     rng=None,
     vectorized: bool = False,
@@ -474,6 +476,12 @@ def minimize(
         Budget of objective evaluations (``>= n_points``). The search stops
         before an iteration that would exceed it, so ``nfev <= max_nfev``.
         See Returns for how evaluations are counted.
+    max_time : float, optional
+        Wall-time limit in seconds (a finite number > 0; default None, no
+        limit). Checked after each iteration: the search ends after the
+        iteration during which the limit passed, so it overruns by up to
+        one iteration. Where a time limit stops it, the result is not
+        reproducible from the seed alone.
     target : float, optional
         Stop as soon as the best cost is at or below ``target``.
     rng : None, int or numpy.random.Generator
@@ -512,9 +520,10 @@ def minimize(
         ``x`` (the best point: the final centre, or an earlier run's best),
         ``fun`` (its cost; non-finite only if no finite cost was ever
         found), ``status`` (a key of :data:`~spiralid.optim.result.STATUS`:
-        1 at ``max_nfev``, 2 at ``max_iter``, 0 at ``target`` or the
-        callback), ``success`` (it ended on its budget or ``target`` with a
-        finite cost, and ``target`` reached if given), ``message``,
+        1 at ``max_nfev``, 2 at ``max_iter``, 3 at ``max_time``, 0 at
+        ``target`` or the callback), ``success`` (it ended on its budget,
+        its time or ``target`` with a finite cost, and ``target`` reached if
+        given), ``message``,
         ``nit`` (over all runs), ``nfev`` (one per point: ``n_points`` for
         the initial population, then ``n_points - 1`` per iteration, as the
         centre does not move and is not re-evaluated; each restart adds its
@@ -542,6 +551,7 @@ def minimize(
     m = integer(n_points, "n_points", 2)
     if max_nfev is not None:
         max_nfev = integer(max_nfev, "max_nfev", m)
+    max_time = check_max_time(max_time)
     if target is not None:
         try:
             target = float(target)
@@ -618,4 +628,6 @@ def minimize(
             status = "target"
         elif stop:
             status = "callback"
+        elif max_time is not None and time.perf_counter() - start > max_time:
+            status = "max_time"
     return search.result(status, time.perf_counter() - start, target)
