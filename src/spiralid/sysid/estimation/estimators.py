@@ -202,6 +202,10 @@ class Method:
         The estimator for a NARX structure,
         ``narx(problem: NARXProblem, **options) -> OptimizeResult`` (see
         :mod:`spiralid.sysid.estimation.narx`); None: ARX only.
+    minimises : str or None
+        The error the estimate minimises, for its covariance
+        (:mod:`~spiralid.sysid.estimation.uncertainty`): a predictor name, or
+        None for the cost's own predictor.
     """
 
     estimate: Callable[..., EstimatorResult]
@@ -210,6 +214,7 @@ class Method:
     safe_start: bool = False
     parametrization: str = DEFAULT_PARAMETRIZATION
     narx: Callable[..., OptimiserResult] | None = None
+    minimises: str | None = None
 
 
 def search_options(options: dict) -> dict:
@@ -596,7 +601,9 @@ METHODS: dict[str, Method] = {
         parametrization="modal",
         narx=_narx.estimate_spiral,
     ),
-    "ls": Method(_estimate_ls, search=False, narx=_narx.estimate_ls),
+    "ls": Method(
+        _estimate_ls, search=False, narx=_narx.estimate_ls, minimises="one-step"
+    ),
     "oe": Method(_estimate_oe, search=False, narx=_narx.estimate_oe),
 }
 

@@ -53,6 +53,7 @@ from .parametrizations import (
     feasible_initial_points,
     make_parametrization,
 )
+from .uncertainty import parameter_covariance
 
 __all__ = [
     "IdentifiedModel",
@@ -278,6 +279,9 @@ def identify(
     res = spec.estimate(problem, **optimiser_options)
     refined = res.get("refine")
     t_refine = 0.0 if refined is None else refined.elapsed
+    covariance, s2 = parameter_covariance(
+        res.x, arx, data, spec.minimises or predictor, initial
+    )
     return IdentifiedModel(
         res.x,
         arx=arx,
@@ -298,6 +302,8 @@ def identify(
             "total": time.perf_counter() - t_start,
         },
         bounds=res.get("bounds"),
+        covariance=covariance,
+        noise_variance=s2,
         **data.provenance(),
     )
 

@@ -16,6 +16,8 @@ ends", says why the coefficients and why a projection.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from scipy import signal
 
@@ -28,7 +30,7 @@ from ..models.polynomials import step_down, step_up
 from .levenberg import levenberg_marquardt
 from .parametrizations import KMAX, stabilise
 
-__all__ = ["local_polish", "steiglitz_mcbride"]
+__all__ = ["error_functions", "local_polish", "steiglitz_mcbride"]
 
 # Tolerance of the polish (gradient, relative fall of the cost, step), and
 # where a crawl ends: a window of 10 (p + 1) evaluations that lowers the cost
@@ -52,6 +54,58 @@ def _reflect_into_bound(theta: np.ndarray, na: int) -> np.ndarray | None:
     k_b = stabilise(theta, ARX(na, theta.size - na, 0))
     a = step_up(k_b[:na])
     return np.r_[a, theta[na:]] if _within_bound(a) else None
+
+
+def error_functions(
+    arx: ARX, data: IOData, predictor: str, initial: str = "rest"
+) -> tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]:
+    """The `predictor`'s error as :class:`PaperCost` defines it, unscaled,
+    and its analytic Jacobian, both functions of the ARX ``theta``.
+
+    ``residual(theta) = yhat - y`` over the samples the cost sums (all ``N``
+    from rest; from ``t0 = max_lag`` on for ``initial="measured"`` and the
+    one-step predictor), ``jacobian(theta) = d residual / d theta``, shape
+    ``(n, p)``: ``d yhat / d b_j = u(t-nk-j) / A`` and ``d yhat / d a_i =
+    -yhat(t-i) / A`` for the simulation, the regressors ``Phi`` one step
+    ahead. The polish (:func:`local_polish`) and the parameter covariance
+    (:mod:`spiralid.sysid.estimation.uncertainty`) use the same pair.
+    """
+    na, t0 = arx.na, arx.max_lag
+    if predictor == "simulation" and initial == "rest":
+        # From rest is the measured-past problem on the record preceded by
+        # t0 zeros: the "measured" past is then the zero state, the input
+        # before t = 0 is zero, and the residual covers all N samples.
+        pad = np.zeros(t0)
+        data = IOData(np.r_[pad, data.u], np.r_[pad, data.y], ts=data.ts)
+    y = data.y
+    yv = y[t0:]
+    n_k = yv.size
+    phi = arx.regressors(data)[t0:]
+    ulags = arx.input_lags(data.u)[:, t0:]
+    past = y[t0 - na : t0][::-1]
+
+    if predictor != "simulation":
+        return (lambda x: phi @ x - yv), (lambda x: phi)
+
+    def simulate(a, b):
+        xs = b @ ulags
+        if na == 0:
+            return xs
+        den = np.r_[1.0, a]
+        zi = signal.lfiltic([1.0], den, past)
+        return signal.lfilter([1.0], den, xs, zi=zi)[0]
+
+    def residual(x):
+        return simulate(x[:na], x[na:]) - yv
+
+    def jacobian(x):
+        a, b = x[:na], x[na:]
+        yext = np.r_[y[:t0], simulate(a, b)]
+        lagged = [-yext[t0 - i : t0 - i + n_k] for i in range(1, na + 1)]
+        rows = np.vstack([*lagged, ulags]) if na else ulags
+        return signal.lfilter([1.0], np.r_[1.0, a], rows, axis=1).T
+
+    return residual, jacobian
 
 
 def local_polish(
@@ -82,48 +136,8 @@ def local_polish(
     the end), ``at_bound`` (the end is on the stable region's edge, where
     the gradient need not vanish), ``max_nfev`` and ``capped`` (the cap, not
     a tolerance, ended it)."""
-    na, t0 = arx.na, arx.max_lag
-    if predictor == "simulation" and initial == "rest":
-        # From rest is the measured-past problem on the record preceded by
-        # t0 zeros: the "measured" past is then the zero state, the input
-        # before t = 0 is zero, and the residual covers all N samples.
-        pad = np.zeros(t0)
-        data = IOData(np.r_[pad, data.u], np.r_[pad, data.y], ts=data.ts)
-    y = data.y
-    yv = y[t0:]
-    n_k = yv.size
-    phi = arx.regressors(data)[t0:]
-    ulags = arx.input_lags(data.u)[:, t0:]
-    past = y[t0 - na : t0][::-1]
-
-    if predictor == "simulation":
-
-        def simulate(a, b):
-            xs = b @ ulags
-            if na == 0:
-                return xs
-            den = np.r_[1.0, a]
-            zi = signal.lfiltic([1.0], den, past)
-            return signal.lfilter([1.0], den, xs, zi=zi)[0]
-
-        def residual(x):
-            return simulate(x[:na], x[na:]) - yv
-
-        def jacobian(x):
-            a, b = x[:na], x[na:]
-            yext = np.r_[y[:t0], simulate(a, b)]
-            lagged = [-yext[t0 - i : t0 - i + n_k] for i in range(1, na + 1)]
-            rows = np.vstack([*lagged, ulags]) if na else ulags
-            return signal.lfilter([1.0], np.r_[1.0, a], rows, axis=1).T
-
-    else:
-
-        def residual(x):
-            return phi @ x - yv
-
-        def jacobian(x):
-            return phi
-
+    na = arx.na
+    residual, jacobian = error_functions(arx, data, predictor, initial)
     if max_nfev is None:
         max_nfev = 100 * (arx.n_params + 1)
     start = stabilise(np.asarray(theta0, dtype=float), arx)

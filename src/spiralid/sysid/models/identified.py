@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -9,7 +10,9 @@ import numpy as np
 from scipy import signal
 
 from ..data import IOData
+from . import _fields
 from .arx import ARX, INITIAL_CONDITIONS
+from .modes import ModeTable, mode_table
 from .polynomials import deflate_integrator, is_stable_polynomial, max_pole_radius
 
 __all__ = ["IdentifiedModel"]
@@ -67,6 +70,14 @@ class IdentifiedModel:
         A known integrator (pole at ``z = 1``) was factored out before
         estimation (``identify(integrator=True)``): the model is marginally
         stable by design, not unstable.
+    covariance : ndarray or None, shape (p', p')
+        The covariance of the estimated parameters, ``s^2 (J^T J)^-1`` at the
+        optimum (:func:`~spiralid.sysid.estimation.uncertainty.parameter_covariance`),
+        over ``[free_denominator, b]`` (``p' = p - 1`` with a known
+        integrator, whose pole is not estimated); None when not computed.
+    noise_variance : float
+        ``s^2``, the variance of the error the estimator minimised (NaN when
+        not computed).
     """
 
     theta: np.ndarray
@@ -99,6 +110,8 @@ class IdentifiedModel:
     # before estimation (`identify(integrator=True)`): the model is then
     # marginally stable by design, not unstable.
     integrator: bool = False
+    covariance: np.ndarray | None = None
+    noise_variance: float = float("nan")
 
     def __post_init__(self) -> None:
         if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
@@ -122,6 +135,15 @@ class IdentifiedModel:
                 raise ValueError(
                     "`integrator` needs a denominator with a pole at z = 1 "
                     f"(A(1) = 0); got A(1) = {a.sum():.3g}"
+                )
+        if self.covariance is not None:
+            self.covariance = np.asarray(self.covariance, dtype=float)
+            free = self.arx.n_params - int(bool(self.integrator))
+            if self.covariance.shape != (free, free):
+                raise ValueError(
+                    f"`covariance` must have shape ({free}, {free}) for {self.arx}"
+                    f"{' with an integrator' if self.integrator else ''}; got "
+                    f"{self.covariance.shape}"
                 )
         biggest = float(np.max(np.abs(self.theta), initial=0.0))
         if biggest > _MAX_COEFFICIENT:
@@ -177,6 +199,32 @@ class IdentifiedModel:
         (:func:`~spiralid.sysid.models.polynomials.max_pole_radius`), over
         the poles the estimation chose (the integrator's is 1)."""
         return float(max_pole_radius(self.free_denominator))
+
+    @property
+    def standard_errors(self) -> np.ndarray | None:
+        """The estimated parameters' standard errors (``sqrt`` of
+        :attr:`covariance`'s diagonal, in its order), or None."""
+        if self.covariance is None:
+            return None
+        return np.sqrt(np.diag(self.covariance))
+
+    @property
+    def modes(self) -> ModeTable:
+        """The complex pole pairs as modes: natural frequency (Hz), damping
+        ratio, 95 % intervals from :attr:`covariance` (delta method), each
+        mode's share of the output, and flags for an interval that reaches
+        ``|z| = 1``, a near pole-zero cancellation and a probably spurious
+        mode (see :class:`~spiralid.sysid.models.modes.ModeTable`). A known
+        integrator is not a mode."""
+        a = self.free_denominator
+        cov = None if self.covariance is None else self.covariance[: a.size, : a.size]
+        b = self.polynomials[0] if not self.integrator else self._free_numerator()
+        return mode_table(a, b, self.ts, covariance=cov)
+
+    def _free_numerator(self) -> np.ndarray:
+        # With a known integrator the estimated model is B / A' on the
+        # summed input; its numerator is B itself.
+        return np.r_[np.zeros(self.arx.nk), self.theta[self.arx.na :]]
 
     def tf_string(self, digits: int = 4) -> str:
         """Transfer function in z as eq. (9)-(10) print it."""
@@ -243,6 +291,11 @@ class IdentifiedModel:
             "y_offset": float(self.y_offset),
             "fraction": None if self.fraction is None else float(self.fraction),
             "integrator": bool(self.integrator),
+            "covariance": None
+            if self.covariance is None
+            else np.where(np.isfinite(self.covariance), self.covariance, None).tolist(),
+            "noise_variance": _finite_or_none(self.noise_variance),
+            "modes": self.modes.to_dict(),
             "result": summary,
         }
         if not timings:
@@ -251,9 +304,19 @@ class IdentifiedModel:
 
     @classmethod
     def from_dict(cls, d: dict) -> IdentifiedModel:
-        """Rebuild from :meth:`to_dict` output (``result`` is not restored)."""
+        """Rebuild from :meth:`to_dict` output (``result`` is not restored);
+        a field that is missing or out of range (``ts <= 0``, an unknown
+        method, a ``fraction`` outside (0, 1)...) raises a ValueError that
+        names it."""
         if not isinstance(d, dict):
             raise ValueError(f"a model must be a JSON object; got {type(d).__name__}")
+        kind = d.get("model", "arx")
+        if kind != "arx":
+            # to_dict writes none; NARXModel.to_dict writes 'narx'.
+            raise ValueError(
+                "field 'model' must be absent or 'arx' for an ARX model ('narx' "
+                f"for NARXModel.from_dict); got {kind!r}"
+            )
         try:
             for name in ("na", "nb", "nk"):
                 # Named as the file names them, not as the command's options.
@@ -262,19 +325,26 @@ class IdentifiedModel:
                         f"field {name!r} must be an integer; got {d[name]!r}"
                     )
             arx = ARX(d["na"], d["nb"], d["nk"])
+            fraction = d.get("fraction")
+            if fraction is not None:
+                fraction = _fields.number(
+                    d, "fraction", "a number in (0, 1) or null", lambda v: 0 < v < 1
+                )
             return cls(
                 theta=np.asarray(d["theta"], dtype=float),
                 arx=arx,
-                ts=float(d["ts"]),
-                method=d["method"],
+                ts=_fields.number(d, "ts", "a number > 0", _fields.positive),
+                method=_fields.method(d, _arx_methods()),
                 predictor=d.get("predictor", "simulation"),
                 parametrization=d.get("parametrization", "coefficients"),
                 # Dicts saved before `initial` existed came from the
                 # measured-past rule, which was then the only one.
                 initial=d.get("initial", "measured"),
-                gain=float(d.get("gain", float("nan"))),
-                penalty=float(d.get("penalty", 1e6)),
-                cost=float(d.get("cost", float("nan"))),
+                gain=_fields.gain(d),
+                penalty=_fields.number(
+                    d, "penalty", "a finite number >= 0", _fields.nonneg, 1e6
+                ),
+                cost=_fields.number(d, "cost", "a number", _fields.anything, math.nan),
                 history=None if d.get("history") is None else np.asarray(d["history"]),
                 timings=dict(d.get("timings", {})),
                 bounds=None if d.get("bounds") is None else np.asarray(d["bounds"]),
@@ -282,10 +352,24 @@ class IdentifiedModel:
                 output_name=d.get("output_name", "y"),
                 input_unit=str(d.get("input_unit", "")),
                 output_unit=str(d.get("output_unit", "")),
-                u_offset=float(d.get("u_offset", 0.0)),
-                y_offset=float(d.get("y_offset", 0.0)),
-                fraction=None if d.get("fraction") is None else float(d["fraction"]),
+                u_offset=_fields.number(
+                    d, "u_offset", "a finite number", _fields.finite, 0.0
+                ),
+                y_offset=_fields.number(
+                    d, "y_offset", "a finite number", _fields.finite, 0.0
+                ),
+                fraction=fraction,
                 integrator=bool(d.get("integrator", False)),
+                covariance=_covariance_field(d),
+                noise_variance=_fields.number(
+                    d,
+                    "noise_variance",
+                    "a number >= 0 or null",
+                    _fields.nonneg,
+                    math.nan,
+                )
+                if d.get("noise_variance") is not None
+                else math.nan,
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None
@@ -297,6 +381,38 @@ class IdentifiedModel:
             f"cost={self.cost:.6g}, "
             f"stable={self.is_stable})"
         )
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if np.isfinite(value) else None
+
+
+def _covariance_field(d: dict) -> np.ndarray | None:
+    """The file's ``covariance``: a square array, ``null`` for an infinite
+    variance (JSON has no infinity)."""
+    raw = d.get("covariance")
+    if raw is None:
+        return None
+    try:
+        cov = np.array(
+            [[np.inf if v is None else v for v in row] for row in raw], dtype=float
+        )
+    except (TypeError, ValueError):
+        raise ValueError(
+            "field 'covariance' must be a square array of numbers"
+        ) from None
+    if cov.ndim != 2 or cov.shape[0] != cov.shape[1] or np.isnan(cov).any():
+        raise ValueError("field 'covariance' must be a square array of numbers")
+    return cov
+
+
+def _arx_methods() -> tuple[str, ...]:
+    """The methods an ARX model file may name: identify()'s, and the
+    Pareto search's (``"pareto-ebsda"``...)."""
+    from spiralid.choices import METHOD_NAMES as METHODS
+    from spiralid.choices import PARETO_METHOD_NAMES as PARETO_METHODS
+
+    return (*METHODS, *(f"pareto-{name}" for name in PARETO_METHODS))
 
 
 _SUMMARY_KEYS = (

@@ -41,6 +41,7 @@ import numba
 import numpy as np
 
 from ..data import IOData, check_signal
+from . import _fields
 
 __all__ = [
     "ACTIVATIONS",
@@ -980,7 +981,9 @@ class NARXModel:
 
     @classmethod
     def from_dict(cls, d: dict) -> NARXModel:
-        """Rebuild from :meth:`to_dict` output (``result`` is not restored).
+        """Rebuild from :meth:`to_dict` output (``result`` is not restored);
+        a field that is missing or out of range (``ts <= 0``, an unknown
+        method, a zero scale...) raises a ValueError that names it.
 
         Parameters
         ----------
@@ -1022,25 +1025,46 @@ class NARXModel:
                 raise ValueError(
                     f"field 'params' must hold {st.n_params} finite numbers for {st}"
                 )
-            sc = Scaling(**{k: float(v) for k, v in d["scaling"].items()})
+            scaling = d["scaling"]
+            if not isinstance(scaling, dict):
+                raise ValueError(
+                    f"field 'scaling' must be an object; got {scaling!r:.80}"
+                )
+            # The scales divide the signals: zero, negative or non-finite
+            # ones would only fail (or mislead) at the first simulation.
+            sc = Scaling(
+                **{
+                    k: _fields.number(scaling, k, allowed, ok, where="scaling.")
+                    for k, allowed, ok in (
+                        ("u_shift", "a finite number", _fields.finite),
+                        ("u_scale", "a number > 0", _fields.positive),
+                        ("y_shift", "a finite number", _fields.finite),
+                        ("y_scale", "a number > 0", _fields.positive),
+                    )
+                }
+            )
             return cls(
                 params=params,
                 structure=st,
                 scaling=sc,
-                ts=float(d["ts"]),
-                method=str(d.get("method", "")),
+                ts=_fields.number(d, "ts", "a number > 0", _fields.positive),
+                method=_fields.method(d, _narx_methods()),
                 predictor=d.get("predictor", "simulation"),
                 initial=d.get("initial", "rest"),
-                cost=float(d.get("cost", float("nan"))),
-                gain=float(d.get("gain", float("nan"))),
+                cost=_fields.number(d, "cost", "a number", _fields.anything, math.nan),
+                gain=_fields.gain(d),
                 history=None if d.get("history") is None else np.asarray(d["history"]),
                 timings=dict(d.get("timings", {})),
                 input_name=d.get("input_name", "u"),
                 output_name=d.get("output_name", "y"),
                 input_unit=str(d.get("input_unit", "")),
                 output_unit=str(d.get("output_unit", "")),
-                u_offset=float(d.get("u_offset", 0.0)),
-                y_offset=float(d.get("y_offset", 0.0)),
+                u_offset=_fields.number(
+                    d, "u_offset", "a finite number", _fields.finite, 0.0
+                ),
+                y_offset=_fields.number(
+                    d, "y_offset", "a finite number", _fields.finite, 0.0
+                ),
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None
@@ -1050,6 +1074,14 @@ class NARXModel:
             f"NARXModel({self.structure}, method={self.method!r}, "
             f"predictor={self.predictor!r}, cost={self.cost:.6g})"
         )
+
+
+def _narx_methods() -> tuple[str, ...]:
+    """The methods a NARX model file may name (the names only: the models
+    stage imports no estimator; tests/test_layout.py)."""
+    from spiralid.choices import METHOD_NAMES
+
+    return METHOD_NAMES
 
 
 def simulate_structure(structure, params, scaling: Scaling, u, y0=None):
