@@ -15,7 +15,7 @@ import numpy as np
 
 from .correlation import check_lags
 from .higher_order import BillingsVoon, billings_voon
-from .validate import _gain, _signals_of, fit_percent, rmse
+from .validate import _format_fit, _gain, _signals_of, fit_percent, rmse
 
 __all__ = ["NARXValidation", "validate_narx"]
 
@@ -66,10 +66,12 @@ class NARXValidation:
 
     def summary(self) -> str:
         """Human-readable report."""
+        free = _format_fit(self.fit_percent, unit=" %")
+        one_step = _format_fit(self.fit_percent_one_step, "one-step prediction", " %")
         lines = [
             f"NARX validation ({self.label}), N = {self.n_samples}",
-            f"  fit (free run)   {self.fit_percent:8.2f} %",
-            f"  fit (one step)   {self.fit_percent_one_step:8.2f} %",
+            f"  fit (free run)   {free:>10}",
+            f"  fit (one step)   {one_step:>10}",
             f"  cost (eq. 2)     {self.cost:8.4g}",
             "  error range      "
             f"[{self.error_range[0]:.4g}, {self.error_range[1]:.4g}]",

@@ -58,6 +58,19 @@ _RESIDUALS = ("one-step", "simulation")
 _CANCELLATION = 1e-6
 
 
+# Below this fit % (an error a million percent of the output's spread) the
+# digits only tell how long an unstable run grew: a table says it diverged.
+_DIVERGED_FIT = -1e6
+
+
+def _format_fit(fit: float, run: str = "free run", unit: str = "") -> str:
+    """A fit % as a table prints it, followed by `unit`: two decimals, or
+    for a `run` that ran away its order of magnitude and that it diverged."""
+    if not fit < _DIVERGED_FIT:
+        return f"{fit:.2f}{unit}"
+    return f"{fit:.2g}{unit} (the {run} diverged)"
+
+
 def fit_percent(y, yhat) -> float:
     """Normalised fit in percent, as MATLAB's ``compare`` reports it.
 
@@ -391,8 +404,11 @@ class Validation:
         unit = f", {self.output_unit}" if self.output_unit else ""
         rows = [
             ("samples (N), ts", f"{self.n_samples}, {self.ts:g} s"),
-            ("fit % (simulation)", f"{self.fit_percent:.2f}"),
-            ("fit % (one-step)", f"{self.fit_percent_one_step:.2f}"),
+            ("fit % (simulation)", _format_fit(self.fit_percent)),
+            (
+                "fit % (one-step)",
+                _format_fit(self.fit_percent_one_step, "one-step prediction"),
+            ),
             ("RMSE (simulation)", f"{self.rmse:.4g}"),
             ("RMSE (one-step)", f"{self.rmse_one_step:.4g}"),
             (f"paper cost, eq. (2) ({self.cost_predictor})", f"{self.cost:.4g}"),
