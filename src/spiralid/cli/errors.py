@@ -15,10 +15,29 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse that reports a bad argument in one line, not usage + error."""
+    """argparse that reports a bad argument in one line, not usage + error,
+    and records in ``given`` the destinations of the options the user typed
+    (in full or abbreviated), so that one given equal to its default can
+    still be refused where it does not apply."""
 
     def error(self, message: str):  # type: ignore[override]
         raise UsageError(message)
+
+    def parse_known_args(self, args=None, namespace=None):
+        parsed, extras = super().parse_known_args(args, namespace)
+        if namespace is None and args is not None and "given" not in vars(parsed):
+            # argparse fills in a default only where the namespace has no
+            # value yet: parsed again over a namespace holding a marker in
+            # every destination, what still holds the marker was not given.
+            marked = argparse.Namespace(**dict.fromkeys(vars(parsed), _NOT_GIVEN))
+            super().parse_known_args(args, marked)
+            parsed.given = frozenset(
+                k for k, v in vars(marked).items() if v is not _NOT_GIVEN
+            )
+        return parsed, extras
+
+
+_NOT_GIVEN = object()
 
 
 _PACKAGE = Path(__file__).resolve().parents[1]

@@ -11,12 +11,14 @@ from .options import (
     _add_initial_option,
     _detrended,
     _fraction,
+    _given,
     _HelpFormatter,
     _listing,
     _load_data,
     _nonneg_int,
     _open_folder,
     _positive_int,
+    _refuse_unused,
     _save_figures,
 )
 
@@ -68,13 +70,6 @@ def _run_narx(args) -> int:
     """`spiralid identify --model narx|polynomial`."""
     from spiralid.sysid import METHODS, identify, validate
 
-    if METHODS[args.method].narx is None:
-        able = ", ".join(n for n, m in METHODS.items() if m.narx is not None)
-        raise UsageError(f"--method {args.method} does not train NARX models: {able}")
-    if args.refine or args.parametrization is not None:
-        raise UsageError("--refine and --parametrization apply to ARX models")
-    if args.model == "polynomial" and args.method != "ls":
-        raise UsageError("--model polynomial is estimated by --method ls (FROLS)")
     data = _load_data(args)
     if args.detrend:
         data = _detrended(data, args.fraction)
@@ -152,19 +147,69 @@ def write_arx_model(staged, model, est, val, label: str, headline: str) -> str:
     return summary
 
 
-# The options only a search takes.
+# The options only a search takes (an MLP NARX draws its initial weights
+# from --seed whatever the method).
 _SEARCH_FLAGS = ("--points", "--iterations", "--budget", "--seed", "--parametrization")
 
+# The options of one kind of --model: the models they apply to.
+_MODEL_FLAGS = {
+    "--refine": ("arx",),
+    "--parametrization": ("arx",),
+    "--hidden": ("narx",),
+    "--activation": ("narx",),
+    "--degree": ("polynomial",),
+    "--terms": ("polynomial",),
+    "--holdout": ("narx", "polynomial"),
+}
 
-def _given(argv: list[str], flag: str) -> bool:
-    """Whether the user wrote `flag` (``--flag value`` or ``--flag=value``)."""
-    return any(a == flag or a.startswith(flag + "=") for a in argv)
+
+def _check_options(args) -> None:
+    """Refuse, before any data is read, what the model and method cannot
+    do and the options they would ignore without a word (identify()
+    refuses the same from Python), given equal to their defaults or not."""
+    from spiralid.sysid import METHODS
+
+    model, method = args.model, args.method
+    if model != "arx" and METHODS[method].narx is None:
+        able = ", ".join(n for n, m in METHODS.items() if m.narx is not None)
+        raise UsageError(f"--method {method} does not train NARX models: {able}")
+    if model == "polynomial" and method != "ls":
+        raise UsageError("--model polynomial is estimated by --method ls (FROLS)")
+    for owners in dict.fromkeys(_MODEL_FLAGS.values()):
+        flags = [f for f, o in _MODEL_FLAGS.items() if o == owners and model not in o]
+        _refuse_unused(
+            _given(args, *flags),
+            f"to --model {' and '.join(owners)}, not to --model {model}",
+        )
+    if METHODS[method].search:
+        return
+    searches = ", ".join(name for name, m in METHODS.items() if m.search)
+    if model == "arx":
+        flags = [*_given(args, *_SEARCH_FLAGS), *_given(args, "--refine")]
+        _refuse_unused(
+            flags, f"to the search methods {searches}; --method {method} takes none"
+        )
+    elif model == "narx":
+        flags = _given(args, "--points", "--iterations", "--budget")
+        _refuse_unused(
+            flags, f"to the search methods {searches}; --method {method} takes none"
+        )
+    else:
+        # Forward regression chooses its terms deterministically.
+        flags = _given(args, "--points", "--iterations", "--budget", "--seed")
+        seed = " (--seed also to --model narx)" if "--seed" in flags else ""
+        _refuse_unused(
+            flags,
+            f"to the search methods {searches}{seed}; --model polynomial "
+            f"--method {method} takes none",
+        )
 
 
 def run(args, argv: list[str]) -> int:
     from spiralid.sysid import METHODS, identify
     from spiralid.sysid.validation.plots import plot_convergence
 
+    _check_options(args)
     if args.model != "arx":
         return _run_narx(args)
     data = _load_data(args)
@@ -179,20 +224,6 @@ def run(args, argv: list[str]) -> int:
         options = {"n_points": args.points, "max_nfev": args.budget}
         if args.iterations is not None:
             options["max_iter"] = args.iterations
-    else:
-        # A search's option given to a method that searches nothing would
-        # be ignored without a word: refuse it, as identify() refuses the
-        # same options from Python.
-        given = [flag for flag in _SEARCH_FLAGS if _given(argv, flag)]
-        if args.refine:
-            given.append("--refine")
-        if given:
-            searches = ", ".join(name for name, m in METHODS.items() if m.search)
-            verb = "applies" if len(given) == 1 else "apply"
-            raise UsageError(
-                f"{', '.join(given)} {verb} to the search methods {searches}; "
-                f"--method {args.method} takes none"
-            )
     with _open_folder(args.out, args.force) as folder:
         model = identify(
             est,

@@ -8,6 +8,8 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
+from .errors import UsageError
+
 
 class _HelpFormatter(argparse.HelpFormatter):
     """--help shows the default of every option that has one."""
@@ -23,6 +25,21 @@ class _HelpFormatter(argparse.HelpFormatter):
         ):
             return text
         return f"{text} (default: %(default)s)"
+
+
+def _given(args, *flags: str) -> list[str]:
+    """Those of `flags` the user typed (in full or abbreviated), in the
+    order listed; one equal to its default counts (see ``_Parser``)."""
+    given = getattr(args, "given", frozenset())
+    return [f for f in flags if f.removeprefix("--").replace("-", "_") in given]
+
+
+def _refuse_unused(flags: list[str], where: str) -> None:
+    """Refuse options that would be ignored without a word: '--a, --b apply
+    `where`' (e.g. "to --model narx, not to --model arx")."""
+    if flags:
+        verb = "applies" if len(flags) == 1 else "apply"
+        raise UsageError(f"{', '.join(flags)} {verb} {where}")
 
 
 def _column(value: str) -> str | int:

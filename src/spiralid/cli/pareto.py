@@ -7,12 +7,13 @@ import csv
 import json
 
 from .errors import UsageError
-from .identify import _given, write_arx_model
+from .identify import write_arx_model
 from .options import (
     _add_data_options,
     _add_detrend_option,
     _detrended,
     _fraction,
+    _given,
     _HelpFormatter,
     _listing,
     _load_data,
@@ -20,6 +21,7 @@ from .options import (
     _nonneg_int,
     _open_folder,
     _positive_int,
+    _refuse_unused,
 )
 
 
@@ -79,8 +81,21 @@ def run(args, argv: list[str]) -> int:
     from spiralid.report.pareto_figures import front_figure
     from spiralid.sysid import ARX, choose_order, identify_pareto
 
-    if args.orders is not None and any(_given(argv, flag) for flag in ("--na", "--nb")):
+    # Every option is checked before the search, which may take minutes.
+    if args.orders is not None and _given(args, "--na", "--nb"):
         raise UsageError("--orders replaces --na and --nb (each order n is ARX(n, n))")
+    if args.max_frequency is not None and args.by_fit is not None:
+        raise UsageError("give --max-frequency or --by-fit, not both")
+    if args.by_fit is not None and (args.orders is None or len(args.orders) < 2):
+        raise UsageError("--by-fit chooses among orders: give --orders")
+    if "frequency" not in args.objectives:
+        if args.max_frequency is not None:
+            raise UsageError("--max-frequency needs the frequency objective")
+        _refuse_unused(
+            _given(args, "--min-coherence"),
+            "to the frequency objective; --objectives "
+            f"{','.join(args.objectives)} has none",
+        )
     data = _load_data(args)
     if args.detrend:
         data = _detrended(data, args.fraction)
@@ -108,16 +123,10 @@ def run(args, argv: list[str]) -> int:
             polish_nfev=args.polish,
             min_coherence=args.min_coherence,
         )
-        if args.max_frequency is not None and args.by_fit is not None:
-            raise UsageError("give --max-frequency or --by-fit, not both")
         if args.max_frequency is not None:
-            if "frequency" not in front.names:
-                raise UsageError("--max-frequency needs the frequency objective")
             chosen = front.choose(max_frequency=args.max_frequency)
             why = f"lowest cost with frequency error <= {args.max_frequency:g} dB"
         elif args.by_fit is not None:
-            if len(structures) < 2:
-                raise UsageError("--by-fit chooses among orders: give --orders")
             chosen = choose_order(front, val, warmup=est, tolerance=args.by_fit)
             why = (
                 f"lowest order within {args.by_fit:g} points of the best validation "
@@ -140,7 +149,8 @@ def run(args, argv: list[str]) -> int:
             f"{chosen} ({why}): {model.arx}, {values}, H(z) = {model.tf_string()}"
         )
         summary = write_arx_model(staged, model, est, val, f"point {chosen}", headline)
-        written = folder.commit(last="model.json")
+        # With --force, an earlier and larger front's surplus points go.
+        written = folder.commit(last="model.json", sets="point-[0-9]*")
     if not args.quiet:
         print(summary)
         files = [p for p in written if not p.name.startswith("point-")]

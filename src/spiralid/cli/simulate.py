@@ -17,6 +17,11 @@ def run(args, argv: list[str]) -> int:
     suffix = Path(args.out).suffix.lower()
     if suffix not in (".csv", ".npz"):
         raise UsageError(f"--out {args.out!r} must end in .csv or .npz")
+    if args.width is not None and args.signal not in _PULSES:
+        raise UsageError(
+            f"--width applies to --signal {' and '.join(_PULSES)}; --signal "
+            f"{args.signal} has no pulses"
+        )
     from spiralid.report.atomic import OutputFile
 
     with OutputFile(args.out, args.force) as target:
@@ -35,6 +40,8 @@ def run(args, argv: list[str]) -> int:
 # The torque (N m) of each signal when --amplitude is not given: the paper
 # experiment's pulses, and a tenth of a newton metre for the broadband ones.
 _AMPLITUDES = {"paper": 0.3, "bang-bang": 0.3, "prbs": 0.1, "chirp": 0.1}
+# The signals made of pulses, which --width shapes.
+_PULSES = ("paper", "bang-bang")
 
 
 def _simulate_record(args):

@@ -200,6 +200,35 @@ def _replace(source: Path, target: Path) -> None:
     os.replace(source, target)
 
 
+def _surplus(
+    staged: Path, target: Path, pattern: str | None
+) -> tuple[list[Path], set[str]]:
+    """The folders matching `pattern` in `target` that `staged` does not
+    hold, and the names of the files the staged ones hold (see
+    :meth:`OutputFolder.commit`)."""
+    if pattern is None:
+        return [], set()
+    fresh = [p for p in staged.glob(pattern) if p.is_dir()]
+    ours = {f.name for p in fresh for f in p.iterdir() if f.is_file()}
+    kept = {p.name for p in fresh}
+    old = [
+        p
+        for p in target.glob(pattern)
+        if p.name not in kept and p.is_dir() and not p.is_symlink()
+    ]
+    return old, ours
+
+
+def _clear(folders: list[Path], names: set[str]) -> None:
+    """Remove the files `names` from `folders`, and each folder once empty."""
+    for folder in folders:
+        for name in names:
+            with contextlib.suppress(FileNotFoundError):
+                (folder / name).unlink()
+        with contextlib.suppress(OSError):  # holds something of the user's
+            folder.rmdir()
+
+
 class _Lock:
     """An exclusive ``flock`` on a file beside the target, removed on release.
 
@@ -360,11 +389,18 @@ class OutputFolder(_Staged):
 
     # -- committing ---------------------------------------------------------------
 
-    def commit(self, last: str | None = None) -> list[Path]:
+    def commit(self, last: str | None = None, sets: str | None = None) -> list[Path]:
         """Move the staged files into the target; return their final paths.
 
         `last` names a file moved after all others (e.g. ``report.html``), so
         that its presence means the rest is there.
+
+        `sets` is a glob pattern of the numbered folders the command writes
+        as many of as its result holds (``"point-[0-9]*"``). With ``force``,
+        those an earlier run left in the target that this commit does not
+        write again lose the files of the names the new ones hold, and go
+        once empty: a smaller result would otherwise leave the earlier one's
+        surplus beside it. Anything else in them (the user's) stays.
         """
         if self.path is None or self._committed:
             raise RuntimeError("commit() needs an open, uncommitted OutputFolder")
@@ -382,8 +418,14 @@ class OutputFolder(_Staged):
                 if not t.exists():
                     os.rename(self.path, t)
                 else:
+                    # Listed before the staged folders move out.
+                    surplus = _surplus(self.path, t, sets)
                     for name in names:
+                        if name == last:
+                            _clear(*surplus)
                         _replace(self.path / name, t / name)
+                    if last not in names:
+                        _clear(*surplus)
             except OSError as exc:
                 raise OutputError(
                     f"cannot move the results into {str(t)!r}: {_why(exc)}"
