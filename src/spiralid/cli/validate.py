@@ -20,8 +20,9 @@ from .options import (
 
 
 def _read_model(name: str):
-    """The model file, and whether it records its preprocessing (files
-    written before it did only know --detrend from the user)."""
+    """The model file, whether it records its preprocessing (files
+    written before it did only know --detrend from the user) and whether
+    it records the names of its input and output."""
     from spiralid.sysid import IdentifiedModel
 
     path = Path(name)
@@ -49,7 +50,69 @@ def _read_model(name: str):
         raise UsageError(
             f"{name!r} is not a valid spiralid model file ({message})"
         ) from None
-    return model, "u_offset" in fields
+    return model, "u_offset" in fields, "output_name" in fields
+
+
+def _names_in(name: str) -> set[str] | None:
+    """The names DATA's columns (a CSV header's, with or without their unit)
+    or variables (NPZ, MAT) go by; None for a shipped data set, a file
+    without a header, or one that cannot be read (reading it says why)."""
+    import csv
+
+    from spiralid.sysid.data import _is_number, _split_unit
+
+    path = Path(name)
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".csv":
+            with path.open(newline="", encoding="utf-8-sig") as fh:
+                header = [c.strip() for c in next((r for r in csv.reader(fh) if r), [])]
+            if not header or all(_is_number(c) for c in header):
+                return None
+            return set(header) | {_split_unit(c)[0] for c in header}
+        if suffix == ".npz":
+            import numpy as np
+
+            with path.open("rb") as fh:
+                if fh.read(4) != b"PK\x03\x04":
+                    return None
+            # Only the archive's member names: nothing is unpickled.
+            with np.load(path, allow_pickle=False) as z:
+                return set(z.files)
+        if suffix == ".mat":
+            from scipy.io import whosmat
+
+            return {n for n, *_ in whosmat(path)}
+    except (OSError, ValueError, TypeError, NotImplementedError, EOFError):
+        return None
+    return None
+
+
+def _columns_of_the_model(args, model) -> None:
+    """--input and --output, when not given, from the names the model file
+    records: another column of the same file would be scored silently (a
+    fit near 0 % for the wrong signal)."""
+    from spiralid import datasets
+
+    if not Path(args.data).exists() and args.data in datasets.NAMES:
+        return  # a shipped data set has one input and one output
+    names = _names_in(args.data)
+    if names is None:
+        return
+    wanted = {
+        "input": model.input_name if args.input is None else None,
+        "output": model.output_name if args.output is None else None,
+    }
+    missing = [v for v in wanted.values() if v is not None and v not in names]
+    if missing:
+        kind = "column" if Path(args.data).suffix.lower() == ".csv" else "variable"
+        raise UsageError(
+            f"the model was estimated on input {model.input_name!r} and output "
+            f"{model.output_name!r}, but {args.data!r} has no {kind} "
+            f"{' or '.join(map(repr, missing))}; give --input and --output"
+        )
+    args.input = args.input if wanted["input"] is None else wanted["input"]
+    args.output = args.output if wanted["output"] is None else wanted["output"]
 
 
 def _prepared_as_the_model(data, model, recorded: bool, args):
@@ -78,7 +141,9 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
 def run(args, argv: list[str]) -> int:
     from spiralid.sysid import validate
 
-    model, recorded = _read_model(args.model)
+    model, recorded, named = _read_model(args.model)
+    if named:
+        _columns_of_the_model(args, model)
     # The data's own sample time wins; validate() refuses one that differs
     # from the model's. Only a file without one borrows the model's.
     data = _load_data(args, default_ts=model.ts)
