@@ -50,10 +50,10 @@ templates_path = ["_templates"]
 
 # --- API reference -----------------------------------------------------------
 autosummary_generate = True
+toc_object_entries_show_parents = "hide"  # "simulate()", not "Model.simulate()"
 autosummary_imported_members = True
 autodoc_typehints = "none"  # the numpydoc sections give the types
 autodoc_member_order = "bysource"
-autodoc_default_options = {"members": False}
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
@@ -90,6 +90,10 @@ html_theme_options = {
     "footer_end": ["sphinx-version"],
 }
 html_show_sourcelink = False
+# The results pages' tables take the page's whole width: no navigation
+# column (the header links every page), and no page contents column (their
+# front matter removes it).
+html_sidebars = {"results/*": []}
 
 # --- API pages from __all__ --------------------------------------------------
 # The packages whose public names the reference lists, with a line on each.
