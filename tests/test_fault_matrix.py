@@ -150,6 +150,56 @@ CASES = [
     ("reproduce --seeds 0", "--seeds"),
     ("reproduce --data ok.csv --ts 0.01 --out full", "is not empty"),
     ("reproduce --data missing.csv", "does not exist"),
+    # fault round 3: models, options, pareto
+    (
+        "identify ok.csv --ts 0.01 --method ls --hidden 5",
+        "--hidden applies to --model narx, not to --model arx",
+    ),
+    # Abbreviated and equal to its default: still typed, still refused.
+    ("identify ok.csv --ts 0.01 --method ls --hid 10", "--hidden applies to"),
+    (
+        "identify ok.csv --ts 0.01 --method ls --activation tanh",
+        "--activation applies to --model narx, not to --model arx",
+    ),
+    (
+        "identify ok.csv --ts 0.01 --method ls --degree 2",
+        "--degree applies to --model polynomial, not to --model arx",
+    ),
+    (
+        "identify ok.csv --ts 0.01 --method ls --holdout 0.2",
+        "--holdout applies to --model narx and polynomial, not to --model arx",
+    ),
+    (
+        "identify ok.csv --ts 0.01 --model polynomial --method ls --budget 10 --seed 5",
+        "--budget, --seed apply to the search methods",
+    ),
+    (
+        "identify ok.csv --ts 0.01 --model narx --method ls --budget 5",
+        "--budget applies to the search methods",
+    ),
+    (
+        "identify ok.csv --ts 0.01 --model narx --degree 4 --terms 3",
+        "--degree, --terms apply to --model polynomial, not to --model narx",
+    ),
+    (
+        "identify ok.csv --ts 0.01 --model polynomial --method ls --hidden 3",
+        "--hidden applies to --model narx, not to --model polynomial",
+    ),
+    (
+        "simulate --signal prbs --width 0.04",
+        "--width applies to --signal paper and bang-bang; --signal prbs",
+    ),
+    ("simulate --signal chirp --width 0.1", "--signal chirp has no pulses"),
+    (
+        "pareto ok.csv --ts 0.01 --objectives cost,one-step --min-coherence 0.5",
+        "--min-coherence applies to the frequency objective",
+    ),
+    (
+        "pareto ok.csv --ts 0.01 --objectives cost,one-step --max-frequency 3",
+        "--max-frequency needs the frequency objective",
+    ),
+    ("pareto ok.csv --ts 0.01 --by-fit 1", "--by-fit chooses among orders"),
+    ("pareto ok.csv --ts 0.01 --orders 3 --by-fit 1", "give --orders"),
     ("frobnicate", "invalid choice"),
     # fault round 3: data, reproduce, study
     ("identify notmat.mat --ts 0.1", "'notmat.mat' is not a readable .mat file"),
@@ -412,6 +462,199 @@ def test_degenerate_models_get_order_advice():
     plain = IdentifiedModel([-1.5, 0.7, 1.0, 0.5], arx=ARX(2, 2, 1), ts=0.01,
                             method="ls")  # fmt: skip
     assert validate(plain, data).order_advice is None
+
+
+# -- third fault round: models, options, pareto -------------------------------
+
+
+@pytest.fixture
+def third_files(files):
+    """Model files with one bad field each, and a record of several columns
+    (as `spiralid simulate` writes) with a model estimated on one of them."""
+    from spiralid.sysid import NARX, NARXModel
+    from spiralid.sysid.models.narx import Scaling
+
+    model = json.loads((files / "model.json").read_text())
+    for name, change in {
+        "ts_zero.json": {"ts": 0},
+        "ts_negative.json": {"ts": -0.01},
+        "method_magic.json": {"method": "magic"},
+        "kind_foo.json": {"model": "foo"},
+        "fraction_5.json": {"fraction": 5},
+        "gain_negative.json": {"gain": -1.0},
+        "offset_nan.json": {"u_offset": float("nan")},
+    }.items():
+        (files / name).write_text(json.dumps({**model, **change}))
+    st = NARX(2, 2, 1, hidden=(2,))
+    narx = NARXModel(np.zeros(st.n_params), st, Scaling(), 0.01, method="ls")
+    zeroed = {
+        **narx.to_dict(),
+        "scaling": dict.fromkeys(("u_shift", "u_scale", "y_shift", "y_scale"), 0.0),
+    }
+    (files / "narx_zeroed.json").write_text(json.dumps(zeroed))
+    data = IOData.from_csv(files / "ok.csv", ts=0.01)
+    noise = np.random.default_rng(1).standard_normal(data.n)
+    _csv(
+        files / "rig3.csv",
+        {
+            "time_s": [i * 0.01 for i in range(data.n)],
+            "torque_Nm": list(data.u),
+            "hub_angle_rad": list(data.y),
+            "end_acceleration_m_s2": list(noise),
+        },
+    )
+    named = IOData(data.u, data.y, ts=0.01, input_name="torque_Nm",
+                   output_name="hub_angle_rad")  # fmt: skip
+    hub = identify(named, ARX(2, 2, 1), method="ls")
+    (files / "hub.json").write_text(json.dumps(hub.to_dict()))
+    return files
+
+
+THIRD_ROUND = [
+    ("validate ts_zero.json ok.csv", "field 'ts' must be a number > 0; got 0"),
+    ("validate ts_negative.json ok.csv --ts 0.01", "field 'ts' must be"),
+    ("validate method_magic.json ok.csv --ts 0.01", "field 'method' must be one"),
+    ("validate kind_foo.json ok.csv --ts 0.01", "field 'model' must be"),
+    ("validate fraction_5.json ok.csv --ts 0.01", "field 'fraction' must be"),
+    ("validate gain_negative.json ok.csv --ts 0.01", "field 'gain' must be"),
+    ("validate offset_nan.json ok.csv --ts 0.01", "field 'u_offset' must be"),
+    ("validate narx_zeroed.json ok.csv --ts 0.01", "field 'scaling.u_scale'"),
+    # The model was estimated on torque_Nm and hub_angle_rad: not in ok.csv,
+    # and u, y (model.json's) are not in rig3.csv.
+    ("validate hub.json ok.csv --ts 0.01", "has no column 'torque_Nm' or"),
+    ("validate model.json rig3.csv", "has no column 'u' or 'y'"),
+]
+
+
+@pytest.mark.parametrize("line, words", THIRD_ROUND, ids=[c[0] for c in THIRD_ROUND])
+def test_third_round_faults_end_in_one_line(third_files, capsys, line, words):
+    argv = [*line.split(), "--out", "out"]
+    before = _state(third_files)
+    assert cli.main(argv) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], err
+    assert lines[0].startswith("spiralid validate: error: ")
+    assert "not a valid spiralid model" in lines[0] or "has no column" in lines[0]
+    assert "warning" not in err and "Traceback" not in err and out == ""
+    assert _state(third_files) == before
+
+
+def test_validate_scores_the_columns_the_model_recorded(third_files, capsys):
+    """Not rig3.csv's default output (end_acceleration_m_s2, here noise),
+    which scored a fit of -0.00 % without a word."""
+    assert cli.main(["validate", "hub.json", "rig3.csv", "--out", "v"]) == 0
+    fit = json.loads((third_files / "v" / "validation.json").read_text())
+    assert fit["fit_percent"] > 95
+    explicit = ["--input", "torque_Nm", "--output", "hub_angle_rad"]
+    assert cli.main(["validate", "hub.json", "rig3.csv", *explicit, "--out", "w"]) == 0
+    same = json.loads((third_files / "w" / "validation.json").read_text())
+    assert same["fit_percent"] == fit["fit_percent"]
+    # What the user names still wins over the model's record.
+    argv = ["validate", "hub.json", "rig3.csv", "--output", "end_acceleration_m_s2"]
+    assert cli.main([*argv, "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_an_unstable_model_s_fit_is_short_and_says_it_diverged(files, capsys):
+    model = json.loads((files / "model.json").read_text())
+    # A pole at z = 1.5: over 600 samples the free run grows by 1e105.
+    (files / "unstable.json").write_text(
+        json.dumps({**model, "theta": [-1.5, 0.0, 1.0, 0.5]})
+    )
+    assert cli.main(["validate", "unstable.json", "ok.csv", "--ts", "0.01"]) == 0
+    row = next(
+        line
+        for line in capsys.readouterr().out.splitlines()
+        if line.startswith("fit % (simulation)")
+    )
+    assert row.split()[-4:] == ["(the", "free", "run", "diverged)"], row
+    value = row.split()[3]
+    assert len(value) < 12 and float(value) < -1e100, row
+
+
+def test_pareto_checks_every_option_before_the_search(files, capsys, monkeypatch):
+    import spiralid.sysid
+
+    def search(*args, **kwargs):
+        raise AssertionError("the search ran before the options were checked")
+
+    monkeypatch.setattr(spiralid.sysid, "identify_pareto", search)
+    for extra in (
+        ["--by-fit", "1"],
+        ["--orders", "2:3", "--by-fit", "1", "--max-frequency", "3"],
+        ["--objectives", "cost,one-step", "--max-frequency", "3"],
+        ["--objectives", "cost,one-step", "--min-coherence", "0.5"],
+    ):
+        status = cli.main(["pareto", "ok.csv", "--ts", "0.01", *extra, "--out", "p"])
+        err = capsys.readouterr().err
+        assert status == 2 and err.startswith("spiralid pareto: error: "), err
+        assert len(err.splitlines()) == 1
+    assert not (files / "p").exists()
+
+
+def test_pareto_force_removes_the_points_of_an_earlier_larger_front(files, capsys):
+    out = files / "front"
+    for i in range(56):
+        (out / f"point-{i}").mkdir(parents=True)
+        (out / f"point-{i}" / "model.json").write_text("{}")
+    (out / "point-40" / "notes.txt").write_text("mine")
+    (out / "point-notes").mkdir()
+    (out / "point-notes" / "model.json").write_text("mine")
+    argv = ["pareto", "ok.csv", "--ts", "0.01", "--na", "2", "--nb", "2", "--nk", "1"]
+    argv += ["--budget", "300", "--points", "12", "--polish", "20", "--quiet"]
+    assert cli.main([*argv, "--out", str(out), "--force"]) == 0
+    rows = (out / "front.csv").read_text().strip().splitlines()[1:]
+    points = sorted(p.name for p in out.glob("point-[0-9]*") if p.name != "point-40")
+    assert points == sorted(f"point-{i}" for i in range(len(rows)))
+    assert len(rows) < 40
+    for i in range(len(rows)):
+        assert json.loads((out / f"point-{i}" / "model.json").read_text())["theta"]
+    # What is not spiralid's stays: the user's file (its folder with it) and
+    # a folder that is not a numbered point.
+    assert sorted(p.name for p in (out / "point-40").iterdir()) == ["notes.txt"]
+    assert (out / "point-notes" / "model.json").read_text() == "mine"
+    assert capsys.readouterr() == ("", "")
+
+
+def test_max_time_ends_a_search_after_the_iteration_that_passes_it():
+    """Without depending on the machine's speed: a limit far below one
+    iteration's time stops every search after its first iteration."""
+    from spiralid.optim import minimize, minimize_pareto
+
+    def sphere(x):
+        return float(x @ x)
+
+    box = [(-5, 5)] * 3
+    capped = minimize(sphere, box, "ebsda", rng=0, n_points=10, max_time=1e-12)
+    free = minimize(sphere, box, "ebsda", rng=0, n_points=10, max_iter=1)
+    assert capped.nit == 1 and capped.nfev == free.nfev == 10 + 9
+    assert capped.status == 3 and capped.success
+    assert "time limit" in capped.message and "max_time" in capped.message
+    np.testing.assert_array_equal(capped.x, free.x)
+    # A generous limit changes nothing.
+    long = minimize(sphere, box, "ebsda", rng=0, n_points=10, max_iter=20,
+                    max_time=1e9)  # fmt: skip
+    assert long.nit == 20 and long.status == 2
+
+    def two(x):
+        return np.column_stack([x[:, 0] ** 2, (x[:, 0] - 2) ** 2])
+
+    kw = {"n_points": 20, "rng": 0, "vectorized": True}
+    front = minimize_pareto(two, [(-5, 5)], max_nfev=2000, max_time=1e-12, **kw)
+    assert front.nit == 1 and front.status == 3 and "time limit" in front.message
+    first = minimize_pareto(two, [(-5, 5)], max_nfev=2000, **kw)
+    assert front.nfev < first.nfev and first.status == 1
+
+
+@pytest.mark.parametrize("bad", [0, -1.0, float("nan"), float("inf"), "5", True])
+def test_max_time_must_be_a_positive_finite_number(bad):
+    from spiralid.optim import minimize, minimize_pareto
+
+    with pytest.raises(ValueError, match=r"`max_time` must be a finite number > 0"):
+        minimize(lambda x: float(x @ x), [(-1, 1)], max_time=bad)
+    with pytest.raises(ValueError, match=r"`max_time` must be a finite number > 0"):
+        minimize_pareto(lambda x: [x[0], -x[0]], [(-1, 1)], max_time=bad)
 
 
 # -- third fault round: data files, reproduce, study stores -------------------
