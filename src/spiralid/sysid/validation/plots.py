@@ -408,6 +408,7 @@ def plot_convergence(
     log: bool = True,
     band: tuple[float, float] = (25.0, 75.0),
     cost_label: str = "best cost",
+    figure=None,
 ) -> Figure:
     """Best cost against iteration (and wall time), one curve per method.
 
@@ -436,11 +437,15 @@ def plot_convergence(
     cost_label : str, default "best cost"
         Label of the cost axis; give the cost's unit, e.g. ``"best cost,
         eq. (2) (% of rms(y))"``.
+    figure : Figure or SubFigure, optional
+        Draw into this (empty) figure, e.g. one of ``Figure.subfigures``,
+        instead of a new one.
 
     Returns
     -------
     Figure
-        One axes (vs iteration) or two (vs iteration, vs time).
+        One axes (vs iteration) or two (vs iteration, vs time); `figure`
+        when given.
 
     Examples
     --------
@@ -501,7 +506,9 @@ def plot_convergence(
                     tr.append(tv)
             time_runs[k] = tr
 
-    fig = Figure(figsize=(8, 6.5 if time_runs else 3.8), layout="constrained")
+    fig = figure
+    if fig is None:
+        fig = Figure(figsize=(8, 6.5 if time_runs else 3.8), layout="constrained")
     axes = fig.subplots(2 if time_runs else 1, 1, squeeze=False)[:, 0]
 
     def draw(ax, x, stack, label):
