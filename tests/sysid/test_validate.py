@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost
+from spiralid.sysid import ARX, IdentifiedModel, IOData, PaperCost, identify
 from spiralid.sysid.validation.correlation import independence_test, whiteness_test
 from spiralid.sysid.validation.validate import (
     fit_percent,
@@ -28,7 +28,9 @@ def second_order_theta():
     return np.r_[den[1:], num[1:]], num, den
 
 
-def model(theta, method="true", **kw):
+def model(theta, method="ls", **kw):
+    # The records below are ARX (equation-error) systems, whose true model is
+    # what least squares estimates: its residual tests use the one-step error.
     return IdentifiedModel(theta=theta, arx=ARX(2, 2, 1), ts=TS, method=method, **kw)
 
 
@@ -177,13 +179,18 @@ def test_gain_model_reuses_the_model_gain():
 
 def test_unstable_model_is_reported_and_penalised():
     data, _ = record(n=500)
-    v = validate(model([-2.0, 1.1, 1.0, 0.0]), data)  # poles 1 +- 0.32j
+    with pytest.warns(UserWarning, match="free run diverges"):
+        v = validate(model([-2.0, 1.1, 1.0, 0.0]), data)  # poles 1 +- 0.32j
     assert not v.stable and v.max_pole_radius == pytest.approx(np.sqrt(1.1))
     assert v.cost >= 1e6
-    # on a long record its free run overflows: say so instead of a NaN fit
+    # On a long record its free run overflows: validation still reports it,
+    # with a fit that says it diverged and one warning, never a NaN or an
+    # error.
     long, _ = record(n=20000)
-    with pytest.raises(ValueError, match=r"`model` is unstable \(max \|pole\| = 1.04"):
-        validate(model([-2.0, 1.1, 1.0, 0.0]), long)
+    with pytest.warns(UserWarning, match=r"free run diverges .*max \|pole\| = 1.04"):
+        v = validate(model([-2.0, 1.1, 1.0, 0.0]), long)
+    assert v.diverged and v.fit_percent < -1e6
+    assert np.all(np.isfinite(v.y_sim)) and "diverged" in v.summary()
 
 
 def test_residual_tests_use_the_one_step_error_of_an_arx_model():
@@ -228,7 +235,13 @@ def test_summary_and_json():
     v = validate(model(theta), data, label="true model")
     text = v.summary()
     assert text.startswith("Validation of true model")
-    for key in ("fit % (simulation)", "fit % (one-step)", "error range", "whiteness"):
+    for key in (
+        "fit % (simulation, from rest)",
+        "fit % (simulation, from measured samples)",
+        "fit % (one-step)",
+        "error range",
+        "whiteness",
+    ):
         assert key in text
     assert str(v) == text
     d = json.loads(json.dumps(v.to_dict()))
@@ -248,7 +261,7 @@ def test_validate_bad_input():
         validate(m, data, lags=100)
     with pytest.raises(ValueError, match="`data` sample time must match the model's"):
         validate(m, IOData(data.u, data.y, ts=0.01))
-    with pytest.raises(ValueError, match="`residuals` must be one of"):
+    with pytest.raises(ValueError, match="`residuals` must be 'auto' or one of"):
         validate(m, data, residuals="two-step")
     with pytest.raises(
         ValueError, match="`gain` must be 'auto', 'model' or a finite number > 0"
@@ -269,3 +282,41 @@ def test_validate_bad_input():
 def test_validate_names_a_model_that_is_not_one(bad):
     with pytest.raises(ValueError, match="`model` must be an IdentifiedModel"):
         validate(bad, record(200))
+
+
+def test_an_output_error_model_is_judged_by_the_tests_output_error_promises():
+    # An output-error plant (white noise added to the output, not through
+    # 1/A): OE at the true order makes the simulation error white noise
+    # independent of the input, while its one-step residual is coloured.
+    # "auto" tests the simulation error and calls whiteness not applicable.
+    _, num, den = second_order_theta()
+    rng = np.random.default_rng(7)
+    u = rng.standard_normal(3000)
+    y = signal.lfilter(num, den, u) + 0.05 * rng.standard_normal(3000)
+    est, val = IOData(u, y, ts=TS).split(2 / 3)
+    fit = identify(est, ARX(2, 2, 1), method="oe")
+    v = validate(fit, val)
+    assert v.residuals == "simulation" and v.output_error
+    assert v.independence.passed[0.99]
+    assert not validate(fit, val, residuals="one-step").whiteness.passed[0.99]
+    text = v.summary()
+    assert "not applicable: an output-error model" in text
+    assert "fit % (one-step)" not in text and "not shown" in text
+    ls = validate(identify(est, ARX(2, 2, 1), method="ls"), val)
+    assert ls.residuals == "one-step" and not ls.output_error
+
+
+def test_the_free_run_from_measured_samples_is_scored_beside_the_run_from_rest():
+    # The measured start is the simulation of PaperCost(initial="measured"):
+    # its fit is computed on the samples after the first max_lag.
+    data, _ = record(n=600, noise=0.02, seed=3)
+    theta, _, _ = second_order_theta()
+    wrong = theta * np.array([1.0, 1.0, 1.2, 1.0])
+    v = validate(model(wrong), data)
+    a, b = np.r_[1.0, wrong[:2]], np.r_[0.0, wrong[2:]]
+    zi = signal.lfiltic(b, a, data.y[1::-1], data.u[1::-1])
+    y_meas = signal.lfilter(b, a, data.u[2:], zi=zi)[0]
+    expected = fit_percent(data.y[2:], y_meas)
+    assert v.initial == "rest"
+    assert v.fit_percent_measured == pytest.approx(expected, rel=1e-9)
+    assert v.to_dict()["fit_percent_measured"] == pytest.approx(expected, rel=1e-9)

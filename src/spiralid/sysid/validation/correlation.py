@@ -172,7 +172,8 @@ def correlation(a, b, max_lag: int) -> np.ndarray:
     max_lag = check_lags(max_lag, n)
     a = a - a.mean()
     b = b - b.mean()
-    scale = np.sqrt(np.dot(a, a) * np.dot(b, b))
+    # Norms, not the product of the squared sums, which overflows first.
+    scale = float(np.linalg.norm(a) * np.linalg.norm(b))
     out = np.zeros(2 * max_lag + 1)
     if scale == 0.0:
         # A constant signal is uncorrelated with anything; report zeros rather

@@ -15,7 +15,7 @@ import numpy as np
 
 from .correlation import check_lags
 from .higher_order import BillingsVoon, billings_voon
-from .validate import _format_fit, _gain, _signals_of, fit_percent, rmse
+from .validate import _bounded_run, _format_fit, _gain, _signals_of, fit_percent, rmse
 
 __all__ = ["NARXValidation", "validate_narx"]
 
@@ -45,7 +45,11 @@ class NARXValidation:
     correlation : BillingsVoon
         The five Billings-Voon tests.
     t, u, y, y_sim, y_pred : ndarray
-        Time, signals and responses over the scored part.
+        Time, signals and responses over the scored part (a diverged free
+        run clipped).
+    diverged : bool
+        The free run grew without bound on this record: its fit is reported
+        (far below zero) but means only that.
     """
 
     label: str
@@ -63,6 +67,7 @@ class NARXValidation:
     y: np.ndarray
     y_sim: np.ndarray
     y_pred: np.ndarray
+    diverged: bool = False
 
     def summary(self) -> str:
         """Human-readable report."""
@@ -97,6 +102,7 @@ class NARXValidation:
             "error_range": [float(v) for v in self.error_range],
             "residuals": self.residuals,
             "billings_voon": self.correlation.to_dict(),
+            "diverged": bool(self.diverged),
         }
         if signals:
             for k in ("t", "u", "y", "y_sim", "y_pred"):
@@ -122,7 +128,7 @@ def validate_narx(
     *,
     lags: int = 25,
     levels=(0.95, 0.99),
-    residuals: str = "one-step",
+    residuals: str = "auto",
     gain="auto",
     warmup=None,
     label: str | None = None,
@@ -137,7 +143,7 @@ def validate_narx(
     data : IOData
     lags : int
     levels : sequence of float
-    residuals : {"one-step", "simulation"}
+    residuals : {"auto", "one-step", "simulation"}
     gain : "auto", "model" or float
     warmup : IOData, optional
     label : str, optional
@@ -148,8 +154,12 @@ def validate_narx(
     """
     u, y, ts = _signals_of(data)
     lags = check_lags(lags, y.size)
+    if residuals == "auto":
+        residuals = model.predictor
     if residuals not in _RESIDUALS:
-        raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
+        raise ValueError(
+            f"`residuals` must be 'auto' or one of {_RESIDUALS}; got {residuals!r}"
+        )
     if not np.isclose(float(model.ts), ts, rtol=1e-9):
         raise ValueError(
             f"`data` sample time must match the model's ts = {float(model.ts)!r}; "
@@ -166,13 +176,10 @@ def validate_narx(
         whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
     else:
         whole = type(data)(u, y, ts=ts)
-    y_sim = model.simulate(whole.u)[start:]
-    y_pred = model.predict(whole)[start:]
-    if not np.all(np.isfinite(y_sim)):
-        raise ValueError(
-            "`model`'s free run diverges on this record; a free-run validation of "
-            "it is meaningless"
-        )
+    with np.errstate(all="ignore"):
+        y_sim = np.asarray(model.simulate(whole.u), dtype=float)[start:]
+        y_pred = np.asarray(model.predict(whole), dtype=float)[start:]
+    y_sim, diverged = _bounded_run(y_sim, y)
     w = _gain(gain, model, y)
     e_sim, e_pred = y - y_sim, y - y_pred
     e_cost = e_sim if model.predictor == "simulation" else e_pred
@@ -193,4 +200,5 @@ def validate_narx(
         y=y,
         y_sim=y_sim,
         y_pred=y_pred,
+        diverged=diverged,
     )

@@ -28,6 +28,8 @@ from spiralid._checks import positive
 
 from ..data import check_pair
 from ..estimation.cost import auto_gain, cost_of_errors
+from ..estimation.outputerror import error_functions
+from ..models.modes import ModeTable
 from ..models.polynomials import (
     format_pole_radius,
     is_stable_polynomial,
@@ -324,6 +326,25 @@ class Validation:
     integrator : bool
         The model has a known integrator (pole at ``z = 1``) by design, so
         ``stable`` is judged without it.
+    initial : {"rest", "warmup"}
+        Where the free run started: from rest, or from the state the model
+        reached over ``warmup``.
+    fit_percent_measured : float
+        The free run's fit started instead from the record's first
+        ``max_lag`` measured samples (its initial state; scored on the
+        samples after them), NaN for a model without an ARX structure.
+    diverged : bool
+        The free run grew without bound on this record: its fit is reported
+        (far below zero, or ``-inf``) but means only that.
+    output_error : bool
+        The model was fitted to its simulation error (output error, the
+        spiral searches): the noise is not modelled, so the whiteness test
+        does not apply to it and its one-step prediction is not what it
+        promises (the summary leaves both out and says why).
+    mode_table : ModeTable or None
+        The model's modes with 95 % intervals and flags
+        (:attr:`~spiralid.sysid.IdentifiedModel.modes`), when the model has
+        a covariance.
     """
 
     label: str
@@ -358,6 +379,11 @@ class Validation:
     output_name: str = "output"
     output_unit: str = ""
     integrator: bool = False
+    initial: str = "rest"
+    fit_percent_measured: float = float("nan")
+    diverged: bool = False
+    output_error: bool = False
+    mode_table: ModeTable | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -374,6 +400,16 @@ class Validation:
         d = self.realization.min_pole_zero_distance
         if not self.realization.minimal or d < _CANCELLATION:
             reasons.append(f"a pole and a zero {d:.2g} apart cancel")
+        if self.mode_table is not None and np.any(self.mode_table.spurious):
+            table = self.mode_table
+            spurious = table.frequency[table.spurious]
+            reasons.append(
+                f"{spurious.size} mode(s) at "
+                + ", ".join(f"{f:.3g}" for f in spurious)
+                + " Hz look spurious (a wide interval, a cancelling zero or "
+                "under 1 % of the output); the data support about "
+                f"{self.poles.size - 2 * spurious.size} poles"
+            )
         at_origin = int(np.sum(np.abs(self.poles) < _CANCELLATION))
         if at_origin:
             reasons.append(
@@ -402,27 +438,32 @@ class Validation:
 
         rz = self.realization
         unit = f", {self.output_unit}" if self.output_unit else ""
+        start = "from rest" if self.initial == "rest" else "after the warm-up"
         rows = [
             ("samples (N), ts", f"{self.n_samples}, {self.ts:g} s"),
-            ("fit % (simulation)", _format_fit(self.fit_percent)),
+            (f"fit % (simulation, {start})", _format_fit(self.fit_percent)),
             (
-                "fit % (one-step)",
-                _format_fit(self.fit_percent_one_step, "one-step prediction"),
+                "fit % (simulation, from measured samples)",
+                _format_fit(self.fit_percent_measured),
             ),
             ("RMSE (simulation)", f"{self.rmse:.4g}"),
-            ("RMSE (one-step)", f"{self.rmse_one_step:.4g}"),
+            *self._one_step_rows(unit),
             (f"paper cost, eq. (2) ({self.cost_predictor})", f"{self.cost:.4g}"),
             (
                 f"error range (simulation{unit})",
                 f"[{self.error_range[0]:.4f}, {self.error_range[1]:.4f}]",
             ),
             (
-                f"error range (one-step{unit})",
-                f"[{self.error_range_one_step[0]:.4f}, "
-                f"{self.error_range_one_step[1]:.4f}]",
+                f"whiteness ({self.residuals} residual)",
+                "not applicable: an output-error model does not model the "
+                "noise, so its residual need not be white"
+                if self.output_error
+                else verdict(self.whiteness),
             ),
-            (f"whiteness ({self.residuals} residual)", verdict(self.whiteness)),
-            ("input-residual independence", verdict(self.independence)),
+            (
+                f"independence from the input ({self.residuals} residual)",
+                verdict(self.independence),
+            ),
             ("PSD peaks, measured (Hz)", hz(self.peaks_measured.frequency)),
             ("PSD peaks, model (Hz)", hz(self.peaks_model.frequency)),
             (
@@ -459,7 +500,34 @@ class Validation:
         title = f"Validation of {self.label}" if self.label else "Validation"
         lines = [title, "-" * max(len(title), width + 30)]
         lines += [f"{k:<{width}}  {v}" for k, v in rows]
+        if self.mode_table is not None and len(self.mode_table):
+            lines += ["", "Modes of the model (intervals from the estimate's "
+                      "covariance)", str(self.mode_table)]  # fmt: skip
         return "\n".join(lines)
+
+    def _one_step_rows(self, unit: str) -> list[tuple[str, str]]:
+        """The one-step prediction's rows, or for an output-error model one
+        row that says why they are left out."""
+        if self.output_error:
+            return [
+                (
+                    "one-step prediction",
+                    "not shown: an output-error model is fitted to its free "
+                    "run, not to predict one step ahead (see to_dict())",
+                )
+            ]
+        return [
+            (
+                "fit % (one-step)",
+                _format_fit(self.fit_percent_one_step, "one-step prediction"),
+            ),
+            ("RMSE (one-step)", f"{self.rmse_one_step:.4g}"),
+            (
+                f"error range (one-step{unit})",
+                f"[{self.error_range_one_step[0]:.4f}, "
+                f"{self.error_range_one_step[1]:.4f}]",
+            ),
+        ]
 
     def __str__(self) -> str:
         return self.summary()
@@ -497,6 +565,13 @@ class Validation:
             "realization": self.realization.to_dict(),
             "poles": cplx(self.poles),
             "zeros": cplx(self.zeros),
+            "initial": self.initial,
+            "fit_percent_measured": float(self.fit_percent_measured),
+            "diverged": bool(self.diverged),
+            "output_error": bool(self.output_error),
+            "mode_table": None
+            if self.mode_table is None
+            else self.mode_table.to_dict(),
         }
         if signals:
             for name in ("t", "u", "y", "y_sim", "y_pred"):
@@ -565,7 +640,7 @@ def validate(
     lags: int = 25,
     n_peaks: int = 3,
     levels=(0.95, 0.99),
-    residuals: str = "one-step",
+    residuals: str = "auto",
     nperseg: int | None = None,
     max_damping: float = 0.3,
     gain="auto",
@@ -593,11 +668,16 @@ def validate(
         the paper's arm).
     levels : sequence of float, default (0.95, 0.99)
         Confidence levels of the correlation bands and verdicts.
-    residuals : {"one-step", "simulation"}, default "one-step"
-        Which error the correlation tests examine. The one-step prediction
-        error is the ARX model's own estimate of its innovations, which is
-        what MATLAB's ``resid`` tests; the simulation error is the
-        output-error view.
+    residuals : {"auto", "one-step", "simulation"}, default "auto"
+        Which error the correlation tests examine. ``"auto"`` takes the error
+        the model was fitted to: the one-step prediction error for least
+        squares and one-step searches (the ARX model's estimate of its
+        innovations, which MATLAB's ``resid`` tests, and which it promises
+        white and independent of the input), the simulation error for output
+        error and the simulation searches. Such an output-error model
+        promises only that its simulation error is independent of past
+        inputs; it does not model the noise, so the whiteness test is then
+        reported as not applicable (``Validation.output_error``).
     nperseg : int, optional
         Welch segment length; default :func:`~spiralid.sysid.spectra.default_nperseg`.
     max_damping : float, default 0.3
@@ -670,6 +750,8 @@ def validate(
     hardly decays. Pass ``warmup`` to validate such a model from the state
     it has reached.
     """
+    if isinstance(residuals, str) and residuals == "auto":
+        residuals = _fitted_error(model)
     if getattr(model, "kind", None) == "narx":
         # Poles, modes and realisations mean nothing for a nonlinear model:
         # its own report (fits and the Billings-Voon tests).
@@ -701,8 +783,10 @@ def validate(
     )
     stable = bool(is_stable_polynomial(denominator))
     max_radius = float(max_pole_radius(denominator))
-    y_sim, y_pred, start = _responses(model, data, warmup, max_radius)
-    y, y_sim = check_pair(y, y_sim, "data.y", "model.simulate(data.u)")
+    y_sim, y_pred, start = _responses(model, data, warmup)
+    y_sim, diverged = _bounded_run(
+        y_sim, y, f" (max |pole| = {format_pole_radius(max_radius)})"
+    )
     y, y_pred = check_pair(y, y_pred, "data.y", "model.predict(data)")
     e_sim, e_pred = y - y_sim, y - y_pred
 
@@ -751,7 +835,72 @@ def validate(
         integrator=bool(getattr(model, "integrator", False)),
         output_name=str(getattr(data, "output_name", "output")),
         output_unit=str(getattr(data, "output_unit", "")),
+        initial="rest" if warmup is None else "warmup",
+        fit_percent_measured=_fit_from_measured(model, data),
+        diverged=diverged,
+        output_error=_fitted_error(model) == "simulation",
+        mode_table=_mode_table(model),
     )
+
+
+# A free run that leaves this many times the measured output's largest
+# value has diverged (its fit would be below -1e6 %, where _format_fit says
+# so); it is clipped there, so the error range, spectra and tests stay
+# finite.
+_RUNAWAY = 1e6
+
+
+def _bounded_run(y_sim: np.ndarray, y: np.ndarray, why: str = ""):
+    """The free run, clipped when it ran away, and whether it did (with one
+    warning line: validation never raises on a model it accepted)."""
+    import warnings
+
+    if y_sim.size != y.size:
+        raise ValueError(
+            f"`model.simulate(data.u)` must have {y.size} samples; got {y_sim.size}"
+        )
+    limit = _RUNAWAY * max(float(np.max(np.abs(y), initial=0.0)), 1e-300)
+    with np.errstate(invalid="ignore"):
+        if np.all(np.isfinite(y_sim)) and np.max(np.abs(y_sim), initial=0.0) < limit:
+            return y_sim, False
+    warnings.warn(
+        f"the model's free run diverges on this record{why}: its fit is "
+        "reported but only says so",
+        UserWarning,
+        stacklevel=3,
+    )
+    clipped = np.clip(np.nan_to_num(y_sim, nan=0.0), -limit, limit)
+    return clipped, True
+
+
+def _fit_from_measured(model, data) -> float:
+    """The free run's fit from the record's first measured samples (its
+    initial state), on the samples after them."""
+    arx = getattr(model, "arx", None)
+    if arx is None or not hasattr(data, "u"):
+        return float("nan")
+    residual, _ = error_functions(arx, data, "simulation", "measured")
+    with np.errstate(all="ignore"):
+        e = residual(np.asarray(model.theta, dtype=float))
+        y = np.asarray(data.y, dtype=float)[arx.max_lag :]
+        fit = 100.0 * (1.0 - np.linalg.norm(e) / np.linalg.norm(y - y.mean()))
+    return float(fit) if np.isfinite(fit) else -np.inf
+
+
+def _mode_table(model) -> ModeTable | None:
+    if getattr(model, "covariance", None) is None:
+        return None
+    return model.modes
+
+
+def _fitted_error(model) -> str:
+    """The error `model`'s estimate minimised: its method's (least squares:
+    the one-step error), else the predictor its cost used."""
+    from ..estimation.estimators import METHODS
+
+    method = METHODS.get(str(getattr(model, "method", "")))
+    predictor = getattr(model, "predictor", None) or "simulation"
+    return (method.minimises if method is not None else None) or predictor
 
 
 def _valid_inputs(model, data, lags, residuals):
@@ -775,7 +924,9 @@ def _valid_inputs(model, data, lags, residuals):
             f"than `data`'s N = {y.size} samples hold"
         )
     if residuals not in _RESIDUALS:
-        raise ValueError(f"`residuals` must be one of {_RESIDUALS}; got {residuals!r}")
+        raise ValueError(
+            f"`residuals` must be 'auto' or one of {_RESIDUALS}; got {residuals!r}"
+        )
     model_ts = getattr(model, "ts", None)
     if model_ts is not None and not np.isclose(float(model_ts), ts, rtol=1e-9):
         raise ValueError(
@@ -809,7 +960,7 @@ def _gain(gain, model, y: np.ndarray) -> float:
         ) from None
 
 
-def _responses(model, data, warmup, max_radius: float):
+def _responses(model, data, warmup):
     """The model's free run and one-step prediction over ``data`` (after
     ``warmup`` when given), and the index of ``data``'s first sample in the
     run."""
@@ -828,11 +979,4 @@ def _responses(model, data, warmup, max_radius: float):
         start = wu.size
         y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[start:]
         y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[start:]
-    if y_sim.size == u.size and not np.all(np.isfinite(y_sim)):
-        raise ValueError(
-            f"`model` is unstable (max |pole| = {format_pole_radius(max_radius)}) "
-            "and its free-run "
-            f"output overflows on this record of N = {u.size} samples; a free-run "
-            "validation of it is meaningless"
-        )
     return y_sim, y_pred, start
