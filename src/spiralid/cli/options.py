@@ -76,7 +76,7 @@ _positive_int = _number(int, ">= 1", lambda v: v >= 1)
 
 
 def _ratio(text: str) -> float:
-    """A number, or a quotient such as ``2/3`` (the README's split)."""
+    """A number, or a quotient such as ``2/3`` (the paper's split)."""
     top, slash, bottom = text.partition("/")
     if not slash:
         return float(text)

@@ -7,7 +7,7 @@ folder. A lock file beside the target refuses a second writer while the
 first one runs; writability is tested when the folder is opened, before any
 computation.
 
-The rules a user relies on (the README's promise):
+The rules a user relies on (docs/guide/cli.md, "Output folders"):
 
 - a target folder must be new or empty unless ``force``; with ``force`` the
   files written replace those of the same name and nothing else in the

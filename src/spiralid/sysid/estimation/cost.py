@@ -3,7 +3,7 @@
     f = w * sqrt(sum_t e(t)^2) / K                  all poles |z| < 1      (2)
     f = w * sqrt(sum_t e(t)^2) / K + penalty        otherwise              (3)
 
-How we read it (README.md, "How we read the paper"):
+How we read it (docs/guide/paper.md, "How we read the paper"):
 
 - ``predictor="simulation"`` (the paper's): ``e`` is the free-run
   simulation error, the model driven by the input alone with its own past

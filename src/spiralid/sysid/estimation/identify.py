@@ -23,8 +23,8 @@ or from the measured past outputs at ``t0 = max_lag``
 (``initial="measured"``). Use ``"rest"`` for records that start at rest
 (the simulated rig's experiments); on such noisy records the measured
 start is harmful, because for lightly damped models it maps the noise of
-the ``na`` measured outputs into a large initial state (the README's API
-example measures both on the rig and on the arm). Use ``"measured"`` only
+the ``na`` measured outputs into a large initial state (docs/guide/paper.md
+and docs/guide/estimation.md measure both). Use ``"measured"`` only
 for a record that starts in motion, such as the real arm (a slice of a
 periodic sweep). Least squares and the one-step predictor do not depend on
 it.
@@ -122,7 +122,7 @@ def identify(
         (the recommended spiral identification: Eb-SDA over the modes with
         the numerator projected out, a memetic Levenberg-Marquardt polish,
         restarts and safe starts; it reaches the output-error optimum, see
-        the README), ``"ebsda"``, ``"sda"``, ``"lasda"`` (the paper's spiral
+        docs/results), ``"ebsda"``, ``"sda"``, ``"lasda"`` (the paper's spiral
         searches), ``"de"`` (SciPy's differential evolution over the same
         cost, box and initial points, a baseline), ``"ls"`` or ``"oe"`` (see
         :mod:`spiralid.sysid.estimation.estimators`). ``"ls"`` minimises the one-step

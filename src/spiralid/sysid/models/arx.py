@@ -6,7 +6,7 @@ The model is
     y(t) + a_1 y(t-1) + ... + a_na y(t-na) = b_0 u(t-nk) + ... + b_(nb-1) u(t-nk-nb+1)
 
 with parameter vector ``theta = [a_1..a_na, b_0..b_(nb-1)]``. The paper's
-eq. (6) is ``ARX(8, 8, 0)`` (b_0 multiplies z^8, as README.md reads it); its
+eq. (6) is ``ARX(8, 8, 0)`` (b_0 multiplies z^8, as docs/guide/paper.md reads it); its
 printed eq. (9)-(10) have ``nk = 1``.
 
 Initial samples: the first ``t0 = max_lag = max(na, nk + nb - 1)`` samples
