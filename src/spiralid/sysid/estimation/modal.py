@@ -27,6 +27,19 @@ p_1..p_R]`` with ``2 S + R = na``.
 Sections are unordered, so every model has ``S!`` equivalent coordinate
 vectors; a population search does not mind, and :meth:`~ModalParametrization.
 from_denominator` returns them sorted by frequency.
+
+A stability margin (``max_radius = r_max < 1``, see
+:mod:`~spiralid.sysid.estimation.margin`): every pole the coordinates give
+is scaled by ``r_max``, ``c1 -> r_max c1``, ``c2 -> r_max^2 c2``, ``p ->
+r_max p``. In continuous time every pole moves left by ``1 / T`` (``r_max =
+exp(-ts / T)``), so a section's decay is ``zeta wn + 1 / T >= 1 / T``
+(``rho <= r_max``) and a first-order pole has ``|p| <= r_max``: the whole
+box maps into the disc of radius ``r_max``, smoothly and one to one (no
+plateau for a search or a Gauss-Newton step), and
+:meth:`~ModalParametrization.from_denominator` divides the poles by
+``r_max`` before it reads their coordinates. The coordinates are then the
+mode's less the margin's shift; ``max_radius=None`` (the default) is the
+map above exactly.
 """
 
 from __future__ import annotations
@@ -66,6 +79,9 @@ class ModalParametrization:
         order). Must have the parity of ``na``.
     log_damping : (float, float), default (-3, 1)
         Box of ``log10(zeta)``.
+    max_radius : float, optional
+        A stability margin ``r_max`` in ``(0, 1]``: every pole is scaled by
+        it (see the module docstring); default None, no margin.
 
     Attributes
     ----------
@@ -93,7 +109,12 @@ class ModalParametrization:
     name = "modal"
 
     def __init__(
-        self, na: int, ts: float, real_poles: int | None = None, log_damping=_LOG_ZETA
+        self,
+        na: int,
+        ts: float,
+        real_poles: int | None = None,
+        log_damping=_LOG_ZETA,
+        max_radius: float | None = None,
     ) -> None:
         na = integer(na, "na", 1)
         ts = _check_ts(ts)
@@ -109,6 +130,13 @@ class ModalParametrization:
                 f"`log_damping` must be (low, high) finite with low < high; "
                 f"got {log_damping!r}"
             )
+        if max_radius is not None:
+            max_radius = float(max_radius)
+            if not 0.0 < max_radius <= 1.0:
+                raise ValueError(
+                    f"`max_radius` must be in (0, 1] or None; got {max_radius!r}"
+                )
+        self.max_radius = max_radius
         self.na = na
         self.ts = ts
         self.n_real = n_real
@@ -122,9 +150,10 @@ class ModalParametrization:
         self.bounds = box
 
     def __repr__(self) -> str:
+        margin = "" if self.max_radius is None else f", max_radius={self.max_radius:g}"
         return (
             f"ModalParametrization(na={self.na}, ts={self.ts:g}, "
-            f"sections={self.n_sections}, real_poles={self.n_real})"
+            f"sections={self.n_sections}, real_poles={self.n_real}{margin})"
         )
 
     def _batch(self, x) -> tuple[np.ndarray, bool]:
@@ -158,7 +187,12 @@ class ModalParametrization:
         osc = 2.0 * rho * np.cos(np.sqrt(np.maximum(g, 0.0)) * wt)
         c1 = -np.where(g >= 0.0, osc, pole_sum)
         c2 = rho * rho
-        return c1, c2, xx[:, 2 * s :]
+        p = xx[:, 2 * s :]
+        r = self.max_radius
+        if r is not None:
+            # The margin: every pole z -> r z (see the module docstring).
+            c1, c2, p = r * c1, (r * r) * c2, r * p
+        return c1, c2, p
 
     def to_denominator(self, x) -> np.ndarray:
         """Map coordinates to ``a_1..a_na`` of the monic denominator.
@@ -208,7 +242,9 @@ class ModalParametrization:
     def from_denominator(self, a) -> np.ndarray:
         """Coordinates of the nearest representable denominator, in the box.
 
-        Poles outside the unit circle are first reflected in (``z -> 1/conj z``).
+        Poles outside the unit circle are first reflected in (``z -> 1/conj z``);
+        with a margin ``r_max`` the poles are divided by it first, so those
+        outside radius ``r_max`` are reflected about that circle.
         Complex pairs become second-order sections; the real poles of largest
         magnitude fill the first-order sections and the rest pair up into
         overdamped sections, where a pair of positive poles is exact and any other pair
@@ -230,6 +266,9 @@ class ModalParametrization:
                 f"`a` must be a finite vector of shape ({self.na},); got {a!r}"
             )
         z = np.roots(np.r_[1.0, a])
+        if self.max_radius is not None:
+            # Coordinates describe the poles before the margin's scaling.
+            z = z / self.max_radius
         mag = np.abs(z)
         outside = mag >= 1.0
         z[outside] = 1.0 / np.conj(z[outside])

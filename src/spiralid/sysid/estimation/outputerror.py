@@ -7,7 +7,12 @@ Jacobian) on the error :class:`~spiralid.sysid.PaperCost` defines, over the
 ARX coefficients themselves, kept in the stable region :data:`KMAX` defines
 (every reflection coefficient ``|k_j| <= KMAX``, ``KMAX = 1 - 1e-6``): a
 trial step that leaves it has its unstable poles reflected into the unit
-circle, ``z -> 1 / conj(z)``, as a start's are. :func:`steiglitz_mcbride`
+circle, ``z -> 1 / conj(z)``, as a start's are. With a stability margin
+(``max_radius = r_max``, identify's ``max_time_constant``, see
+:mod:`~spiralid.sysid.estimation.margin`) the region is the disc of radius
+``r_max`` instead: the reflection coefficients of ``A(r_max z)`` are
+bounded by ``KMAX``, and outside poles are reflected about that circle
+(``z -> r_max^2 / conj(z)``). :func:`steiglitz_mcbride`
 gives the classical output-error start. The estimators
 (:mod:`spiralid.sysid.estimation.estimators`) run the polish from several
 starts and keep the lowest cost. docs/design-notes.md, "Where a local polish
@@ -28,6 +33,7 @@ from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
 from ..models.polynomials import step_down, step_up
 from .levenberg import levenberg_marquardt
+from .margin import project_denominator, scaled, within
 from .parametrizations import KMAX, stabilise
 
 __all__ = ["error_functions", "local_polish", "steiglitz_mcbride"]
@@ -41,19 +47,27 @@ _TOL = 1e-12
 _STALL_WINDOW, _STALL_GAIN = 10, 1e-6
 
 
-def _within_bound(a: np.ndarray) -> bool:
-    """Every reflection coefficient of ``A`` at most :data:`KMAX` in size."""
+def _within_bound(a: np.ndarray, radius: float | None = None) -> bool:
+    """Every reflection coefficient of ``A`` (of ``A(radius z)`` with a
+    margin) at most :data:`KMAX` in size."""
+    if radius is not None:
+        return within(a, radius, KMAX)
     return a.size == 0 or bool(np.all(np.abs(step_down(a)) <= KMAX))
 
 
-def _reflect_into_bound(theta: np.ndarray, na: int) -> np.ndarray | None:
+def _reflect_into_bound(
+    theta: np.ndarray, na: int, radius: float | None = None
+) -> np.ndarray | None:
     """`theta` with its denominator's poles outside the region reflected in
     (``None`` when rounding leaves it outside even so)."""
-    if _within_bound(theta[:na]):
+    if _within_bound(theta[:na], radius):
         return theta
-    k_b = stabilise(theta, ARX(na, theta.size - na, 0))
-    a = step_up(k_b[:na])
-    return np.r_[a, theta[na:]] if _within_bound(a) else None
+    if radius is None:
+        k_b = stabilise(theta, ARX(na, theta.size - na, 0))
+        a = step_up(k_b[:na])
+    else:
+        a = project_denominator(theta[:na], radius, KMAX)
+    return np.r_[a, theta[na:]] if _within_bound(a, radius) else None
 
 
 def error_functions(
@@ -115,6 +129,7 @@ def local_polish(
     predictor: str,
     initial: str = "rest",
     max_nfev: int | None = None,
+    max_radius: float | None = None,
 ) -> tuple[np.ndarray, OptimiserResult]:
     """Levenberg-Marquardt polish of the `predictor`'s error as
     :class:`PaperCost` defines it, kept stable: the search is over ``theta``
@@ -135,32 +150,45 @@ def local_polish(
     records ``nfev``, ``optimality`` (the gradient's largest component at
     the end), ``at_bound`` (the end is on the stable region's edge, where
     the gradient need not vanish), ``max_nfev`` and ``capped`` (the cap, not
-    a tolerance, ended it)."""
+    a tolerance, ended it).
+
+    ``max_radius`` (``r_max``, optional) is a stability margin: the region
+    is then the disc of radius ``r_max`` (see the module docstring), the
+    start is projected into it, and ``at_bound`` is on its edge."""
     na = arx.na
     residual, jacobian = error_functions(arx, data, predictor, initial)
     if max_nfev is None:
         max_nfev = 100 * (arx.n_params + 1)
-    start = stabilise(np.asarray(theta0, dtype=float), arx)
-    x0 = np.r_[step_up(start[:na]), start[na:]] if na else start
+    theta0 = np.asarray(theta0, dtype=float)
+    if max_radius is None or na == 0:
+        max_radius = None
+        start = stabilise(theta0, arx)
+        x0 = np.r_[step_up(start[:na]), start[na:]] if na else start
+    else:
+        x0 = np.r_[project_denominator(theta0[:na], max_radius, KMAX), theta0[na:]]
     res = levenberg_marquardt(
         residual,
         jacobian,
         x0,
-        project=lambda x: _reflect_into_bound(x, na),
+        project=lambda x: _reflect_into_bound(x, na, max_radius),
         max_nfev=max_nfev,
         tol=_TOL,
         stall=(_STALL_WINDOW * (arx.n_params + 1), _STALL_GAIN),
     )
     res.max_nfev = max_nfev
     res.capped = res.status == 1
+    a_end = res.x[:na] if max_radius is None else scaled(res.x[:na], max_radius)
     res.at_bound = na > 0 and bool(
-        np.max(np.abs(step_down(res.x[:na]))) > KMAX * (1.0 - 1e-9)
+        np.max(np.abs(step_down(a_end))) > KMAX * (1.0 - 1e-9)
     )
     if res.at_bound and not res.capped:
         res.message = (
             "Ended on the edge of the stable region (a reflection coefficient "
             f"at {KMAX}): the cost falls further only with a pole on or outside "
             "the unit circle."
+            if max_radius is None
+            else "Ended on the stability margin (a pole at |z| = max_radius = "
+            f"{max_radius:.6g}): the cost falls further only with a slower pole."
         )
     return res.x.copy(), res
 

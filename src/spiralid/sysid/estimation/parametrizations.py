@@ -27,6 +27,13 @@ model, see the safe start in :mod:`spiralid.sysid.estimation.estimators`).
     ``KMAX = 1 - 1e-6``) and mapped by step-up, so every candidate is stable
     and the penalty never fires. The initial points are uniform in the box.
 
+A stability margin ``r_max`` (``max_radius``; identify's
+``max_time_constant``, see :mod:`~spiralid.sysid.estimation.margin`) is
+applied inside ``"modal"`` (every pole scaled by ``r_max``) and
+``"reflection"`` (the step-up polynomial's roots ``p -> r_max p``, i.e.
+``a_k -> a_k r_max^k``), so every candidate has its poles inside radius
+``r_max``; ``"coefficients"``, the paper's, has none (eq. (3)'s penalty).
+
 Default box: ``|a_i| <= binom(na, i)`` (every stable monic polynomial of
 degree na lies in that box, so it loses no stable model), ``k_i`` in
 ``[-1, 1]``, and ``|b_j| <= s`` with ``s = 2 max_j |b_j^LS|`` scaled from
@@ -62,6 +69,7 @@ from spiralid.choices import PARAMETRIZATION_NAMES, require_names
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
 from ..models.polynomials import fold_reflection, step_down, step_up
+from .margin import project_denominator, scaled, unscaled
 
 __all__ = [
     "DEFAULT_PARAMETRIZATION",
@@ -93,6 +101,10 @@ class Parametrization:
         The estimation record (scales the default numerator box).
     arx : ARX
         The model structure.
+    max_radius : float, optional
+        A stability margin ``r_max``: every candidate's poles inside that
+        radius (``"modal"`` and ``"reflection"`` only; see the module
+        docstring). Default None: the unit circle.
 
     Attributes
     ----------
@@ -104,10 +116,18 @@ class Parametrization:
     """
 
     name: ClassVar[str] = ""
+    # Whether the parametrisation can keep the poles inside a margin.
+    takes_margin: ClassVar[bool] = False
 
-    def __init__(self, data: IOData, arx: ARX):
+    def __init__(self, data: IOData, arx: ARX, max_radius: float | None = None):
+        if max_radius is not None and not self.takes_margin:
+            raise ValueError(
+                f"`parametrization` {self.name!r} has no stability margin; "
+                "use 'modal' or 'reflection'"
+            )
         self.data = data
         self.arx = arx
+        self.max_radius = max_radius
         self._theta_ls: np.ndarray | None = None
 
     @property
@@ -195,6 +215,7 @@ class Reflection(Parametrization):
     """``x = [k, b]``, stable by construction (see the module docstring)."""
 
     name = "reflection"
+    takes_margin = True
 
     def denominator_bounds(self) -> np.ndarray:
         return np.tile([-1.0, 1.0], (self.arx.na, 1))
@@ -204,27 +225,36 @@ class Reflection(Parametrization):
         x2 = np.atleast_2d(xx)
         na = self.arx.na
         a = step_up(fold_reflection(x2[:, :na], KMAX))
+        if self.max_radius is not None:
+            a = unscaled(a, self.max_radius)
         theta = np.concatenate([a, x2[:, na:]], axis=1)
         return theta[0] if xx.ndim == 1 else theta
 
     def from_theta(self, theta) -> np.ndarray:
-        return stabilise(np.asarray(theta, dtype=float), self.arx)
+        th = np.asarray(theta, dtype=float)
+        if self.max_radius is None:
+            return stabilise(th, self.arx)
+        na = self.arx.na
+        a = project_denominator(th[:na], self.max_radius, KMAX)
+        k = step_down(scaled(a, self.max_radius)) if na else a
+        return np.r_[k, th[na:]]
 
 
 class Modal(Parametrization):
     """Modal denominator, numerator projected out (see the module docstring)."""
 
     name = "modal"
+    takes_margin = True
 
-    def __init__(self, data: IOData, arx: ARX):
-        super().__init__(data, arx)
+    def __init__(self, data: IOData, arx: ARX, max_radius: float | None = None):
+        super().__init__(data, arx, max_radius)
         from .modal import ModalParametrization
 
         if arx.na == 0:
             raise ValueError(
                 f"`parametrization` 'modal' needs a denominator; got {arx} (na = 0)"
             )
-        self.modes = ModalParametrization(arx.na, data.ts)
+        self.modes = ModalParametrization(arx.na, data.ts, max_radius=max_radius)
         self._projected = None
 
     @property
@@ -283,13 +313,16 @@ require_names(
 )
 
 
-def make_parametrization(name, data: IOData, arx: ARX) -> Parametrization:
-    """The parametrisation called `name` on this record and structure."""
+def make_parametrization(
+    name, data: IOData, arx: ARX, max_radius: float | None = None
+) -> Parametrization:
+    """The parametrisation called `name` on this record and structure, with
+    the stability margin `max_radius` (``"modal"`` and ``"reflection"``)."""
     if not isinstance(name, str) or name not in PARAMETRIZATIONS:
         raise ValueError(
             f"`parametrization` must be one of {tuple(PARAMETRIZATIONS)}; got {name!r}"
         )
-    return PARAMETRIZATIONS[name](data, arx)
+    return PARAMETRIZATIONS[name](data, arx, max_radius)
 
 
 def default_bounds(
