@@ -77,9 +77,9 @@ for label, rep in reports.items():
     print(f"{label:<14} {percent(rep.fit_percent)} {percent(rep.fit_percent_one_step)}")
 
 # %%
-# The NARX validation also runs the five Billings-Voon correlation tests on
-# the one-step residual, which a model that left no structure unexplained
-# passes:
+# The NARX validation also runs the five Billings-Voon correlation tests,
+# which a model that left no structure unexplained passes, on the residual
+# its summary names (``validate``'s ``residuals=`` chooses it):
 print(reports["NARX oe"].summary())
 
 # %%
