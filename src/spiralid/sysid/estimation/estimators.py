@@ -46,6 +46,17 @@ for ``sda``, ``ebsda``, ``lasda`` and ``de``): their first populations are
 the paper's, so their numbers per seed stay as printed. A method added for
 usable models turns it on in its table entry.
 
+Stability margin and pole-zero cancellation
+--------------------------------------------
+``"spiral"`` and ``"oe"`` (``Method.margin``, ``Method.cancel``) keep every
+pole inside radius ``exp(-ts / T)``, ``T`` the estimation record's length by
+default (identify's ``max_time_constant``,
+:mod:`~spiralid.sysid.estimation.margin`; also the polish of
+``refine=True``), and remove a pole-zero pair closer than the record's
+frequency resolution when that costs at most 1 % (identify's ``cancel``,
+:mod:`~spiralid.sysid.estimation.cancellation`). The paper's searches and
+``"de"`` keep eq. (3)'s penalty alone.
+
 Status
 ------
 ``status`` is a key of :data:`STATUS`: ``1`` when the estimator stopped at
@@ -145,6 +156,11 @@ class EstimatorResult(OptimiserResult):
     refine : EstimatorResult or None
         The polish of ``refine=True``; ``refine.accepted`` says whether it
         lowered the cost (otherwise ``x`` is the search's).
+    cancelled : list of dict, optional
+        The near-cancelling pole-zero pairs removed after the estimate
+        (:func:`~spiralid.sysid.estimation.cancellation.reduce_order`);
+        ``effective_order`` ``(na', nb')`` and ``x_full``, ``fun_full`` (the
+        estimate before) with them.
     raw : object
         The underlying optimiser's own result.
     """
@@ -166,6 +182,11 @@ class Problem:
     bounds: np.ndarray | None = None
     refine: bool = False
     safe_start: bool = False
+    # The stability margin r_max of the polish (and of the parametrisation
+    # when the method applies it), None for none; and whether pole-zero
+    # pairs are cancelled after the estimate.
+    max_radius: float | None = None
+    cancel: bool = False
 
     def simulation_cost(self) -> PaperCost:
         """The simulation cost output error minimises, whatever `predictor`."""
@@ -206,6 +227,14 @@ class Method:
         The error the estimate minimises, for its covariance
         (:mod:`~spiralid.sysid.estimation.uncertainty`): a predictor name, or
         None for the cost's own predictor.
+    margin : bool
+        Applies identify's ``max_time_constant`` (by default the record's
+        length) to its parametrisation and polish; a search without it
+        applies it to ``refine``'s polish only.
+    cancel : bool
+        Default of ``identify(cancel=None)``: remove near-cancelling
+        pole-zero pairs after the estimate; False: the option does not
+        apply.
     """
 
     estimate: Callable[..., EstimatorResult]
@@ -215,6 +244,8 @@ class Method:
     parametrization: str = DEFAULT_PARAMETRIZATION
     narx: Callable[..., OptimiserResult] | None = None
     minimises: str | None = None
+    margin: bool = False
+    cancel: bool = False
 
 
 def search_options(options: dict) -> dict:
@@ -268,7 +299,12 @@ def _polish(
     costs = {}
     for name, start in starts.items():
         theta, res = local_polish(
-            start, problem.arx, problem.data, predictor, problem.initial
+            start,
+            problem.arx,
+            problem.data,
+            predictor,
+            problem.initial,
+            max_radius=problem.max_radius,
         )
         costs[name] = float(cost(theta))
         if best is None or costs[name] < best[0]:
@@ -311,8 +347,45 @@ def _standard_starts(problem: Problem) -> dict[str, np.ndarray]:
 def _estimate_oe(problem: Problem) -> EstimatorResult:
     # With a one-step `predictor` the selection is still on the simulation
     # error OE minimises, not on the reported cost.
-    return _polish(
-        problem, _standard_starts(problem), "simulation", problem.simulation_cost()
+    cost = problem.simulation_cost()
+    result = _polish(problem, _standard_starts(problem), "simulation", cost)
+    if problem.cancel:
+        _cancel(problem, result, cost)
+    return result
+
+
+def _cancel(problem: Problem, result: EstimatorResult, cost: PaperCost) -> None:
+    """Remove the near-cancelling pole-zero pairs that raise `cost` (the
+    error the method minimises) by at most 1 %
+    (:func:`~spiralid.sysid.estimation.cancellation.reduce_order`); each
+    reduced model is polished by output error, with the same margin, from
+    the deflated model (fresh starts at the reduced order would find other
+    minima: that is choosing an order, not removing a pair)."""
+    from .cancellation import effective, reduce_order
+
+    def polish(start, reduced):
+        theta, _ = local_polish(
+            start,
+            reduced,
+            problem.data,
+            "simulation",
+            problem.initial,
+            max_radius=problem.max_radius,
+        )
+        return theta
+
+    theta, removed = reduce_order(result.x, problem.arx, problem.data.n, cost, polish)
+    if not removed:
+        return
+    result.x_full, result.fun_full = result.x, result.fun
+    result.x, result.fun = theta, float(problem.cost(theta))
+    result.cancelled = removed
+    k = sum(c["order"] for c in removed)
+    result.effective_order = (problem.arx.na - k, problem.arx.nb - k)
+    _, reduced = effective(theta, problem.arx, result.effective_order)
+    result.message = (
+        f"{result.message} Then {len(removed)} near-cancelling pole-zero "
+        f"pair(s) removed: effective order {reduced}."
     )
 
 
@@ -430,6 +503,14 @@ def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
         rows = [par.from_theta(th) for th in (theta_ls, theta_sm, 0 * theta_ls)]
         a_ls = step_up(stabilise(theta_ls, arx)[: arx.na])
         safe = np.array([a_ls, theta_sm[: arx.na]])
+        if problem.max_radius is not None:
+            # The safe denominators obey the margin as the search does.
+            from .margin import project_denominator
+            from .parametrizations import KMAX
+
+            safe = np.array(
+                [project_denominator(a, problem.max_radius, KMAX) for a in safe]
+            )
     if n_peaks:
         rows += list(frequency_seeds(problem.data, modes, int(n_peaks), problem.rng))
     if x0 is not None:
@@ -470,8 +551,12 @@ def _estimate_recommended(
     the stabilised least-squares and Steiglitz-McBride starts (as
     ``refine=True``), and the lowest cost is kept: the result is never above
     output error's (unless ``polish_every=None``, which asks for no
-    gradient step at all). Default budget ``max_nfev = 10_000`` evaluations of the
-    search, its polish steps included (``benchmarks/identification.py``
+    gradient step at all) before the pole-zero cancellation (``cancel``),
+    which may then trade at most 1 % of that cost for a lower order
+    (``fun_full`` is the cost before). The search, its polish and output
+    error keep the stability margin (``max_time_constant``). Default budget
+    ``max_nfev = 10_000`` evaluations of the search, its polish steps
+    included (``benchmarks/identification.py``
     measures what each ingredient does). An FIR structure (``na = 0``) has no
     modes: its cost is quadratic in the numerator and the exact minimiser is
     returned without a search.
@@ -543,6 +628,8 @@ def _estimate_recommended(
         # own best (the search's LM steps are capped, OE's run to its
         # tolerances). `polish_every=None` asks for no gradient step at all.
         _refine(problem, result)
+    if problem.cancel:
+        _cancel(problem, result, problem.cost)
     return result
 
 
@@ -600,11 +687,15 @@ METHODS: dict[str, Method] = {
         safe_start=True,
         parametrization="modal",
         narx=_narx.estimate_spiral,
+        margin=True,
+        cancel=True,
     ),
     "ls": Method(
         _estimate_ls, search=False, narx=_narx.estimate_ls, minimises="one-step"
     ),
-    "oe": Method(_estimate_oe, search=False, narx=_narx.estimate_oe),
+    "oe": Method(
+        _estimate_oe, search=False, narx=_narx.estimate_oe, margin=True, cancel=True
+    ),
 }
 
 require_names(METHODS, METHOD_NAMES, "spiralid.sysid.METHODS")

@@ -28,6 +28,16 @@ and docs/guide/estimation.md measure both). Use ``"measured"`` only
 for a record that starts in motion, such as the real arm (a slice of a
 periodic sweep). Least squares and the one-step predictor do not depend on
 it.
+
+Stability margin and order (``max_time_constant``, ``cancel``)
+--------------------------------------------------------------
+``"spiral"``, ``"oe"`` and the polish of ``refine=True`` keep every pole
+inside radius ``exp(-ts / T)``, ``T`` the estimation record's length by
+default (:mod:`~spiralid.sysid.estimation.margin`), and ``"spiral"`` and
+``"oe"`` then remove a pole-zero pair closer than the record's frequency
+resolution when that raises the cost by at most 1 %
+(:mod:`~spiralid.sysid.estimation.cancellation`). The paper's searches keep
+eq. (3) as printed: they refuse either option.
 """
 
 from __future__ import annotations
@@ -44,11 +54,14 @@ from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from ..models.narx import NARX, PolynomialNARX
 from ..models.polynomials import with_integrator
+from .cancellation import effective, embed_covariance
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS, Problem
+from .margin import AUTO, max_radius
 from .outputerror import steiglitz_mcbride
 from .parametrizations import (
     DEFAULT_PARAMETRIZATION,
+    PARAMETRIZATIONS,
     default_bounds,
     feasible_initial_points,
     make_parametrization,
@@ -102,6 +115,8 @@ def identify(
     initial: str = "rest",
     safe_start: bool | None = None,
     integrator: bool = False,
+    max_time_constant: float | str | None = AUTO,
+    cancel: bool | None = None,
     **optimiser_options,
 ) -> IdentifiedModel:
     """Estimate an ARX model from input-output data.
@@ -172,6 +187,31 @@ def identify(
         is composed back. Needs ``predictor="simulation"`` and
         ``initial="rest"``. The model is marginally stable by design: its
         stability verdict is on the other poles.
+    max_time_constant : float, "auto" or None, default "auto"
+        A stability margin tied to the data, in seconds: every pole inside
+        the radius ``r_max = exp(-ts / T)``, the pole of a continuous mode
+        with time constant ``T`` (:mod:`~spiralid.sysid.estimation.margin`).
+        A mode slower than the record is indistinguishable from drift; an
+        unconstrained estimate fits the drift with a pole at ``|z| ~
+        0.9999`` nearly cancelled by a zero, and validates badly.
+        ``"auto"``: ``T = N ts``, the estimation record's length, for
+        ``"spiral"``, ``"oe"`` and the polish of ``refine=True`` (applied
+        inside the modal parametrisation, the variable-projection polish and
+        the Levenberg-Marquardt polish, so no evaluation is spent outside
+        it), and no margin for the others. ``None``: no margin (the unit
+        circle). A number or None given to a method it does not apply to
+        (the paper's searches and ``"de"`` without ``refine``, ``"ls"``) is
+        refused: they keep eq. (3)'s penalty as printed. A plant that
+        integrates is ``integrator=True``, never a pole near ``z = 1``.
+    cancel : bool, optional
+        After ``"spiral"`` and ``"oe"`` (their default, True), remove a pole
+        and a zero closer than the record's frequency resolution (``|p - z|
+        < 2 pi / N``) when the reduced model, polished by output error,
+        costs at most 1 % more
+        (:mod:`~spiralid.sysid.estimation.cancellation`). The model keeps
+        the structure asked for, with zero coefficients where the pair was;
+        ``effective_order`` and ``cancellations`` say what was removed.
+        Refused by the other methods.
     **optimiser_options
         Passed to :func:`spiralid.optim.minimize` (``n_points``, ``max_iter``,
         ``max_nfev``, ``target``, ``callback``, ``bounds_policy``, ``x0``...);
@@ -214,6 +254,8 @@ def identify(
                 bounds=bounds,
                 safe_start=safe_start,
                 integrator=integrator,
+                max_time_constant=max_time_constant,
+                cancel=cancel,
             ),
             **optimiser_options,
         )
@@ -241,6 +283,8 @@ def identify(
                 bounds=bounds,
                 initial=initial,
                 safe_start=safe_start,
+                max_time_constant=max_time_constant,
+                cancel=cancel,
                 **optimiser_options,
             ),
         )
@@ -251,13 +295,22 @@ def identify(
             # An FIR model has no modes; the recommended method solves it
             # exactly over the coefficients (see `_estimate_fir`).
             parametrization = DEFAULT_PARAMETRIZATION
-    par = make_parametrization(parametrization, data, arx)
+    if not isinstance(refine, bool | np.bool_):
+        raise ValueError(f"`refine` must be True or False; got {refine!r}")
+    radius, cancel = margin_options(method, data, refine, max_time_constant, cancel)
+    # The margin inside the search: for the methods that apply it, in a
+    # parametrisation that can hold it (a paper search's refine polishes alone).
+    kind = (
+        PARAMETRIZATIONS.get(parametrization)
+        if isinstance(parametrization, str)
+        else None
+    )
+    inside = METHODS[method].margin and getattr(kind, "takes_margin", False)
+    par = make_parametrization(parametrization, data, arx, radius if inside else None)
     if safe_start is not None and not isinstance(safe_start, bool | np.bool_):
         raise ValueError(
             f"`safe_start` must be True, False or None; got {safe_start!r}"
         )
-    if not isinstance(refine, bool | np.bool_):
-        raise ValueError(f"`refine` must be True or False; got {refine!r}")
     spec = METHODS[method]
     cost = PaperCost(
         arx, data, predictor=predictor, gain=gain, penalty=penalty, initial=initial
@@ -275,13 +328,26 @@ def identify(
         bounds=None if bounds is None else _check_bounds(bounds, par.n_search),
         refine=bool(refine),
         safe_start=spec.safe_start if safe_start is None else bool(safe_start),
+        max_radius=radius,
+        cancel=cancel,
     )
     res = spec.estimate(problem, **optimiser_options)
     refined = res.get("refine")
     t_refine = 0.0 if refined is None else refined.elapsed
-    covariance, s2 = parameter_covariance(
-        res.x, arx, data, spec.minimises or predictor, initial
-    )
+    cancelled = res.get("cancelled") or []
+    if cancelled:
+        # The removed coefficients are fixed at zero, not estimated: the
+        # covariance is the reduced model's, with zero variance for them.
+        order = res.effective_order
+        theta_r, arx_r = effective(res.x, arx, order)
+        cov_r, s2 = parameter_covariance(
+            theta_r, arx_r, data, spec.minimises or predictor, initial
+        )
+        covariance = embed_covariance(cov_r, arx, order)
+    else:
+        covariance, s2 = parameter_covariance(
+            res.x, arx, data, spec.minimises or predictor, initial
+        )
     return IdentifiedModel(
         res.x,
         arx=arx,
@@ -304,8 +370,55 @@ def identify(
         bounds=res.get("bounds"),
         covariance=covariance,
         noise_variance=s2,
+        cancellations=tuple(cancelled),
         **data.provenance(),
     )
+
+
+def margin_options(method: str, data: IOData, refine, max_time_constant, cancel):
+    """identify's ``max_time_constant`` and ``cancel`` for `method`: the
+    margin's radius (None: none) and whether to cancel; a value given to a
+    method it does not apply to is a one-line ValueError."""
+    spec = METHODS[method]
+    applies = spec.margin or (spec.search and bool(refine))
+    where = tuple(name for name, m in METHODS.items() if m.margin)
+    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
+        seconds = data.n * data.ts if applies else None
+    else:
+        if not applies:
+            why = (
+                "keeps eq. (3)'s penalty as printed"
+                if spec.search
+                else "takes no margin"
+            )
+            raise ValueError(
+                f"`max_time_constant` applies to the methods {where} and to the "
+                f"polish of refine=True; method {method!r} {why} (got "
+                f"{max_time_constant!r})"
+            )
+        if max_time_constant is not None:
+            bad = isinstance(max_time_constant, bool | np.bool_ | str)
+            try:
+                seconds = float(max_time_constant)
+            except (TypeError, ValueError):
+                bad = True
+            if bad or not (np.isfinite(seconds) and seconds > 0):
+                raise ValueError(
+                    "`max_time_constant` must be a number of seconds > 0, "
+                    f"{AUTO!r} or None; got {max_time_constant!r}"
+                )
+        else:
+            seconds = None
+    if cancel is None:
+        cancel = spec.cancel
+    elif not isinstance(cancel, bool | np.bool_):
+        raise ValueError(f"`cancel` must be True, False or None; got {cancel!r}")
+    elif not spec.cancel:
+        able = tuple(name for name, m in METHODS.items() if m.cancel)
+        raise ValueError(
+            f"`cancel` applies to the methods {able}; method {method!r} got {cancel!r}"
+        )
+    return max_radius(data.ts, seconds), bool(cancel)
 
 
 def _identify_narx(data, structure, method, *, other: dict, **options):
@@ -327,6 +440,8 @@ def _identify_narx(data, structure, method, *, other: dict, **options):
         bounds=None,
         safe_start=None,
         integrator=False,
+        max_time_constant=AUTO,
+        cancel=None,
     )
     given = sorted(k for k, v in other.items() if v is not defaults[k])
     if given:

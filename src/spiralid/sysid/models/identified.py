@@ -78,6 +78,15 @@ class IdentifiedModel:
     noise_variance : float
         ``s^2``, the variance of the error the estimator minimised (NaN when
         not computed).
+    cancellations : tuple of dict
+        The near-cancelling pole-zero pairs removed after the estimation
+        (``identify(cancel=True)``,
+        :mod:`~spiralid.sysid.estimation.cancellation`): each with the
+        ``pole`` and ``zero`` (``[re, im]``, the upper one of a complex
+        pair), its ``order`` (1 real, 2 a complex pair), their
+        ``distance``, the ``tolerance`` and the ``cost_increase`` (a share
+        of the cost). The removed coefficients are zeros at the end of
+        ``a`` and ``b``; :attr:`effective_order` is what is left.
     """
 
     theta: np.ndarray
@@ -112,6 +121,7 @@ class IdentifiedModel:
     integrator: bool = False
     covariance: np.ndarray | None = None
     noise_variance: float = float("nan")
+    cancellations: tuple = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
@@ -145,6 +155,17 @@ class IdentifiedModel:
                     f"{' with an integrator' if self.integrator else ''}; got "
                     f"{self.covariance.shape}"
                 )
+        self.cancellations = tuple(self.cancellations)
+        na_eff, nb_eff = self.effective_order
+        removed = np.r_[
+            self.theta[na_eff : self.arx.na], self.theta[self.arx.na + nb_eff :]
+        ]
+        if na_eff < 0 or nb_eff < 1 or np.any(removed != 0.0):
+            raise ValueError(
+                "`cancellations` must leave na >= 0, nb >= 1 and zeros where "
+                f"the pairs were removed; got effective order ({na_eff}, "
+                f"{nb_eff}) of {self.arx}"
+            )
         biggest = float(np.max(np.abs(self.theta), initial=0.0))
         if biggest > _MAX_COEFFICIENT:
             # Two such coefficients multiplied pass float64's range (1.8e308):
@@ -165,17 +186,60 @@ class IdentifiedModel:
         return self.arx.predict(self.theta, data)
 
     @property
+    def effective_order(self) -> tuple[int, int]:
+        """``(na, nb)`` left after the removed pole-zero pairs
+        (:attr:`cancellations`); the structure's own when none was."""
+        k = sum(int(c["order"]) for c in self.cancellations)
+        return self.arx.na - k, self.arx.nb - k
+
+    def _effective(self) -> tuple[ARX, np.ndarray]:
+        """The structure and theta of :attr:`effective_order` (the same
+        transfer function, without the removed coefficients' zeros)."""
+        if not self.cancellations:
+            return self.arx, self.theta
+        na, nb = self.effective_order
+        arx = ARX(na, nb, self.arx.nk)
+        return arx, np.r_[self.theta[:na], self.theta[self.arx.na : self.arx.na + nb]]
+
+    @property
     def polynomials(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(num, den)`` in ``z^-1``, equal lengths (see ``ARX.polynomials``)."""
-        return self.arx.polynomials(self.theta)
+        """``(num, den)`` in ``z^-1``, equal lengths (see ``ARX.polynomials``),
+        of the :attr:`effective_order`."""
+        arx, theta = self._effective()
+        return arx.polynomials(theta)
 
     @property
     def poles(self) -> np.ndarray:
-        return self.arx.poles(self.theta)
+        """Poles in z (of the :attr:`effective_order`: none for a removed
+        pair)."""
+        arx, theta = self._effective()
+        return arx.poles(theta)
 
     @property
     def zeros(self) -> np.ndarray:
-        return self.arx.zeros(self.theta)
+        """Finite zeros in z (of the :attr:`effective_order`)."""
+        arx, theta = self._effective()
+        return arx.zeros(theta)
+
+    @property
+    def reduction(self) -> str | None:
+        """What the pole-zero cancellation removed, in a sentence, or None."""
+        if not self.cancellations:
+            return None
+        where = ", ".join(_root_text(c["pole"]) for c in self.cancellations)
+        dist = max(float(c["distance"]) for c in self.cancellations)
+        tol = float(self.cancellations[0]["tolerance"])
+        # Each removal's rise is of the cost before any: the last is the total.
+        rise = float(self.cancellations[-1]["cost_increase"])
+        na, nb = self.effective_order
+        n = len(self.cancellations)
+        return (
+            f"{n} near-cancelling pole-zero pair{'s' if n > 1 else ''} removed "
+            f"after the estimation (pole at z = {where}; |p - z| <= {dist:.2g}, "
+            f"below the record's resolution 2 pi / N = {tol:.2g}; estimation "
+            f"cost {100 * rise:+.2g} %): effective order na = {na}, nb = {nb} "
+            f"of {self.arx}"
+        )
 
     @property
     def free_denominator(self) -> np.ndarray:
@@ -227,8 +291,10 @@ class IdentifiedModel:
         return np.r_[np.zeros(self.arx.nk), self.theta[self.arx.na :]]
 
     def tf_string(self, digits: int = 4) -> str:
-        """Transfer function in z as eq. (9)-(10) print it."""
-        return self.arx.tf_string(self.theta, digits=digits)
+        """Transfer function in z as eq. (9)-(10) print it (of the
+        :attr:`effective_order`)."""
+        arx, theta = self._effective()
+        return arx.tf_string(theta, digits=digits)
 
     def to_dlti(self) -> signal.dlti:
         """The model as a ``scipy.signal.dlti`` transfer function with ``dt = ts``."""
@@ -295,6 +361,7 @@ class IdentifiedModel:
             if self.covariance is None
             else np.where(np.isfinite(self.covariance), self.covariance, None).tolist(),
             "noise_variance": _finite_or_none(self.noise_variance),
+            "cancellations": [dict(c) for c in self.cancellations],
             "modes": self.modes.to_dict(),
             "result": summary,
         }
@@ -370,6 +437,7 @@ class IdentifiedModel:
                 )
                 if d.get("noise_variance") is not None
                 else math.nan,
+                cancellations=_cancellations_field(d),
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None
@@ -385,6 +453,46 @@ class IdentifiedModel:
 
 def _finite_or_none(value: float) -> float | None:
     return float(value) if np.isfinite(value) else None
+
+
+def _root_text(root) -> str:
+    re, im = (float(v) for v in root)
+    return f"{re:.4g}" if im == 0.0 else f"{re:.4g} +- {abs(im):.4g}j"
+
+
+def _cancellations_field(d: dict) -> tuple:
+    """The file's ``cancellations``: a list of objects with a ``pole`` and a
+    ``zero`` ([re, im]), an ``order`` (1 or 2) and three numbers."""
+    raw = d.get("cancellations") or []
+    bad = ValueError(
+        "field 'cancellations' must be a list of objects with 'pole' and 'zero' "
+        "([re, im]), 'order' (1 or 2), 'distance', 'tolerance' and "
+        "'cost_increase'"
+    )
+    if not isinstance(raw, list):
+        raise bad
+    out = []
+    for c in raw:
+        try:
+            entry = {
+                "pole": [float(v) for v in c["pole"]],
+                "zero": [float(v) for v in c["zero"]],
+                "order": c["order"],
+                "distance": float(c["distance"]),
+                "tolerance": float(c["tolerance"]),
+                "cost_increase": float(c["cost_increase"]),
+            }
+        except (KeyError, TypeError, ValueError):
+            raise bad from None
+        if (
+            len(entry["pole"]) != 2
+            or len(entry["zero"]) != 2
+            or entry["order"] not in (1, 2)
+            or isinstance(entry["order"], bool)
+        ):
+            raise bad
+        out.append(entry)
+    return tuple(out)
 
 
 def _covariance_field(d: dict) -> np.ndarray | None:

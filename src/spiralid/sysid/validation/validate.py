@@ -345,6 +345,9 @@ class Validation:
         The model's modes with 95 % intervals and flags
         (:attr:`~spiralid.sysid.IdentifiedModel.modes`), when the model has
         a covariance.
+    reduction : str or None
+        What the estimation's pole-zero cancellation removed
+        (:attr:`~spiralid.sysid.IdentifiedModel.reduction`), or None.
     """
 
     label: str
@@ -384,6 +387,7 @@ class Validation:
     diverged: bool = False
     output_error: bool = False
     mode_table: ModeTable | None = None
+    reduction: str | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -416,11 +420,16 @@ class Validation:
                 f"{at_origin} pole(s) at the origin (vanishing denominator "
                 "coefficients)"
             )
+        # What the estimation already removed (`identify(cancel=True)`).
+        done = [] if self.reduction is None else [self.reduction]
         if not reasons:
-            return None
-        return (
-            f"{' and '.join(reasons)}: the order is higher than the data "
-            "support; try a lower one"
+            return done[0] if done else None
+        return "; ".join(
+            [
+                *done,
+                f"{' and '.join(reasons)}: the order is higher than the data "
+                "support; try a lower one",
+            ]
         )
 
     def summary(self) -> str:
@@ -799,7 +808,9 @@ def validate(
     fs = 1.0 / ts
     spec_y = psd(y, fs, nperseg=nperseg)
     spec_m = psd(y_sim, fs, nperseg=nperseg)
-    num, den = model.arx.polynomials(model.theta)
+    # An IdentifiedModel's own polynomials: those of its effective order
+    # when the estimation removed a pole-zero pair.
+    num, den = getattr(model, "polynomials", None) or model.arx.polynomials(model.theta)
     label = label if label is not None else str(getattr(model, "method", "") or "")
 
     return Validation(
@@ -840,6 +851,7 @@ def validate(
         diverged=diverged,
         output_error=_fitted_error(model) == "simulation",
         mode_table=_mode_table(model),
+        reduction=getattr(model, "reduction", None),
     )
 
 
