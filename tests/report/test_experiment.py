@@ -87,11 +87,30 @@ def test_baselines_and_table2(rep, data):
 def test_summary_and_verdict_are_honest(rep):
     text = summary_text(rep)
     assert "Table-2" in text and verdict(rep) in text
-    a = rep.statistics("Eb-SDA")["cost_median"]
-    b = rep.statistics("SDA")["cost_median"]
+    test = rep.ranksum("Eb-SDA", "SDA")
     assert verdict(rep).startswith("Eb-SDA beat") == (
-        a < b and rep.ranksum("Eb-SDA", "SDA")["p_less"] < 0.05
+        test["p_two_sided"] < 0.05 and test["a12"] > 0.5
     )
+
+
+def test_one_headline_test_in_summary_results_and_report(rep):
+    """The verdict's test is the two-sided rank-sum test, named and quoted the
+    same in summary_text, results.json and report.html; no one-sided p."""
+    from spiralid.report.output import HEADLINE_TEST, _html
+
+    results = json.loads(json.dumps(results_dict(rep)))
+    head = results["headline_test"]
+    p = rep.ranksum("Eb-SDA", "SDA")["p_two_sided"]
+    assert head["test"] == HEADLINE_TEST and "two-sided" in HEADLINE_TEST
+    assert (head["a"], head["b"], head["p_two_sided"]) == ("Eb-SDA", "SDA", p)
+    assert head["verdict"] == results["verdict"] == verdict(rep)
+    assert f"two-sided Wilcoxon rank-sum p = {p:.3g}" in head["verdict"]
+    text = summary_text(rep)
+    page = _html(rep, {}, None)
+    for where in (text, page):
+        assert head["verdict"] in where
+        assert f"Headline test: {HEADLINE_TEST}." in where
+        assert "one-sided" not in where
 
 
 def test_bad_input(data):

@@ -20,9 +20,11 @@ body { font-family: sans-serif; max-width: 980px; margin: 2em auto; color: #222;
 table { border-collapse: collapse; margin: 1em 0; font-size: 0.92em; }
 th, td { border: 1px solid #bbb; padding: 0.25em 0.6em; text-align: left; }
 th { background: #eee; }
-img { max-width: 100%; }
-code, pre { background: #f5f5f5; }
-pre { padding: 0.6em; overflow-x: auto; }
+img { max-width: 100%; height: auto; }
+code, pre { background: #f5f5f5; overflow-wrap: anywhere; }
+pre { padding: 0.6em; white-space: pre-wrap; }
+.table-wrap { max-width: 100%; overflow-x: auto; margin: 1em 0; }
+.table-wrap table { margin: 0; }
 .caption { font-size: 0.9em; color: #444; margin-bottom: 2em; }
 """
 
@@ -48,7 +50,11 @@ def table(header: list[str], rows: list[list], fmt: str = "text") -> str:
             "<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
             for row in cells
         )
-        return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+        # In a box of the column's width that scrolls a table wider than it.
+        return (
+            f"<div class='table-wrap'><table><thead><tr>{head}</tr></thead>"
+            f"<tbody>{body}</tbody></table></div>"
+        )
     widths = [max([len(h), *(len(r[i]) for r in cells)]) for i, h in enumerate(header)]
     line = "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))
     out = [line, "  ".join("-" * w for w in widths)]
