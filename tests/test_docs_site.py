@@ -21,6 +21,7 @@ import importlib
 import json
 import os
 import re
+import select
 import shutil
 import subprocess
 import types
@@ -156,6 +157,11 @@ class Browser:
 
     def _read(self) -> dict:
         while b"\0" not in self._buffer:
+            # A safety net only (see patience.py): a page loads in well under
+            # a second.
+            wait = allowance(60)
+            if not select.select([self._from_browser], [], [], wait)[0]:
+                raise RuntimeError(f"Chromium did not answer in {wait:.0f} s")
             chunk = os.read(self._from_browser, 1 << 16)
             if not chunk:
                 raise RuntimeError("Chromium closed its pipe")
