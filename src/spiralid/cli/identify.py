@@ -9,6 +9,7 @@ from .options import (
     _add_data_options,
     _add_detrend_option,
     _add_initial_option,
+    _add_quiet_option,
     _detrended,
     _fraction,
     _given,
@@ -18,6 +19,7 @@ from .options import (
     _nonneg_int,
     _open_folder,
     _positive_int,
+    _progress,
     _refuse_unused,
     _save_figures,
 )
@@ -38,6 +40,25 @@ def _holdout(text: str) -> float:
         import argparse
 
         raise argparse.ArgumentTypeError(f"must be a number in [0, 0.5); got {text!r}")
+    return v
+
+
+def _time_constant(text: str) -> float | str | None:
+    """--max-time-constant: seconds > 0, 'none' (no margin) or 'auto' (the
+    estimation part's length for the methods it applies to)."""
+    word = text.strip().lower()
+    if word in ("none", "auto"):
+        return None if word == "none" else "auto"
+    try:
+        v = float(text)
+    except ValueError:
+        v = float("nan")
+    if not (v > 0 and v < float("inf")):
+        import argparse
+
+        raise argparse.ArgumentTypeError(
+            f"must be a number of seconds > 0 or 'none'; got {text!r}"
+        )
     return v
 
 
@@ -68,54 +89,104 @@ def _narx_structure(args):
 
 def _run_narx(args) -> int:
     """`spiralid identify --model narx|polynomial`."""
-    from spiralid.sysid import METHODS, identify, validate
+    from spiralid.sysid import METHODS, identify
 
-    data = _load_data(args)
-    if args.detrend:
-        data = _detrended(data, args.fraction)
-    structure = _narx_structure(args)
-    est, val = data.split(args.fraction)
-    structure.check_length(est, "estimation part of DATA")
-    options = {}
-    if METHODS[args.method].search:
-        options = {"n_points": args.points}
-        if args.budget is not None:
-            options["max_nfev"] = args.budget
-        if args.iterations is not None:
-            options["max_iter"] = args.iterations
-    with _open_folder(args.out, args.force) as folder:
-        model = identify(
-            est,
-            structure,
-            method=args.method,
-            predictor=args.predictor,
-            initial=args.initial,
-            rng=args.seed,
-            holdout=args.holdout,
-            **options,
-        )
-        v_est = validate(model, est, label=f"{args.method} (estimation)")
-        v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
-        staged = folder.path
-        summary = _write_model(
-            staged, model, v_est, v_val, f"{structure} by {args.method} on {args.data}"
-        )
-        _save_figures(v_val.plot(), staged, "validation_")
-        written = folder.commit(last="model.json")
+    with _progress(args) as progress:
+        progress.phase("load", "loading the data")
+        data = _load_data(args)
+        if args.detrend:
+            data = _detrended(data, args.fraction)
+        structure = _narx_structure(args)
+        est, val = data.split(args.fraction)
+        structure.check_length(est, "estimation part of DATA")
+        options = {}
+        if METHODS[args.method].search:
+            options = {"n_points": args.points}
+            if args.budget is not None:
+                options["max_nfev"] = args.budget
+            if args.iterations is not None:
+                options["max_iter"] = args.iterations
+        with _open_folder(args.out, args.force) as folder:
+            steps = _search_steps(args, narx=True)
+            what = f"estimating {structure} by {args.method}"
+            progress.phase("estimation", what, **steps)
+            if steps:
+                options["callback"] = _search_callback(progress, steps, args)
+            model = identify(
+                est,
+                structure,
+                method=args.method,
+                predictor=args.predictor,
+                initial=args.initial,
+                rng=args.seed,
+                holdout=args.holdout,
+                **options,
+            )
+            progress.phase("validation", "validating on both parts")
+            v_est, v_val = _validated(model, est, val, args.method)
+            progress.phase("writing", "writing files and figures")
+            staged = folder.path
+            headline = f"{structure} by {args.method} on {args.data}"
+            summary = _write_model(staged, model, v_est, v_val, headline)
+            _save_figures(v_val.plot(), staged, "validation_")
+            _write_timings(staged, progress, model)
+            written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)
         print(f"\nwrote {_listing(written, args.out)}")
     return 0
 
 
+# The budget of the searches that have one of their own (identify's
+# "spiral", estimators._estimate_recommended, and every NARX search,
+# narx.estimate_search and estimate_spiral), and the iteration cap of the
+# others (spiralid.optim.minimize, differential_evolution): what --help says
+# and what the progress counts toward.
+_DEFAULT_BUDGET = 10_000
+_DEFAULT_ITERATIONS = 500
+
+
+def _search_steps(args, narx: bool = False) -> dict:
+    """What the search's progress counts toward: ``{"total", "unit"}``, or
+    nothing for a method that does not search (or does not report: the
+    NARX "spiral")."""
+    from spiralid.sysid import METHODS
+
+    if not METHODS[args.method].search or (narx and args.method == "spiral"):
+        return {}
+    if args.budget is not None or args.method == "spiral" or narx:
+        return {"total": args.budget or _DEFAULT_BUDGET, "unit": "evaluations"}
+    return {"total": args.iterations or _DEFAULT_ITERATIONS, "unit": "iterations"}
+
+
+def _search_callback(progress, steps: dict, args):
+    """The search's ``callback(intermediate_result)``: reports its
+    evaluations (or iterations) to `progress`; never asks it to stop."""
+    if steps["unit"] == "iterations":
+        return lambda res: progress(int(res.nit))
+    if args.method == "de":
+        # SciPy counts calls, one population per generation.
+        return lambda res: progress(args.points * (int(res.nit) + 1))
+    return lambda res: progress(int(res.nfev))
+
+
+def _validated(model, est, val, label: str):
+    """The validations of `model` on the estimation and validation parts."""
+    from spiralid.sysid import validate
+
+    v_est = validate(model, est, label=f"{label} (estimation)")
+    v_val = validate(model, val, warmup=est, label=f"{label} (validation)")
+    return v_est, v_val
+
+
 def _write_model(staged, model, v_est, v_val, headline: str) -> str:
-    """model.json, timings.json, validation.json and summary.txt of a fitted
-    model (ARX or NARX); returns the summary. model.json holds what the seed
-    decides, byte for byte the same on a rerun; the wall times go beside it."""
+    """model.json, validation.json and summary.txt of a fitted model (ARX
+    or NARX); returns the summary. model.json holds what the seed decides,
+    byte for byte the same on a rerun; the wall times go beside it
+    (:func:`_write_timings`)."""
     (staged / "model.json").write_text(
         json.dumps(model.to_dict(timings=False), indent=2)
     )
-    (staged / "timings.json").write_text(json.dumps(model.timings, indent=2))
     (staged / "validation.json").write_text(
         json.dumps(
             {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
@@ -133,18 +204,33 @@ def _write_model(staged, model, v_est, v_val, headline: str) -> str:
     return summary
 
 
-def write_arx_model(staged, model, est, val, label: str, headline: str) -> str:
-    """An ARX model validated on both parts of the record, written as
-    ``spiralid identify`` writes it (:func:`_write_model` and the
+def write_arx_model(staged, model, v_est, v_val, headline: str) -> str:
+    """An ARX model and its validations on both parts of the record, written
+    as ``spiralid identify`` writes them (:func:`_write_model` and the
     estimation and validation figures); returns the summary."""
-    from spiralid.sysid import validate
-
-    v_est = validate(model, est, label=f"{label} (estimation)")
-    v_val = validate(model, val, warmup=est, label=f"{label} (validation)")
     summary = _write_model(staged, model, v_est, v_val, headline)
     _save_figures(v_val.plot(), staged, "validation_")
     _save_figures(v_est.plot(), staged, "estimation_")
     return summary
+
+
+def _write_timings(staged, progress, model=None) -> None:
+    """timings.json: the seconds of each phase of the command (load,
+    estimation or search, validation, writing), the estimator's own parts
+    after its phase (the search and the polish of ``model.timings``) and
+    the command's total; written last, just before the commit."""
+    phases = progress.timings()
+    total = phases.pop("total")
+    own = {} if model is None else model.timings
+    own = {k: float(v) for k, v in own.items() if k != "total" and k not in phases}
+    times = {}
+    for name, seconds in phases.items():
+        times[name] = seconds
+        if name == "estimation":
+            times.update(own)
+    times.update({k: v for k, v in own.items() if k not in times})
+    times["total"] = total
+    (staged / "timings.json").write_text(json.dumps(times, indent=2))
 
 
 # The options only a search takes (an MLP NARX draws its initial weights
@@ -155,6 +241,7 @@ _SEARCH_FLAGS = ("--points", "--iterations", "--budget", "--seed", "--parametriz
 _MODEL_FLAGS = {
     "--refine": ("arx",),
     "--parametrization": ("arx",),
+    "--max-time-constant": ("arx",),
     "--hidden": ("narx",),
     "--activation": ("narx",),
     "--degree": ("polynomial",),
@@ -180,6 +267,14 @@ def _check_options(args) -> None:
         _refuse_unused(
             _given(args, *flags),
             f"to --model {' and '.join(owners)}, not to --model {model}",
+        )
+    spec = METHODS[method]
+    if model == "arx" and not (spec.margin or (spec.search and args.refine)):
+        margin = ", ".join(name for name, m in METHODS.items() if m.margin)
+        _refuse_unused(
+            _given(args, "--max-time-constant"),
+            f"to --method {margin} and to --refine's polish, not to --method "
+            f"{method}" + (" without --refine" if spec.search else ""),
         )
     if METHODS[method].search:
         return
@@ -212,41 +307,54 @@ def run(args, argv: list[str]) -> int:
     _check_options(args)
     if args.model != "arx":
         return _run_narx(args)
-    data = _load_data(args)
-    if args.detrend:
-        data = _detrended(data, args.fraction)
-    arx = _structure(args)
-    est, val = data.split(args.fraction)
-    arx.check_length(est, "estimation part of DATA")
-    options = {}
-    if METHODS[args.method].search:
-        # The budget rule is identify()'s (estimators.search_options).
-        options = {"n_points": args.points, "max_nfev": args.budget}
-        if args.iterations is not None:
-            options["max_iter"] = args.iterations
-    with _open_folder(args.out, args.force) as folder:
-        model = identify(
-            est,
-            arx,
-            method=args.method,
-            predictor=args.predictor,
-            initial=args.initial,
-            integrator=args.integrator,
-            parametrization=args.parametrization,
-            refine=args.refine,
-            rng=args.seed,
-            **options,
-        )
-        staged = folder.path
-        model.fraction = args.fraction
-        headline = f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}"
-        summary = write_arx_model(staged, model, est, val, args.method, headline)
-        if model.history is not None:
-            plot_convergence(
-                {args.method: model.history},
-                cost_label="best cost, eq. (2) (% of rms(y))",
-            ).savefig(staged / "convergence.png", dpi=110)
-        written = folder.commit(last="model.json")
+    with _progress(args) as progress:
+        progress.phase("load", "loading the data")
+        data = _load_data(args)
+        if args.detrend:
+            data = _detrended(data, args.fraction)
+        arx = _structure(args)
+        est, val = data.split(args.fraction)
+        arx.check_length(est, "estimation part of DATA")
+        options = {}
+        if METHODS[args.method].search:
+            # The budget rule is identify()'s (estimators.search_options).
+            options = {"n_points": args.points, "max_nfev": args.budget}
+            if args.iterations is not None:
+                options["max_iter"] = args.iterations
+        with _open_folder(args.out, args.force) as folder:
+            steps = _search_steps(args)
+            progress.phase("estimation", f"estimating {arx} by {args.method}", **steps)
+            if steps:
+                options["callback"] = _search_callback(progress, steps, args)
+            model = identify(
+                est,
+                arx,
+                method=args.method,
+                predictor=args.predictor,
+                initial=args.initial,
+                integrator=args.integrator,
+                parametrization=args.parametrization,
+                refine=args.refine,
+                rng=args.seed,
+                max_time_constant=args.max_time_constant,
+                **options,
+            )
+            model.fraction = args.fraction
+            progress.phase("validation", "validating on both parts")
+            v_est, v_val = _validated(model, est, val, args.method)
+            progress.phase("writing", "writing files and figures")
+            staged = folder.path
+            headline = (
+                f"{arx} by {args.method} on {args.data}: H(z) = {model.tf_string()}"
+            )
+            summary = write_arx_model(staged, model, v_est, v_val, headline)
+            if model.history is not None:
+                plot_convergence(
+                    {args.method: model.history},
+                    cost_label="best cost, eq. (2) (% of rms(y))",
+                ).savefig(staged / "convergence.png", dpi=110)
+            _write_timings(staged, progress, model)
+            written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)
         print(f"\nwrote {_listing(written, args.out)}")
@@ -327,6 +435,15 @@ def add_parser(sub) -> None:
         "--refine", action="store_true", help="polish a spiral result locally"
     )
     p.add_argument(
+        "--max-time-constant",
+        type=_time_constant,
+        default="auto",
+        metavar="SECONDS",
+        help="stability margin: every pole's time constant at most this "
+        "(|z| <= exp(-ts / T)); 'none' for no margin; default the estimation "
+        "part's length, for --method spiral and oe and --refine's polish",
+    )
+    p.add_argument(
         "--integrator",
         action="store_true",
         help="the output integrates (a known pole at z = 1, e.g. the rig's hub "
@@ -337,10 +454,16 @@ def add_parser(sub) -> None:
         "--iterations",
         type=_positive_int,
         default=None,
-        help="max iterations (default 500, or no cap below --budget)",
+        help="max iterations (default: 500 for the paper's searches and de; no "
+        "cap for spiral, a NARX search or below a --budget)",
     )
     p.add_argument(
-        "--budget", type=_positive_int, default=None, help="max cost evaluations"
+        "--budget",
+        type=_positive_int,
+        default=None,
+        help="max cost evaluations (default: the method's own: 10,000 "
+        "evaluations for spiral and every NARX search; the others stop at "
+        "--iterations)",
     )
     p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
     p.add_argument(
@@ -351,5 +474,5 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--out", default="spiralid-identify", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    p.add_argument("--quiet", action="store_true", help="print nothing")
+    _add_quiet_option(p)
     p.set_defaults(run=run)
