@@ -18,6 +18,7 @@ class _HelpFormatter(argparse.HelpFormatter):
         text = action.help or ""
         if (
             "%(default)" in text
+            or "(default:" in text  # said in its own words
             or not action.option_strings
             or action.default is None
             or action.default is False
@@ -178,10 +179,21 @@ def _save_figures(figures: dict, folder: Path, prefix: str = "") -> None:
         fig.savefig(folder / f"{prefix}{name}.png", dpi=110)
 
 
-def _progress(args, total: int, label: str):
-    from spiralid.report.progress import ProgressBar
+def _add_quiet_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="print no progress, summary or warnings (errors still print)",
+    )
 
-    return ProgressBar(total, label, enabled=not args.quiet)
+
+def _progress(args):
+    """The command's progress on standard error (a status line on a
+    terminal, a few plain lines in a log; nothing with --quiet), which
+    also times its phases for timings.json."""
+    from spiralid.report.progress import Progress
+
+    return Progress(f"spiralid {args.command}", enabled=not args.quiet)
 
 
 def _listing(paths: list[Path], out: str) -> str:

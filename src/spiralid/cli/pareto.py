@@ -7,10 +7,11 @@ import csv
 import json
 
 from .errors import UsageError
-from .identify import write_arx_model
+from .identify import _validated, _write_timings, write_arx_model
 from .options import (
     _add_data_options,
     _add_detrend_option,
+    _add_quiet_option,
     _detrended,
     _fraction,
     _given,
@@ -21,6 +22,7 @@ from .options import (
     _nonneg_int,
     _open_folder,
     _positive_int,
+    _progress,
     _refuse_unused,
 )
 
@@ -57,11 +59,30 @@ def _coherence(text: str) -> float:
     return v
 
 
+# Each objective as front.csv names its column (with its unit, as the
+# records `spiralid simulate` writes name theirs) and as the summary says it.
+_COLUMNS = {
+    "cost": "cost_pct",
+    "one-step": "one_step_pct",
+    "frequency": "frequency_dB",
+    "order": "parameters",
+}
+_SAID = {
+    "cost": ("cost", "cost {:.4g} % of rms(y)"),
+    "one-step": ("one-step cost", "one-step cost {:.4g} % of rms(y)"),
+    "frequency": ("frequency error", "frequency error {:.4g} dB"),
+    "order": ("parameters", "parameters (na + nb) {:.0f}"),
+}
+
+
 def _write_front(staged, front) -> None:
     """front.csv (one row per point) and point-<i>/model.json."""
-    with open(staged / "front.csv", "w", newline="") as fh:
-        out = csv.writer(fh)
-        out.writerow(["point", "na", "nb", "nk", "start", *front.names, "knee"])
+    with open(staged / "front.csv", "w", newline="", encoding="utf-8") as fh:
+        # "\n" as every file spiralid writes (the csv module's default is
+        # "\r\n").
+        out = csv.writer(fh, lineterminator="\n")
+        columns = [_COLUMNS[n] for n in front.names]
+        out.writerow(["point", "na", "nb", "nk", "start", *columns, "knee"])
         for i, (model, row) in enumerate(
             zip(front.models, front.objectives, strict=True)
         ):
@@ -96,61 +117,75 @@ def run(args, argv: list[str]) -> int:
             "to the frequency objective; --objectives "
             f"{','.join(args.objectives)} has none",
         )
-    data = _load_data(args)
-    if args.detrend:
-        data = _detrended(data, args.fraction)
-    if args.orders is None:
-        structure = ARX(args.na, args.nb, args.nk)
-        structures = [structure]
-    else:
-        structure = args.orders
-        structures = [ARX(n, n, args.nk) for n in structure]
-    est, val = data.split(args.fraction)
-    for arx in structures:
-        arx.check_length(est, "estimation part of DATA")
-    with _open_folder(args.out, args.force) as folder:
-        front = identify_pareto(
-            est,
-            structure,
-            args.objectives,
-            method=args.method,
-            rng=args.seed,
-            max_nfev=args.budget,
-            n_points=args.points,
-            nk=args.nk,
-            parametrization=args.parametrization,
-            seed_estimates=not args.no_seeds,
-            polish_nfev=args.polish,
-            min_coherence=args.min_coherence,
-        )
-        if args.max_frequency is not None:
-            chosen = front.choose(max_frequency=args.max_frequency)
-            why = f"lowest cost with frequency error <= {args.max_frequency:g} dB"
-        elif args.by_fit is not None:
-            chosen = choose_order(front, val, warmup=est, tolerance=args.by_fit)
-            why = (
-                f"lowest order within {args.by_fit:g} points of the best validation "
-                "fit, chosen on the validation part (its fit is optimistic)"
-            )
+    with _progress(args) as progress:
+        progress.phase("load", "loading the data")
+        data = _load_data(args)
+        if args.detrend:
+            data = _detrended(data, args.fraction)
+        if args.orders is None:
+            structure = ARX(args.na, args.nb, args.nk)
+            structures = [structure]
         else:
-            chosen, why = front.knee, "the knee"
-        staged = folder.path
-        _write_front(staged, front)
-        front_figure(front, chosen).savefig(staged / "front.png", dpi=110)
-        model = front.models[chosen]
-        model.fraction = args.fraction
-        values = ", ".join(
-            f"{n} {v:.4g}"
-            for n, v in zip(front.names, front.objectives[chosen], strict=True)
-        )
-        headline = (
-            f"Pareto front of {len(front)} stable models ({', '.join(front.names)}) "
-            f"by {args.method} on {args.data}, {front.nfev} evaluations; point "
-            f"{chosen} ({why}): {model.arx}, {values}, H(z) = {model.tf_string()}"
-        )
-        summary = write_arx_model(staged, model, est, val, f"point {chosen}", headline)
-        # With --force, an earlier and larger front's surplus points go.
-        written = folder.commit(last="model.json", sets="point-[0-9]*")
+            structure = args.orders
+            structures = [ARX(n, n, args.nk) for n in structure]
+        est, val = data.split(args.fraction)
+        for arx in structures:
+            arx.check_length(est, "estimation part of DATA")
+        with _open_folder(args.out, args.force) as folder:
+            what = ", ".join(map(str, structures))
+            progress.phase(
+                "search", f"searching the front of {what}", unit="evaluations"
+            )
+            front = identify_pareto(
+                est,
+                structure,
+                args.objectives,
+                method=args.method,
+                rng=args.seed,
+                max_nfev=args.budget,
+                n_points=args.points,
+                nk=args.nk,
+                parametrization=args.parametrization,
+                seed_estimates=not args.no_seeds,
+                polish_nfev=args.polish,
+                min_coherence=args.min_coherence,
+                progress=progress,
+            )
+            progress.phase("validation", "choosing a point and validating it")
+            if args.max_frequency is not None:
+                chosen = front.choose(max_frequency=args.max_frequency)
+                why = f"lowest cost with frequency error <= {args.max_frequency:g} dB"
+            elif args.by_fit is not None:
+                chosen = choose_order(front, val, warmup=est, tolerance=args.by_fit)
+                why = (
+                    f"lowest order within {args.by_fit:g} points of the best "
+                    "validation fit, chosen on the validation part (its fit is "
+                    "optimistic)"
+                )
+            else:
+                chosen, why = front.knee, "the knee"
+            model = front.models[chosen]
+            v_est, v_val = _validated(model, est, val, f"point {chosen}")
+            progress.phase("writing", "writing the front, files and figures")
+            staged = folder.path
+            _write_front(staged, front)
+            model.fraction = args.fraction
+            front_figure(front, chosen).savefig(staged / "front.png", dpi=110)
+            values = ", ".join(
+                _SAID[n][1].format(v)
+                for n, v in zip(front.names, front.objectives[chosen], strict=True)
+            )
+            objectives = ", ".join(_SAID[n][0] for n in front.names)
+            headline = (
+                f"Pareto front of {len(front)} stable models ({objectives}) by "
+                f"{args.method} on {args.data}, {front.nfev} evaluations; point "
+                f"{chosen} ({why}): {model.arx}, {values}, H(z) = "
+                f"{model.tf_string()}"
+            )
+            summary = write_arx_model(staged, model, v_est, v_val, headline)
+            _write_timings(staged, progress)
+            # With --force, an earlier and larger front's surplus points go.
+            written = folder.commit(last="model.json", sets="point-[0-9]*")
     if not args.quiet:
         print(summary)
         files = [p for p in written if not p.name.startswith("point-")]
@@ -187,7 +222,8 @@ def add_parser(sub) -> None:
         type=_orders,
         default=None,
         help="several orders n, each ARX(n, n, nk), e.g. 2:12 or 2,4,8; adds the "
-        "number of parameters as an objective",
+        "number of parameters as an objective (default: none, the one ARX(--na, "
+        "--nb, --nk))",
     )
     p.add_argument(
         "--objectives",
@@ -240,7 +276,7 @@ def add_parser(sub) -> None:
         type=_nonneg_float,
         default=None,
         help="validate the lowest-cost point with a frequency error at most this "
-        "many dB instead of the knee",
+        "many dB instead of the knee (default: none, the knee)",
     )
     p.add_argument(
         "--by-fit",
@@ -248,7 +284,8 @@ def add_parser(sub) -> None:
         default=None,
         metavar="POINTS",
         help="validate the lowest order whose lowest-cost model's validation fit "
-        "is within POINTS of the best order's, instead of the knee (with --orders)",
+        "is within POINTS of the best order's, instead of the knee (with "
+        "--orders; default: none, the knee)",
     )
     p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
     p.add_argument(
@@ -259,5 +296,5 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--out", default="spiralid-pareto", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    p.add_argument("--quiet", action="store_true", help="print nothing")
+    _add_quiet_option(p)
     p.set_defaults(run=run)

@@ -9,6 +9,7 @@ from .errors import UsageError
 from .options import (
     _add_data_options,
     _add_initial_option,
+    _add_quiet_option,
     _HelpFormatter,
     _load_data,
     _nonneg_int,
@@ -23,22 +24,27 @@ def run(args, argv: list[str]) -> int:
     from spiralid.report import reproduce, summary_text, write_reproduction
 
     data = source = None
-    if args.data is not None:
-        data = _load_data(args)
-        source = (
-            {"kind": "shipped data set", "name": args.data}
-            if not Path(args.data).exists() and args.data in datasets.NAMES
-            else {"kind": "user data", "path": str(Path(args.data).resolve())}
-        )
-    elif (args.input, args.output, args.ts, args.input_unit, args.output_unit) != (
-        (None,) * 5
-    ):
+    if args.data is None and (
+        args.input,
+        args.output,
+        args.ts,
+        args.input_unit,
+        args.output_unit,
+    ) != ((None,) * 5):
         raise UsageError(
             "--input, --output, --ts and the units describe --data; give --data too"
         )
-    with _open_folder(args.out, args.force) as folder:
-        bar = _progress(args, 1, "reproduce")
-        try:
+    with _progress(args) as progress:
+        if args.data is not None:
+            progress.phase("load", "loading the data")
+            data = _load_data(args)
+            source = (
+                {"kind": "shipped data set", "name": args.data}
+                if not Path(args.data).exists() and args.data in datasets.NAMES
+                else {"kind": "user data", "path": str(Path(args.data).resolve())}
+            )
+        with _open_folder(args.out, args.force) as folder:
+            progress.phase("runs", "running the experiment", unit="runs")
             rep = reproduce(
                 data,
                 seeds=range(args.first_seed, args.first_seed + args.seeds),
@@ -47,12 +53,11 @@ def run(args, argv: list[str]) -> int:
                 initial=args.initial,
                 source=source,
                 workers=args.workers,
-                progress=bar,
+                progress=progress,
             )
-        finally:
-            bar.close()
-        command = "spiralid " + shlex.join(argv)
-        write_reproduction(rep, folder, command=command)
+            progress.phase("writing", "writing the figures and the report")
+            command = "spiralid " + shlex.join(argv)
+            write_reproduction(rep, folder, command=command)
     if not args.quiet:
         print(summary_text(rep))
         print(f"\nwrote figures, results.json and report.html in {args.out}")
@@ -84,11 +89,12 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--data",
         default=None,
-        help="your own CSV/NPZ/MAT record, or 'robot_arm' (the shipped DaISy arm)",
+        help="your own CSV/NPZ/MAT record, or 'robot_arm' (the shipped DaISy arm) "
+        "(default: the simulated rig's paper experiment)",
     )
     _add_data_options(p)
     _add_initial_option(p)
     p.add_argument("--out", default="spiralid-reproduce", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    _add_quiet_option(p)
     p.set_defaults(run=run)

@@ -6,10 +6,12 @@ from pathlib import Path
 
 from .errors import UsageError
 from .options import (
+    _add_quiet_option,
     _HelpFormatter,
     _nonneg_float,
     _nonneg_int,
     _positive_float,
+    _progress,
 )
 
 
@@ -24,8 +26,10 @@ def run(args, argv: list[str]) -> int:
         )
     from spiralid.report.atomic import OutputFile
 
-    with OutputFile(args.out, args.force) as target:
+    with _progress(args) as progress, OutputFile(args.out, args.force) as target:
+        progress.phase("simulation", f"simulating {args.duration:g} s of the rig")
         rec, rig = _simulate_record(args)
+        progress.phase("writing", f"writing {args.out}")
         _write_record(rec, target.path, suffix)
         target.commit()
     if not args.quiet:
@@ -188,5 +192,5 @@ def add_parser(sub) -> None:
     p.add_argument("--seed", type=_nonneg_int, default=0, help="noise seed")
     p.add_argument("--out", default="rig.csv", help="output file, .csv or .npz")
     p.add_argument("--force", action="store_true", help="overwrite --out")
-    p.add_argument("--quiet", action="store_true", help="print nothing")
+    _add_quiet_option(p)
     p.set_defaults(run=run)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from .errors import UsageError
 from .options import (
+    _add_quiet_option,
     _HelpFormatter,
     _positive_int,
     _progress,
@@ -42,31 +43,34 @@ def _cmd_study(args, argv: list[str]) -> int:
         )
     if args.scheduler is not None and args.engine != "dask":
         raise UsageError("--scheduler needs --engine dask")
-    bar = _progress(args, 1, "study")
-    try:
+    with _progress(args) as progress:
+        progress.phase("runs", "running the study", unit="runs")
         run = run_study(
             spec,
             store,
             engine=args.engine,
             scheduler=args.scheduler,
             workers=args.workers,
-            progress=bar,
+            progress=progress,
         )
-    finally:
-        bar.close()
-    if run.failures and run.reused + run.computed == 0:
-        # Every run failed: a store of no run is no study, and a report of
-        # nothing would hide the one thing to say, why they failed.
-        _remove_fresh_store(fresh)
-        raise _failures_error(run)
+        if run.failures and run.reused + run.computed == 0:
+            # Every run failed: a store of no run is no study, and a report
+            # of nothing would hide the one thing to say, why they failed.
+            _remove_fresh_store(fresh)
+            raise _failures_error(run)
+        report = None
+        if not args.no_report:
+            # The failures are the one line to say: no warning of missing runs.
+            report = _study_report(
+                store, out, args, argv, progress, warn=not run.failures
+            )
     if not args.quiet:
         print(
             f"{run.total} runs: {run.reused} already in {store}, "
             f"{run.computed} computed now, {len(run.failures)} failed"
         )
-    if not args.no_report:
-        # The failures are the one line to say: no warning of missing runs.
-        _study_report(store, out, args, argv, warn=not run.failures)
+        if report is not None:
+            print(report)
     if run.failures:
         raise _failures_error(run)
     return 0
@@ -106,10 +110,11 @@ def _remove_fresh_store(fresh: list[Path]) -> None:
 
 
 def _study_report(
-    store: Path, out: Path, args, argv: list[str], warn: bool = True
-) -> None:
-    """Analyse the store and write its report; `warn` says in a warning
-    when runs are missing (the report itself always says so)."""
+    store: Path, out: Path, args, argv: list[str], progress, warn: bool = True
+) -> str:
+    """Analyse the store and write its report; return what to print (the
+    summary and the files written). `warn` says in a warning when runs are
+    missing (the report itself always says so)."""
     import warnings
 
     from spiralid.report.study_output import (
@@ -119,6 +124,7 @@ def _study_report(
     )
     from spiralid.study import ResultStore, analyse, parse_spec
 
+    progress.phase("analysis", "analysing the store")
     with ResultStore.open(store, readonly=True) as db:
         rows, spec_text = db.rows(), db.meta().get("spec", "")
     try:
@@ -136,6 +142,7 @@ def _study_report(
     summary = study_summary(res)
     if warn and res.missing_runs:
         warnings.warn(partial_note(res), stacklevel=1)
+    progress.phase("writing", "writing the report")
     written = write_study_report(
         res,
         out,
@@ -143,9 +150,7 @@ def _study_report(
         force=True,
         command="spiralid " + shlex.join(argv),
     )
-    if not args.quiet:
-        print(summary)
-        print(f"\nwrote {', '.join(p.name for p in written)} in {out}")
+    return f"{summary}\n\nwrote {', '.join(p.name for p in written)} in {out}"
 
 
 def _cmd_study_report(args, argv: list[str]) -> int:
@@ -162,7 +167,10 @@ def _cmd_study_report(args, argv: list[str]) -> int:
         raise UsageError(f"store {args.store!r} does not exist")
     out = Path(args.out) if args.out is not None else store.parent
     _check_study_dir(out, store, args.force)
-    _study_report(store, out, args, argv)
+    with _progress(args) as progress:
+        report = _study_report(store, out, args, argv, progress)
+    if not args.quiet:
+        print(report)
     return 0
 
 
@@ -243,7 +251,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--force", action="store_true", help="write into an --out with other files"
     )
-    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    _add_quiet_option(p)
     p.set_defaults(run=_cmd_study)
 
     p = sub.add_parser(
@@ -261,5 +269,5 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--force", action="store_true", help="write into an --out with other files"
     )
-    p.add_argument("--quiet", action="store_true", help="print nothing")
+    _add_quiet_option(p)
     p.set_defaults(run=_cmd_study_report)

@@ -9,12 +9,14 @@ from .errors import UsageError
 from .options import (
     _add_data_options,
     _add_detrend_option,
+    _add_quiet_option,
     _detrended,
     _fraction,
     _HelpFormatter,
     _listing,
     _load_data,
     _open_folder,
+    _progress,
     _save_figures,
 )
 
@@ -141,31 +143,39 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
 def run(args, argv: list[str]) -> int:
     from spiralid.sysid import validate
 
-    model, recorded, named = _read_model(args.model)
-    if named:
-        _columns_of_the_model(args, model)
-    # The data's own sample time wins; validate() refuses one that differs
-    # from the model's. Only a file without one borrows the model's.
-    data = _load_data(args, default_ts=model.ts)
-    data = _prepared_as_the_model(data, model, recorded, args)
-    if args.fraction is not None:
-        warm, data = data.split(args.fraction)
-    else:
-        warm = None
-    if args.out is None:
-        v = validate(model, data, warmup=warm, label=model.method)
-        if not args.quiet:
-            print(v.summary())
-        return 0
-    with _open_folder(args.out, args.force) as folder:
-        v = validate(model, data, warmup=warm, label=model.method)
-        (folder.path / "validation.json").write_text(json.dumps(v.to_dict(), indent=2))
-        (folder.path / "summary.txt").write_text(v.summary() + "\n")
-        _save_figures(v.plot(), folder.path)
-        written = folder.commit(last="validation.json")
+    with _progress(args) as progress:
+        progress.phase("load", "loading the model and the data")
+        model, recorded, named = _read_model(args.model)
+        if named:
+            _columns_of_the_model(args, model)
+        # The data's own sample time wins; validate() refuses one that
+        # differs from the model's. Only a file without one borrows the
+        # model's.
+        data = _load_data(args, default_ts=model.ts)
+        data = _prepared_as_the_model(data, model, recorded, args)
+        if args.fraction is not None:
+            warm, data = data.split(args.fraction)
+        else:
+            warm = None
+        if args.out is None:
+            progress.phase("validation", "validating")
+            v = validate(model, data, warmup=warm, label=model.method)
+            written = None
+        else:
+            with _open_folder(args.out, args.force) as folder:
+                progress.phase("validation", "validating")
+                v = validate(model, data, warmup=warm, label=model.method)
+                progress.phase("writing", "writing files and figures")
+                (folder.path / "validation.json").write_text(
+                    json.dumps(v.to_dict(), indent=2)
+                )
+                (folder.path / "summary.txt").write_text(v.summary() + "\n")
+                _save_figures(v.plot(), folder.path)
+                written = folder.commit(last="validation.json")
     if not args.quiet:
         print(v.summary())
-        print(f"\nwrote {_listing(written, args.out)}")
+        if written is not None:
+            print(f"\nwrote {_listing(written, args.out)}")
     return 0
 
 
@@ -195,8 +205,11 @@ def add_parser(sub) -> None:
         "one estimated without --detrend refuses it",
     )
     p.add_argument(
-        "--out", default=None, help="directory for validation.json and figures"
+        "--out",
+        default=None,
+        help="directory for validation.json, summary.txt and figures (default: "
+        "none, only the summary is printed)",
     )
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    p.add_argument("--quiet", action="store_true", help="print nothing")
+    _add_quiet_option(p)
     p.set_defaults(run=run)

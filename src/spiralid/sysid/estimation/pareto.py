@@ -58,7 +58,7 @@ bounds on the others.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -417,11 +417,15 @@ class _StructureRun:
 def _search_structure(
     data, arx, error, searched, method, gen, *, parametrization, cost,
     seed_estimates, polish_nfev, initial, n_points, max_nfev, neighbours, gain,
+    count=None,
 ) -> _StructureRun:  # fmt: skip
     """Search one structure's front; collect the seeds, the archive of the
-    search's incumbents and the polished extremes as candidates."""
+    search's incumbents and the polished extremes as candidates. `count`,
+    if given, is told the number of points of every evaluation."""
     par = make_parametrization(parametrization, data, arx)
     evaluate = _objective_function(par, cost, error, searched, gain)
+    if count is not None:
+        evaluate = _counted(evaluate, count)
     box = par.default_bounds()
     seeds = _seed_thetas(data, arx, par, initial) if seed_estimates else {}
     x0 = np.array([par.from_theta(t) for t in seeds.values()]) if seeds else None
@@ -458,6 +462,32 @@ def _search_structure(
         run.rows.extend(f)
         run.starts.extend(origin)
     return run
+
+
+def _counted(evaluate, count: Callable[[int], None]):
+    """`evaluate` that tells `count` how many points it evaluated."""
+
+    def counted(x):
+        out = evaluate(x)
+        count(1 if np.ndim(x) == 1 else len(x))
+        return out
+
+    return counted
+
+
+class _Progress:
+    """``progress(done, total)`` of the evaluations of every structure's
+    search, fed one evaluation call at a time; `total` is what the budgets
+    allow (the seeds' and candidates' evaluations pass it: then it says the
+    total)."""
+
+    def __init__(self, progress: Callable[[int, int], None], total: int):
+        self.progress, self.total, self.done = progress, max(int(total), 1), 0
+        progress(0, self.total)
+
+    def __call__(self, n: int) -> None:
+        self.done += n
+        self.progress(min(self.done, self.total), self.total)
 
 
 def _front_model(
@@ -518,6 +548,7 @@ def identify_pareto(
     fmax: float | None = None,
     min_coherence: float = DEFAULT_MIN_COHERENCE,
     neighbours: int = 10,
+    progress: Callable[[int, int], None] | None = None,
 ) -> ParetoIdentification:
     """A Pareto front of stable ARX models on an estimation record.
 
@@ -568,6 +599,10 @@ def identify_pareto(
         Bins with lower coherence are not scored.
     neighbours : int, default 10
         Neighbourhood of the decomposition (``minimize_pareto``).
+    progress : callable, optional
+        ``progress(done, total)`` as the evaluations go: ``total`` is what
+        the budgets allow, ``len(orders) * (max_nfev + polish_nfev * k)``
+        for ``k`` searched objectives (``done`` stops there).
 
     Returns
     -------
@@ -604,6 +639,10 @@ def identify_pareto(
         data, nperseg=nperseg, fmin=fmin, fmax=fmax, min_coherence=min_coherence
     )
     searched = [n for n in names if n != "order"]
+    count = None
+    if progress is not None:
+        budget = integer(max_nfev, "max_nfev", 1) + len(searched) * polish_nfev
+        count = _Progress(progress, len(structures) * budget)
     runs = []
     for arx in structures:
         arx.check_length(data)
@@ -624,6 +663,7 @@ def identify_pareto(
                 max_nfev=max_nfev,
                 neighbours=neighbours,
                 gain=gain,
+                count=count,
             )
         )
     candidates = [(run, i) for run in runs for i in range(len(run.starts))]
