@@ -15,7 +15,8 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid import cli
-from spiralid.sysid import ARX, IOData, identify
+from spiralid.sysid import ARX, NARX, IOData, NARXModel, identify
+from spiralid.sysid.models.narx import Scaling
 
 
 def _csv(path, columns: dict, encoding="utf-8"):
@@ -66,6 +67,9 @@ def files(tmp_path, monkeypatch):
     (tmp_path / "bad.mat").write_bytes(b"MATLAB 5.0 garbage" * 10)
     model = identify(IOData(u, y, ts=0.01), ARX(2, 2, 1), method="ls")
     (tmp_path / "model.json").write_text(json.dumps(model.to_dict()))
+    st = NARX(2, 2, 1, hidden=(2,))
+    narx = NARXModel(np.zeros(st.n_params), st, Scaling(), 0.01, method="ls")
+    (tmp_path / "narx.json").write_text(json.dumps(narx.to_dict()))
     (tmp_path / "garbage.json").write_text('{"theta": ["a"], "na": 1}')
     (tmp_path / "notjson.json").write_text("this is not json")
     bad_theta = {**model.to_dict(), "theta": [1e400, 0, 0, 0]}
@@ -246,6 +250,25 @@ CASES = [
         "identify complex.npz",
         "--input variable 'u' of 'complex.npz' must be real-valued",
     ),
+    # export
+    ("export nothing.json", "model file 'nothing.json' does not exist"),
+    ("export folder.csv", "'folder.csv' is a folder, not a model.json"),
+    ("export binary.csv", "'binary.csv' is not UTF-8 text"),
+    ("export notjson.json", "'notjson.json' is not a valid spiralid model file"),
+    ("export garbage.json", "'garbage.json' is not a valid spiralid model file"),
+    ("export inf_theta.json", "not a valid spiralid model file"),
+    (
+        "export narx.json",
+        "'narx.json' is a NARX model: it has no transfer function to export",
+    ),
+    ("export model.json --to npz", "--to npz writes a file: give --out FILE.npz"),
+    ("export model.json --to mat", "--to mat writes a file: give --out FILE.mat"),
+    ("export model.json --to json --out tf.npz", "must end in .json for --to json"),
+    ("export model.json --out tf.npz --to mat", "must end in .mat for --to mat"),
+    ("export model.json --out tf.json --to tf", "--to tf writes text, not .json"),
+    ("export model.json --out existing.csv", "exists; pass --force"),
+    ("export model.json --out full", "is a folder, not a file"),
+    ("export model.json --to pdf", "invalid choice"),
 ]
 
 

@@ -53,6 +53,7 @@ _SUBCOMMANDS = (
     "identify",
     "pareto",
     "validate",
+    "export",
     "reproduce",
     "study",
     "study-report",

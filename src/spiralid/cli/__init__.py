@@ -1,5 +1,5 @@
 """The ``spiralid`` command: simulate the rig, identify (one model or a
-Pareto front), validate, reproduce, study.
+Pareto front), validate, export, reproduce, study.
 
 Every subcommand has ``--help``. Bad arguments and bad input end with exit
 status 2 and a one-line ``spiralid <command>: error: ...`` message on
@@ -23,7 +23,7 @@ import sys
 import warnings
 from contextlib import contextmanager
 
-from . import identify, pareto, reproduce, simulate, study, validate
+from . import export, identify, pareto, reproduce, simulate, study, validate
 from .errors import (
     _Parser,
     _show_warnings,
@@ -36,7 +36,7 @@ from .errors import (
 __all__ = ["build_parser", "console", "main"]
 
 # In the order `spiralid --help` lists them.
-_SUBCOMMANDS = (simulate, identify, pareto, validate, reproduce, study)
+_SUBCOMMANDS = (simulate, identify, pareto, validate, export, reproduce, study)
 
 
 def build_parser() -> argparse.ArgumentParser:
