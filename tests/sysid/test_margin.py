@@ -161,6 +161,7 @@ def test_the_margin_is_on_the_other_poles_of_a_known_integrator():
         (dict(method="ebsda", max_time_constant=None), ["max_time_constant", "'oe'"]),
         (dict(method="ls", max_time_constant=2.0), ["max_time_constant", "no margin"]),
         (dict(method="oe", max_time_constant=0.0), ["seconds > 0"]),
+        (dict(method="oe", max_time_constant=0.005), ["at least the sample time"]),
         (dict(method="oe", max_time_constant=True), ["seconds > 0"]),
         (dict(method="oe", max_time_constant="long"), ["seconds > 0"]),
         (dict(method="sda", cancel=True), ["`cancel` applies", "'spiral', 'oe'"]),

@@ -407,6 +407,13 @@ def margin_options(method: str, data: IOData, refine, max_time_constant, cancel)
                     "`max_time_constant` must be a number of seconds > 0, "
                     f"{AUTO!r} or None; got {max_time_constant!r}"
                 )
+            if seconds < data.ts:
+                # Every pole inside exp(-1) = 0.37 and below: no sampled
+                # plant's margin, and r_max^na would underflow.
+                raise ValueError(
+                    "`max_time_constant` must be at least the sample time "
+                    f"ts = {data.ts:g} s; got {max_time_constant!r}"
+                )
         else:
             seconds = None
     if cancel is None:
