@@ -79,8 +79,16 @@ def main(argv=None) -> None:
             for method in ("oe", "spiral"):
                 for integrator in (False, True):
                     t0 = time.perf_counter()
+                    # With the known integrator the margin is off: the hub
+                    # angle's second integrator (the rigid body) is slower
+                    # than any record (docs/guide/models.md).
                     fit = identify(
-                        est, arx, method=method, rng=0, integrator=integrator
+                        est,
+                        arx,
+                        method=method,
+                        rng=0,
+                        integrator=integrator,
+                        max_time_constant=None if integrator else "auto",
                     )
                     seconds = time.perf_counter() - t0
                     fit_val = validate(fit, val, warmup=est).fit_percent

@@ -39,10 +39,17 @@ print(data.output_label, data.n, "samples at", 1 / data.ts, "Hz;", arx)
 # Least squares, output error and the default ``spiral`` method, each
 # without and with ``integrator=True``. The validation runs each model over
 # the whole record and scores the last third.
+# The hub angle integrates twice (the rigid body); the second pole, at
+# 0.9999997, is slower than the stability margin of oe and spiral allows
+# (a time constant of at most the record's length), so the runs with the
+# known integrator switch the margin off.
 runs = {}
 for method in ("ls", "oe", "spiral"):
     for integrator in (False, True):
-        model = sid.identify(est, arx, method=method, rng=0, integrator=integrator)
+        margin = {"max_time_constant": None} if integrator and method != "ls" else {}
+        model = sid.identify(
+            est, arx, method=method, rng=0, integrator=integrator, **margin
+        )
         label = f"{method}{' + integrator' if integrator else ''}"
         runs[label] = sid.validate(model, val, warmup=est, label=label)
 

@@ -81,7 +81,7 @@ def test_identify_then_validate(rig_csv, tmp_path):
         "identify", rig_csv, "--budget", "400", "--out", tmp_path / "m", cwd=tmp_path
     )
     assert proc.returncode == 0, proc.stderr
-    assert "fit % (simulation)" in proc.stdout
+    assert "fit % (simulation, from rest)" in proc.stdout
     model = IdentifiedModel.from_dict(
         json.loads((tmp_path / "m" / "model.json").read_text())
     )
