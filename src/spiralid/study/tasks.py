@@ -198,10 +198,14 @@ def run_task(task: Task, data, detail: bool = False) -> dict:
     predictor, initial = PREDICTORS[task.predictor]
     scorer = PaperCost(arx, est, predictor=predictor, initial=initial)
     kwargs = dict(predictor=predictor, initial=initial)
-    stamps: list[float] = []
+    # (history entries so far, wall time) at every callback: a restart adds
+    # a history entry between two callbacks, so entries are matched to the
+    # first stamp that covers them, not counted one per call.
+    stamps: list[tuple[int | None, float]] = []
 
-    def clock(_intermediate) -> bool:
-        stamps.append(time.perf_counter())
+    def clock(intermediate) -> bool:
+        history = getattr(intermediate, "history", None)
+        stamps.append((None if history is None else len(history), time.perf_counter()))
         return False
 
     if task.seed is not None:
@@ -238,9 +242,27 @@ def run_task(task: Task, data, detail: bool = False) -> dict:
     }
     if detail:
         # Index 0 of the history (the initial population) is put at t = 0.
-        times = np.array([start, *stamps]) - start if stamps else None
-        row.update(model_object=model, times=times)
+        row.update(model_object=model, times=_entry_times(model, stamps, start))
     return row
+
+
+def _entry_times(model, stamps, start: float) -> np.ndarray | None:
+    """The wall time of every entry of the model's search history (index 0,
+    the initial population, at t = 0), from the callback's `stamps`."""
+    history = getattr(model, "history", None)
+    if not stamps or history is None:
+        return None
+    n = len(history)
+    if any(count is None for count, _ in stamps):
+        # A callback that does not see the history: one stamp per entry.
+        return np.array([start, *(t for _, t in stamps)])[:n] - start
+    times = np.full(n, stamps[-1][1])
+    times[0] = start
+    filled = 1
+    for count, t in stamps:
+        times[filled : min(count, n)] = t
+        filled = max(filled, min(count, n))
+    return times - start
 
 
 def reproducible_part(row: dict) -> dict:
