@@ -115,17 +115,8 @@ PACKAGES = {
 
 
 def public_names(package: str) -> list[str]:
-    """A package's public names: its ``__all__``, or (``spiralid.sysid``
-    has none) every public name it imports, its lazy ones included."""
-    module = importlib.import_module(package)
-    if hasattr(module, "__all__"):
-        return list(module.__all__)
-    names = [
-        name
-        for name, value in vars(module).items()
-        if not name.startswith("_") and not isinstance(value, types.ModuleType)
-    ]
-    return names + [n for n in getattr(module, "_LAZY", {}) if n not in names]
+    """A package's public names: its ``__all__``."""
+    return list(importlib.import_module(package).__all__)
 
 
 def _kind(value) -> str:

@@ -58,17 +58,8 @@ needs_chromium = pytest.mark.skipif(
 
 
 def public_names(package: str) -> list[str]:
-    """``__all__``; ``spiralid.sysid`` has none, so there every public name
-    it imports (its lazily loaded ones included)."""
-    module = importlib.import_module(package)
-    if hasattr(module, "__all__"):
-        return list(module.__all__)
-    names = [
-        name
-        for name, value in vars(module).items()
-        if not name.startswith("_") and not isinstance(value, types.ModuleType)
-    ]
-    return names + [n for n in getattr(module, "_LAZY", {}) if n not in names]
+    """A package's public names: its ``__all__`` (every package has one)."""
+    return list(importlib.import_module(package).__all__)
 
 
 def _ids(page: Path) -> set[str]:

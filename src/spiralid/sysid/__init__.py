@@ -20,6 +20,7 @@ from .estimation.pareto import knee_point as knee_point
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.identified import IdentifiedModel as IdentifiedModel
+from .models.modes import ModeTable as ModeTable
 from .models.narx import NARX as NARX
 from .models.narx import NARXModel as NARXModel
 from .models.narx import PolynomialNARX as PolynomialNARX
@@ -47,6 +48,52 @@ from .validation.validate import Validation as Validation
 from .validation.validate import fit_percent as fit_percent
 from .validation.validate import realization_tests as realization_tests
 from .validation.validate import validate as validate
+
+__all__ = [
+    "ARX",
+    "METHODS",
+    "NARX",
+    "PARAMETRIZATIONS",
+    "CorrelationTest",
+    "EstimatorResult",
+    "IOData",
+    "IdentifiedModel",
+    "ModalParametrization",
+    "ModeTable",
+    "NARXModel",
+    "PaperCost",
+    "ParetoIdentification",
+    "PolynomialNARX",
+    "ProjectedCost",
+    "Realization",
+    "Validation",
+    "arx_least_squares",
+    "billings_voon",
+    "choose",
+    "choose_order",
+    "default_bounds",
+    "find_resonances",
+    "fit_percent",
+    "fits_by_order",
+    "fold_reflection",
+    "format_pole_radius",
+    "identify",
+    "identify_pareto",
+    "independence_test",
+    "is_stable_polynomial",
+    "knee_point",
+    "max_pole_radius",
+    "modes_from_poles",
+    "projected_spiral",
+    "psd",
+    "random_stable_polynomial",
+    "realization_tests",
+    "steiglitz_mcbride",
+    "step_down",
+    "step_up",
+    "validate",
+    "whiteness_test",
+]
 
 # The modal search's building blocks, loaded on first use (identify loads
 # them itself when a method needs them).

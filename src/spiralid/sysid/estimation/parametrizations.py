@@ -330,6 +330,20 @@ def default_bounds(
 ) -> np.ndarray:
     """The default search box, shape (p, 2) (see the module docstring).
 
+    Parameters
+    ----------
+    data : IOData
+        The estimation record (it sets the numerator's scale).
+    arx : ARX
+        The structure.
+    parametrization : str, default "coefficients"
+        The parametrisation's name (:data:`PARAMETRIZATIONS`).
+
+    Returns
+    -------
+    ndarray, shape (p, 2)
+        Lower and upper bound of every searched parameter.
+
     Examples
     --------
     >>> import numpy as np

@@ -277,6 +277,15 @@ def format_pole_radius(radius: float) -> str:
     it, so ``1 - 4e-07`` (stable) and ``1 + 3e-08`` (unstable) do not both
     read ``1.0000000``.
 
+    Parameters
+    ----------
+    radius : float
+        The largest pole radius.
+
+    Returns
+    -------
+    str
+
     Examples
     --------
     >>> format_pole_radius(0.98765), format_pole_radius(1 - 4e-7)
@@ -301,6 +310,18 @@ def fold_reflection(x, kmax: float = 1.0 - 1e-6) -> np.ndarray:
     reflected back continuously rather than piling up on the boundary; the
     result is then clipped to ``kmax < 1`` so the polynomial is strictly
     stable. Never returns ``nan`` for finite input; non-finite input maps to 0.
+
+    Parameters
+    ----------
+    x : array_like
+        Any real numbers.
+    kmax : float, default 1 - 1e-6
+        The largest magnitude returned.
+
+    Returns
+    -------
+    ndarray
+        The folded values, the shape of `x`.
 
     Examples
     --------
