@@ -113,6 +113,17 @@ def test_one_headline_test_in_summary_results_and_report(rep):
         assert "one-sided" not in where
 
 
+def test_the_report_lists_each_best_model_s_modes_with_intervals(rep):
+    from spiralid.report.output import _html
+
+    page = _html(rep, {}, None)
+    assert "<h2>Modes with 95 % intervals</h2>" in page
+    oe = rep.best("OE").model.modes
+    assert len(oe) == 1  # the record's one lightly damped pair
+    lo, hi = oe.frequency_interval[0]
+    assert f"[{lo:.4g}, {hi:.4g}]" in page
+
+
 def test_bad_input(data):
     with pytest.raises(ValueError, match="`seeds`"):
         reproduce(data, seeds=[], arx=ARX(2, 2, 1))

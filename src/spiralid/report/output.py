@@ -505,6 +505,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
             "html",
         )
     )
+    parts.append(_modes_section(rep))
     parts.append(
         "<h2>How we read the paper</h2><ul>"
         "<li>Cost, eq. (2)-(3): f = w sqrt(sum e^2) / K plus a penalty of 1e6 "
@@ -526,6 +527,60 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "its distance from 1.</li></ul>"
     )
     return page("spiralid: SDA vs Eb-SDA reproduction", parts)
+
+
+def _modes_section(rep: Reproduction) -> str:
+    """Each best model's modes with their 95 % intervals (from the
+    estimate's covariance, ``IdentifiedModel.modes``) and flags."""
+    rows = []
+    for label in [*rep.runs, *rep.baselines]:
+        model = rep.best(label).model
+        if getattr(model, "covariance", None) is None:
+            continue
+        table_ = model.modes
+        f_int, d_int = table_.frequency_interval, table_.damping_interval
+        for i in range(len(table_)):
+            flags = [
+                text
+                for flag, text in (
+                    (table_.reaches_unit_circle[i], "interval reaches |z| = 1"),
+                    (table_.cancelled[i], "cancelled by a zero"),
+                    (table_.spurious[i], "probably spurious"),
+                )
+                if flag
+            ]
+            rows.append(
+                [
+                    label,
+                    f"{table_.frequency[i]:.4g}",
+                    f"[{f_int[i, 0]:.4g}, {f_int[i, 1]:.4g}]",
+                    f"{table_.damping[i]:.4f}",
+                    f"[{d_int[i, 0]:.4f}, {d_int[i, 1]:.4f}]",
+                    f"{100 * table_.share[i]:.1f}",
+                    "; ".join(flags),
+                ]
+            )
+    if not rows:
+        return ""
+    return (
+        "<h2>Modes with 95 % intervals</h2><p>Each best model's complex pole "
+        "pairs as modes; the intervals come from the estimate's covariance "
+        "s<sup>2</sup> (J<sup>T</sup>J)<sup>-1</sup> by the delta method, and "
+        "the share is the mode's resonant peak as a part of the model's.</p>"
+        + table(
+            [
+                "model",
+                "frequency (Hz)",
+                "95 % interval (Hz)",
+                "damping",
+                "95 % interval",
+                "share (%)",
+                "flags",
+            ],
+            rows,
+            "html",
+        )
+    )
 
 
 def ranksums(rep: Reproduction) -> list[dict]:
