@@ -46,7 +46,7 @@ from spiralid.optim._decomposition import (
     SpiralMoves,
     Subproblems,
 )
-from spiralid.optim._loop import STOPS, check_max_time
+from spiralid.optim._loop import STOPS, check_max_time, check_objective
 from spiralid.optim.front import (
     hypervolume,
     non_dominated,
@@ -97,7 +97,10 @@ def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray
 
 
 def _parse_rule(method) -> SpiralRule | LearnedMetricSpiral:
-    rule = _parse_method(method)
+    # A name is checked against the Pareto rules first: the single-objective
+    # list (with the step-rate rules) would offer names refused here.
+    named = isinstance(method, str) and method.lower() in PARETO_METHODS
+    rule = _parse_method(method) if named or not isinstance(method, str) else None
     if not isinstance(rule, SpiralRule | LearnedMetricSpiral):
         raise ValueError(
             f"`method` must be one of {', '.join(PARETO_METHODS)}, a SpiralRule "
@@ -250,7 +253,7 @@ def minimize_pareto(
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
-    vectorized = bool(vectorized)
+    vectorized = check_objective(fun, vectorized)
 
     x = _initial_points(gen, lo, hi, m, x0)
     f = _evaluate(fun, x, vectorized, None)

@@ -561,7 +561,18 @@ def _estimate_recommended(
     modes: its cost is quadratic in the numerator and the exact minimiser is
     returned without a search.
     """
+    from spiralid.optim.spiral import _parse_method
+
     from .memetic import projected_spiral
+
+    try:
+        _parse_method(rule)
+    except ValueError:
+        # Named as this method's option, not as minimize's `method`.
+        raise ValueError(
+            f"`rule` of method 'spiral' must be one of {', '.join(RULES)}, a "
+            f"SpiralRule or a StepRateRule instance; got {rule!r}"
+        ) from None
     from .parametrizations import Modal
 
     if problem.arx.na == 0:

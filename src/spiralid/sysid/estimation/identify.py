@@ -450,7 +450,7 @@ def _identify_narx(data, structure, method, *, other: dict, **options):
         max_time_constant=AUTO,
         cancel=None,
     )
-    given = sorted(k for k, v in other.items() if v is not defaults[k])
+    given = sorted(k for k, v in other.items() if not _is_default(v, defaults[k]))
     if given:
         raise ValueError(
             f"{given} apply to ARX structures; a NARX takes its integrator, "
@@ -459,6 +459,21 @@ def _identify_narx(data, structure, method, *, other: dict, **options):
     from .narx import identify_narx
 
     return identify_narx(data, structure, method=method, estimate=estimate, **options)
+
+
+def _is_default(value, default) -> bool:
+    """`value` is the option's default: the same object, or an equal number
+    or string (``penalty=float("1e6")`` is the default 1e6, ``True`` is not
+    ``1``)."""
+    if value is default:
+        return True
+    if isinstance(default, bool):
+        return isinstance(value, bool | np.bool_) and bool(value) == default
+    if isinstance(value, bool | np.bool_):
+        return False
+    if isinstance(default, int | float) and isinstance(value, int | float | np.number):
+        return bool(value == default)
+    return isinstance(default, str) and isinstance(value, str) and value == default
 
 
 def _identify_integrating(data: IOData, arx: ARX, options: dict) -> IdentifiedModel:
