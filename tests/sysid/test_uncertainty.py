@@ -143,3 +143,43 @@ def test_too_short_a_record_for_a_covariance_is_named():
     data = IOData(np.arange(4.0), np.arange(4.0) ** 2, ts=TS)
     with pytest.raises(ValueError, match="too short for a covariance"):
         parameter_covariance(np.zeros(6), ARX(3, 3, 0), data, "one-step")
+
+
+def test_a_pole_at_the_origin_does_not_swamp_the_modes_shares():
+    # Two modes and a real pole ever closer to z = 0: the modes keep their
+    # shares and neither is called spurious.
+    pairs = [np.exp((-0.02 + 1j) * w * TS) for w in (2 * np.pi * 5, 2 * np.pi * 12)]
+    b = [0.0, 1.0, 0.3, -0.2, 0.1, 0.05]
+    shares = []
+    for c in (0.5, 1e-6, 1e-10):
+        a = np.poly([*pairs, *np.conj(pairs), c]).real[1:]
+        table = mode_table(a, b, TS, covariance=np.eye(5) * 1e-10)
+        assert not np.any(table.spurious), (c, table.share)
+        shares.append(table.share)
+    np.testing.assert_allclose(shares[1], shares[2], rtol=1e-3)
+
+
+def test_the_factor_keeps_a_delta_method_variance_that_the_matrix_rounds_away():
+    # J with condition 1e9: C = s^2 (J^T J)^-1 spans 18 orders of magnitude,
+    # and g^T C g along the best-determined direction v_1 is lost in C's
+    # rounding, while |R g|^2 with R = s S^-1 V^T keeps it. Exact value:
+    # s^2 / S_1^2 = s^2 (S_1 = 1, V orthonormal).
+    from spiralid.sysid.models.modes import _Root, _spread
+
+    rng = np.random.default_rng(6)
+    v, _ = np.linalg.qr(rng.standard_normal((6, 6)))
+    singular = np.logspace(0, -9, 6)
+    root = 0.01 * v.T / singular[:, None]
+    spread = _spread(v[:, :1].T, _Root(root))
+    np.testing.assert_allclose(spread, [0.01], rtol=1e-9)
+
+
+def test_factor_and_matrix_agree_where_the_matrix_is_well_conditioned():
+    rng = np.random.default_rng(8)
+    root = rng.standard_normal((5, 5)) * 1e-3
+    a = np.poly([0.9 * np.exp(0.3j), 0.9 * np.exp(-0.3j), 0.7 * np.exp(1.1j),
+                 0.7 * np.exp(-1.1j), 0.5]).real[1:]  # fmt: skip
+    by_root = mode_table(a, [0.0, 1.0, 0.3], TS, factor=root)
+    by_matrix = mode_table(a, [0.0, 1.0, 0.3], TS, covariance=root.T @ root)
+    np.testing.assert_allclose(by_root.frequency_se, by_matrix.frequency_se, rtol=1e-9)
+    np.testing.assert_allclose(by_root.damping_se, by_matrix.damping_se, rtol=1e-9)

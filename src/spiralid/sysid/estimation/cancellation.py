@@ -49,6 +49,7 @@ __all__ = [
     "deflate",
     "effective",
     "embed_covariance",
+    "embed_factor",
     "near_cancellations",
     "pad",
     "reduce_order",
@@ -200,6 +201,16 @@ def embed_covariance(cov, arx: ARX, order: tuple[int, int]) -> np.ndarray:
     idx = np.r_[np.arange(na), arx.na + np.arange(nb)]
     out = np.zeros((arx.n_params, arx.n_params))
     out[np.ix_(idx, idx)] = cov
+    return out
+
+
+def embed_factor(root, arx: ARX, order: tuple[int, int]) -> np.ndarray:
+    """A reduced model's covariance factor ``R`` (``C = R^T R``) in `arx`'s
+    layout: zero columns for the removed coefficients."""
+    na, nb = order
+    idx = np.r_[np.arange(na), arx.na + np.arange(nb)]
+    out = np.zeros((root.shape[0], arx.n_params))
+    out[:, idx] = root
     return out
 
 

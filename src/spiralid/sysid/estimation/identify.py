@@ -54,7 +54,7 @@ from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from ..models.narx import NARX, PolynomialNARX
 from ..models.polynomials import with_integrator
-from .cancellation import effective, embed_covariance
+from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS, Problem
 from .margin import AUTO, max_radius
@@ -340,13 +340,14 @@ def identify(
         # covariance is the reduced model's, with zero variance for them.
         order = res.effective_order
         theta_r, arx_r = effective(res.x, arx, order)
-        cov_r, s2 = parameter_covariance(
-            theta_r, arx_r, data, spec.minimises or predictor, initial
+        cov_r, s2, root_r = parameter_covariance(
+            theta_r, arx_r, data, spec.minimises or predictor, initial, factor=True
         )
         covariance = embed_covariance(cov_r, arx, order)
+        root = None if root_r is None else embed_factor(root_r, arx, order)
     else:
-        covariance, s2 = parameter_covariance(
-            res.x, arx, data, spec.minimises or predictor, initial
+        covariance, s2, root = parameter_covariance(
+            res.x, arx, data, spec.minimises or predictor, initial, factor=True
         )
     return IdentifiedModel(
         res.x,
@@ -369,6 +370,7 @@ def identify(
         },
         bounds=res.get("bounds"),
         covariance=covariance,
+        covariance_factor=root,
         noise_variance=s2,
         cancellations=tuple(cancelled),
         **data.provenance(),

@@ -28,8 +28,14 @@ __all__ = ["parameter_covariance"]
 
 
 def parameter_covariance(
-    theta, arx: ARX, data: IOData, predictor: str, initial: str = "rest"
-) -> tuple[np.ndarray, float]:
+    theta,
+    arx: ARX,
+    data: IOData,
+    predictor: str,
+    initial: str = "rest",
+    *,
+    factor: bool = False,
+):
     """The covariance of `theta` and the error variance ``s^2``.
 
     Parameters
@@ -44,6 +50,13 @@ def parameter_covariance(
         The error the estimator minimised.
     initial : {"rest", "measured"}
         The simulation's initial condition (see :class:`PaperCost`).
+    factor : bool, default False
+        Also return a square-root factor ``R`` with ``covariance = R^T R``
+        (``R = s S^-1 V^T`` from the SVD ``J = U S V^T``), or None when a
+        direction is undetermined. A quadratic form ``g^T C g`` computed as
+        ``|R g|^2`` keeps its precision where forming ``C`` squares the
+        condition of ``J`` (a delta-method variance near a well-determined
+        direction can otherwise round to zero).
 
     Returns
     -------
@@ -54,6 +67,8 @@ def parameter_covariance(
         variance.
     s2 : float
         ``e^T e / (N - p)``.
+    factor : ndarray or None, shape (p, p)
+        Only with ``factor=True``.
 
     Examples
     --------
@@ -83,8 +98,10 @@ def parameter_covariance(
     _, sv, vt = np.linalg.svd(jac, full_matrices=False)
     with np.errstate(divide="ignore"):
         inverse = np.where(sv > 1e-12 * sv[0], 1.0 / sv**2, np.inf)
+    root = None
     if np.all(np.isfinite(inverse)):
         covariance = s2 * (vt.T * inverse) @ vt
+        root = np.sqrt(s2) * vt / sv[:, None]
     else:
         # inf * 0 would give NaN: the undetermined directions' variance is
         # infinite on every coefficient they touch.
@@ -92,4 +109,4 @@ def parameter_covariance(
         covariance = s2 * (vt[finite].T * inverse[finite]) @ vt[finite]
         touched = np.any(np.abs(vt[~finite]) > 1e-12, axis=0)
         covariance[np.ix_(touched, touched)] = np.inf
-    return covariance, s2
+    return (covariance, s2, root) if factor else (covariance, s2)

@@ -75,6 +75,10 @@ class IdentifiedModel:
         optimum (:func:`~spiralid.sysid.estimation.uncertainty.parameter_covariance`),
         over ``[free_denominator, b]`` (``p' = p - 1`` with a known
         integrator, whose pole is not estimated); None when not computed.
+    covariance_factor : ndarray or None, shape (k, p')
+        A square-root factor ``R`` of :attr:`covariance` (``C = R^T R``),
+        which the mode intervals use for precision; not saved in model.json
+        (a model read back uses the covariance itself).
     noise_variance : float
         ``s^2``, the variance of the error the estimator minimised (NaN when
         not computed).
@@ -120,6 +124,7 @@ class IdentifiedModel:
     # marginally stable by design, not unstable.
     integrator: bool = False
     covariance: np.ndarray | None = None
+    covariance_factor: np.ndarray | None = None
     noise_variance: float = float("nan")
     cancellations: tuple = ()
 
@@ -282,8 +287,10 @@ class IdentifiedModel:
         integrator is not a mode."""
         a = self.free_denominator
         cov = None if self.covariance is None else self.covariance[: a.size, : a.size]
+        root = self.covariance_factor
+        root = None if root is None else root[:, : a.size]
         b = self.polynomials[0] if not self.integrator else self._free_numerator()
-        return mode_table(a, b, self.ts, covariance=cov)
+        return mode_table(a, b, self.ts, covariance=cov, factor=root)
 
     def _free_numerator(self) -> np.ndarray:
         # With a known integrator the estimated model is B / A' on the

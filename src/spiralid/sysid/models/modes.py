@@ -31,6 +31,7 @@ SPURIOUS_SHARE = 0.01
 SPURIOUS_WIDTH = 0.10
 # Imaginary parts at or below this are real poles (as modes_from_poles).
 _REAL_TOL = 1e-9
+_ORIGIN = 1e-2
 
 
 @dataclass(frozen=True)
@@ -165,6 +166,7 @@ def mode_table(
     *,
     covariance=None,
     level: float = 0.95,
+    factor=None,
 ) -> ModeTable:
     """The modes of ``B(q) / A(q)`` with intervals from the coefficients'
     covariance.
@@ -183,6 +185,10 @@ def mode_table(
         no flag is raised from an interval.
     level : float, default 0.95
         Confidence level of the intervals.
+    factor : array_like, shape (k, n), optional
+        A square-root factor ``R`` of `covariance` (``C = R^T R``): the
+        variances are then ``|R g|^2``, which keep their precision where
+        ``g^T C g`` on an ill-conditioned ``C`` rounds to zero.
 
     Returns
     -------
@@ -213,8 +219,12 @@ def mode_table(
 
     nan = np.full(upper.size, np.nan)
     freq_se, damp_se, radius_se = nan.copy(), nan.copy(), nan.copy()
-    if covariance is not None and upper.size:
-        cov = np.asarray(covariance, dtype=float)
+    if (covariance is not None or factor is not None) and upper.size:
+        cov = (
+            np.asarray(covariance, dtype=float)
+            if factor is None
+            else _Root(np.asarray(factor, dtype=float))
+        )
         # dp/da_k = -p^(n-k) / A'(p), one row per pole.
         slope = np.polyval(np.polyder(den), upper)
         dp = -(upper[:, None] ** (n - np.arange(1, n + 1))) / slope[:, None]
@@ -262,8 +272,17 @@ def mode_table(
     )
 
 
-def _spread(gradient: np.ndarray, cov: np.ndarray) -> np.ndarray:
+class _Root:
+    """A covariance given by its factor ``R`` (``C = R^T R``)."""
+
+    def __init__(self, root: np.ndarray) -> None:
+        self.root = root
+
+
+def _spread(gradient: np.ndarray, cov) -> np.ndarray:
     """Delta-method standard deviations, one per row of `gradient`."""
+    if isinstance(cov, _Root):
+        return np.linalg.norm(cov.root @ gradient.T, axis=0)
     var = np.einsum("ik,kl,il->i", gradient, cov, gradient)
     return np.sqrt(np.maximum(var, 0.0))
 
@@ -276,9 +295,12 @@ def _peak_shares(b: np.ndarray, den: np.ndarray, upper: np.ndarray) -> np.ndarra
     with np.errstate(all="ignore"):
         residues, poles, _ = signal.residuez(b, den)
         peaks = np.abs(residues) / np.abs(1.0 - np.abs(poles))
-    if not np.all(np.isfinite(peaks)):
+    # A pole within 1e-2 of the origin decays within a sample: it is neither
+    # a mode nor drift, and its residue (of order 1 / p when it nearly
+    # cancels) would swamp every mode's share.
+    once = (poles.imag >= -_REAL_TOL) & (np.abs(poles) > _ORIGIN)
+    if not np.all(np.isfinite(peaks[once])):
         return np.full(upper.size, np.nan)
-    once = poles.imag >= -_REAL_TOL
     total = peaks[once].sum()
     nearest = np.argmin(np.abs(upper[:, None] - poles[None, :]), axis=1)
     return peaks[nearest] / total
