@@ -575,7 +575,10 @@ class Validation:
             "poles": cplx(self.poles),
             "zeros": cplx(self.zeros),
             "initial": self.initial,
-            "fit_percent_measured": float(self.fit_percent_measured),
+            # JSON has no infinity: a measured start that diverged is null.
+            "fit_percent_measured": float(self.fit_percent_measured)
+            if np.isfinite(self.fit_percent_measured)
+            else None,
             "diverged": bool(self.diverged),
             "output_error": bool(self.output_error),
             "mode_table": None
