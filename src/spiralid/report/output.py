@@ -540,15 +540,6 @@ def _modes_section(rep: Reproduction) -> str:
         table_ = model.modes
         f_int, d_int = table_.frequency_interval, table_.damping_interval
         for i in range(len(table_)):
-            flags = [
-                text
-                for flag, text in (
-                    (table_.reaches_unit_circle[i], "interval reaches |z| = 1"),
-                    (table_.cancelled[i], "cancelled by a zero"),
-                    (table_.spurious[i], "probably spurious"),
-                )
-                if flag
-            ]
             rows.append(
                 [
                     label,
@@ -557,7 +548,7 @@ def _modes_section(rep: Reproduction) -> str:
                     f"{table_.damping[i]:.4f}",
                     f"[{d_int[i, 0]:.4f}, {d_int[i, 1]:.4f}]",
                     f"{100 * table_.share[i]:.1f}",
-                    "; ".join(flags),
+                    "; ".join(table_.notes(i)),
                 ]
             )
     if not rows:

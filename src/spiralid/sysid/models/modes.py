@@ -95,6 +95,18 @@ class ModeTable:
         half = self._z * self.damping_se
         return np.c_[self.damping - half, self.damping + half]
 
+    def notes(self, i: int) -> list[str]:
+        """Mode `i`'s flags in words (for tables)."""
+        return [
+            text
+            for flag, text in (
+                (self.reaches_unit_circle[i], "interval reaches |z| = 1"),
+                (self.cancelled[i], "cancelled by a zero"),
+                (self.spurious[i], "probably spurious"),
+            )
+            if flag
+        ]
+
     def to_dict(self) -> dict:
         """Plain Python values, one dict per mode (for JSON)."""
         f_lo, f_hi = self.frequency_interval.T
@@ -127,15 +139,7 @@ class ModeTable:
         ]
         f_int, d_int = self.frequency_interval, self.damping_interval
         for i in range(len(self)):
-            notes = [
-                text
-                for flag, text in (
-                    (self.reaches_unit_circle[i], "interval reaches |z| = 1"),
-                    (self.cancelled[i], "cancelled by a zero"),
-                    (self.spurious[i], "probably spurious"),
-                )
-                if flag
-            ]
+            notes = self.notes(i)
             lines.append(
                 f"{i + 1:>4}  {self.frequency[i]:9.4g} "
                 f"[{_num(f_int[i, 0])}, {_num(f_int[i, 1])}]  "
