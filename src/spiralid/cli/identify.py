@@ -87,18 +87,26 @@ def _narx_structure(args):
     )
 
 
+def _load_parts(args, progress, make_structure):
+    """DATA loaded (detrended when asked), the structure built from the
+    options, and the record split: the structure must fit the estimation
+    part."""
+    progress.phase("load", "loading the data")
+    data = _load_data(args)
+    if args.detrend:
+        data = _detrended(data, args.fraction)
+    structure = make_structure(args)
+    est, val = data.split(args.fraction)
+    structure.check_length(est, "estimation part of DATA")
+    return structure, est, val
+
+
 def _run_narx(args) -> int:
     """`spiralid identify --model narx|polynomial`."""
     from spiralid.sysid import METHODS, identify
 
     with _progress(args) as progress:
-        progress.phase("load", "loading the data")
-        data = _load_data(args)
-        if args.detrend:
-            data = _detrended(data, args.fraction)
-        structure = _narx_structure(args)
-        est, val = data.split(args.fraction)
-        structure.check_length(est, "estimation part of DATA")
+        structure, est, val = _load_parts(args, progress, _narx_structure)
         options = {}
         if METHODS[args.method].search:
             options = {"n_points": args.points}
@@ -308,13 +316,7 @@ def run(args, argv: list[str]) -> int:
     if args.model != "arx":
         return _run_narx(args)
     with _progress(args) as progress:
-        progress.phase("load", "loading the data")
-        data = _load_data(args)
-        if args.detrend:
-            data = _detrended(data, args.fraction)
-        arx = _structure(args)
-        est, val = data.split(args.fraction)
-        arx.check_length(est, "estimation part of DATA")
+        arx, est, val = _load_parts(args, progress, _structure)
         options = {}
         if METHODS[args.method].search:
             # The budget rule is identify()'s (estimators.search_options).
