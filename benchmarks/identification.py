@@ -4,7 +4,7 @@ ingredient contributes.
 Records (ARX(8, 8, 0), first 2/3 estimates, last 1/3 validates):
 
 - ``rig``: the default rig record of ``spiralid reproduce``
-  (``spiralid.report.default_data()``: bang-bang experiment, end-point
+  (``spiralid.reproduction.default_data()``: bang-bang experiment, end-point
   acceleration, 500 Hz).
 - ``rig-long``: a 1.2 m beam instead of 0.9 m (modes move down).
 - ``rig-payload``: a 0.1 kg payload at the tip.
@@ -112,7 +112,7 @@ def load_record(name: str, arm_csv: str | None = None) -> IOData:
     from spiralid.fms import FlexibleManipulator, paper_experiment
 
     if name == "rig":
-        from spiralid.report.experiment import default_data
+        from spiralid.reproduction import default_data
 
         return default_data()
     if name == "rig-long":

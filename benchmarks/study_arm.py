@@ -198,7 +198,7 @@ def _oe_variant(data, arx, theta0, initial, kmax=1.0 - 1e-6):
 def oe_initial_state_study() -> None:
     """Why "oe" validates below least squares on the real arm (issue 4).
 
-    For the arm and the simulated rig (``spiralid.report.default_data()``),
+    For the arm and the simulated rig (``spiralid.reproduction.default_data()``),
     ARX(8, 8, 0): output error under four initial-state rules, each from
     the least-squares and the Steiglitz-McBride start: the library's
     ``initial="rest"`` and ``"measured"``, and two study variants
@@ -221,7 +221,7 @@ def oe_initial_state_study() -> None:
     if ARM.exists():
         records["arm"] = IOData.from_csv(ARM, input="u", output="y", ts=0.01).split()
     try:
-        from spiralid.report import default_data
+        from spiralid.reproduction import default_data
 
         records["rig"] = default_data().split()
     except ImportError:

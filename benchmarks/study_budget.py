@@ -14,7 +14,7 @@ Run: ``python benchmarks/study_budget.py [n_seeds] [budget ...]``
 import sys
 import time
 
-from spiralid.report import Configuration, default_data, reproduce
+from spiralid.reproduction import Configuration, default_data, reproduce
 
 CONFIGS = (
     Configuration("SDA", "sda"),

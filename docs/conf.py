@@ -109,7 +109,8 @@ PACKAGES = {
     "spiralid.fms": "The finite-element flexible manipulator rig and its signals.",
     "spiralid.datasets": "Data shipped with the package and the record reader.",
     "spiralid.study": "Studies over every reading of the paper's cost (Dask).",
-    "spiralid.report": "The paper's reproduction experiment and its files.",
+    "spiralid.reproduction": "The paper's SDA vs Eb-SDA experiment, computed.",
+    "spiralid.report": "The reproduction's and study's figures, HTML and files.",
     "spiralid.choices": "The names a user chooses among, in one light module.",
 }
 

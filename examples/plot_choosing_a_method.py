@@ -14,7 +14,7 @@ package (:func:`spiralid.datasets.robot_arm`), torque in, acceleration out,
 1,024 samples. The paper's searches run at the paper's budget of 20,000
 cost evaluations and 50 points, and ``spiral`` at its default of 10,000; one
 seed each, so this is one draw, not a statistic (``spiralid study`` and
-:func:`spiralid.report.reproduce` repeat such runs over seeds).
+:func:`spiralid.reproduction.reproduce` repeat such runs over seeds).
 """
 
 import time

@@ -5,7 +5,7 @@ The paper's reproduction, at a reduced size
 The paper (Nasir, Ismail, Ahmad and Tokhi) identifies an ARX(8, 8, 0) model
 of a flexible manipulator's end-point acceleration with SDA and with its
 exponential-based variant Eb-SDA, and reports that Eb-SDA does better.
-:func:`spiralid.report.reproduce` runs that comparison on the simulated rig
+:func:`spiralid.reproduction.reproduce` runs that comparison on the simulated rig
 with every search given the same budget of cost evaluations, over several
 seeds, with least squares (LS) and output error (OE) beside them; it is
 what ``spiralid reproduce`` runs before it writes its report.
@@ -21,13 +21,14 @@ run from the command line::
 
 import matplotlib.pyplot as plt
 
-from spiralid.report import CONFIGURATIONS, reproduce, summary_text
 from spiralid.report import figures as report_figures
+from spiralid.report import summary_text
+from spiralid.reproduction import CONFIGURATIONS, reproduce
 
 # %%
 # The configurations
 # ------------------
-# :data:`~spiralid.report.CONFIGURATIONS` lists every arm of the comparison:
+# :data:`~spiralid.reproduction.CONFIGURATIONS` lists every arm of the comparison:
 # the paper's SDA and Eb-SDA over the raw coefficients (with the stability
 # penalty), the same searches over reflection coefficients (stable by
 # construction), Eb-SDA polished by the output-error method, Eb-SDA with the
@@ -66,7 +67,7 @@ for label in ("LS", "OE"):
 # Figures
 # -------
 # :mod:`spiralid.report.figures` draws the report's figures from the
-# :class:`~spiralid.report.Reproduction`. They are ``Figure`` objects that
+# :class:`~spiralid.reproduction.Reproduction`. They are ``Figure`` objects that
 # pyplot does not track; ``plt.figure(fig)`` hands each to pyplot so that
 # the gallery shows it.
 #

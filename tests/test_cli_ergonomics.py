@@ -16,10 +16,10 @@ import pytest
 from scipy.io import loadmat
 from scipy.signal import lfilter
 
-import spiralid.report.progress as progress_module
+import spiralid.outputs.progress as progress_module
 from spiralid import IdentifiedModel, cli
 from spiralid.cli.export import PYTHON_LOAD
-from spiralid.report.progress import Progress
+from spiralid.outputs.progress import Progress
 
 SEARCH = ["--method", "ebsda", "--na", "2", "--nb", "2", "--nk", "1",
           "--budget", "600", "--points", "12"]  # fmt: skip

@@ -40,6 +40,7 @@ PACKAGES = (
     "spiralid.fms",
     "spiralid.datasets",
     "spiralid.study",
+    "spiralid.reproduction",
     "spiralid.report",
     "spiralid.choices",
 )

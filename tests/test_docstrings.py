@@ -22,6 +22,7 @@ MODULES = (
     "spiralid.fms",
     "spiralid.study",
     "spiralid.datasets",
+    "spiralid.reproduction",
 )
 _SECTION = re.compile(r"^(Parameters|Attributes|Other Parameters)\n-+\n", re.M)
 _HEADER = re.compile(r"^\S.*\n-+\n", re.M)

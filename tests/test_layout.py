@@ -3,7 +3,9 @@
 `sysid` runs data -> models -> estimation -> validation (docs/design-notes.md,
 "Layout and dependencies"): a subpackage imports only from those before it,
 and nothing in the library below the command imports the command, the
-report or the study.
+report or the study. Above the library the flow is study -> reproduction ->
+report -> cli, and the output plumbing (`outputs`) is a leaf that only
+those four use.
 """
 
 import ast
@@ -59,13 +61,51 @@ def test_sysid_stages_import_only_earlier_stages(stage):
                 )
 
 
-@pytest.mark.parametrize("sub", ["optim", "fms", "sysid", "datasets"])
-def test_the_library_does_not_import_the_command_report_or_study(sub):
-    for path in _files(sub):
+LIBRARY = ["optim", "fms", "sysid", "datasets"]
+# Above the library, each of these imports only from those before it.
+UPPER = ["study", "reproduction", "report", "cli"]
+
+
+def _sources(sub: str) -> list[Path]:
+    """A subpackage's files, or the one module `sub`.py."""
+    module = ROOT / f"{sub}.py"
+    return [module] if module.is_file() else _files(sub)
+
+
+def _assert_no_import(subs, banned):
+    banned = tuple(f"spiralid.{b}" for b in banned)
+    for sub in subs:
+        for path in _sources(sub):
+            for name in _imports(path):
+                assert not (
+                    name in banned or name.startswith(tuple(f"{b}." for b in banned))
+                ), f"{path.relative_to(ROOT)} imports {name}"
+
+
+@pytest.mark.parametrize("sub", LIBRARY)
+def test_the_library_imports_nothing_above_it(sub):
+    # The library reports progress through callbacks and never writes a
+    # command's files, so `outputs` is above it too.
+    _assert_no_import([sub], [*UPPER, "outputs"])
+
+
+@pytest.mark.parametrize("stage", UPPER[:-1])
+def test_the_upper_packages_import_only_earlier_ones(stage):
+    _assert_no_import([stage], UPPER[UPPER.index(stage) + 1 :])
+
+
+def test_the_output_plumbing_imports_nothing_of_ours():
+    for path in _files("outputs"):
         for name in _imports(path):
-            assert not name.startswith(
-                ("spiralid.cli", "spiralid.report", "spiralid.study")
-            ), f"{path.relative_to(ROOT)} imports {name}"
+            assert not name.startswith("spiralid"), (
+                f"{path.relative_to(ROOT)} imports {name}"
+            )
+
+
+def test_the_reader_sees_every_upper_package():
+    # Guards the checks above against a renamed or moved package.
+    for sub in [*UPPER, "outputs"]:
+        assert _sources(sub), sub
 
 
 def test_data_and_spectra_import_no_later_stage():

@@ -105,7 +105,7 @@ def _never_called(*args, **kwargs):
 @pytest.mark.parametrize(
     "argv, patch",
     [
-        (["reproduce", "--out", "OUT"], "spiralid.report.reproduce"),
+        (["reproduce", "--out", "OUT"], "spiralid.reproduction.reproduce"),
         (
             ["identify", "DATA", "--ts", "0.1", "--method", "ls", "--out", "OUT"],
             "spiralid.sysid.identify",

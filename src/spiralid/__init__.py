@@ -10,10 +10,9 @@ manipulator.
 # The public names load on first use (PEP 562): `import spiralid` stays as
 # cheap as the metadata lookup above, and SciPy, Numba and the compiled
 # kernels are imported only by the parts that need them.
-_SUBPACKAGES = ("datasets", "fms", "optim", "report", "sysid")
+_SUBPACKAGES = ("datasets", "fms", "optim", "report", "reproduction", "sysid")
 _NAMES = {
     "OptimiserResult": "optim",
-    "SpiralResult": "optim",
     "minimize": "optim",
     "FlexibleManipulator": "fms",
     "Recording": "fms",

@@ -7,8 +7,8 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid import ARX, IOData
-from spiralid.report import Configuration, reproduce
 from spiralid.report.figures import all_figures, figure_labels, recommended
+from spiralid.reproduction import Configuration, reproduce
 
 CONFIGS = (
     Configuration("SDA", "sda"),

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 from patience import allowance
 
-from spiralid.report import reproduce, write_reproduction
+from spiralid.report import write_reproduction
+from spiralid.reproduction import reproduce
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 

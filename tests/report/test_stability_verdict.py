@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from spiralid.report import Configuration, reproduce
 from spiralid.report.output import _html, results_dict
+from spiralid.reproduction import Configuration, reproduce
 from spiralid.sysid import ARX, IdentifiedModel, IOData, validate
 from spiralid.sysid.estimation import estimators
 from spiralid.sysid.models.polynomials import format_pole_radius

@@ -336,7 +336,7 @@ def test_rig_rest_criterion_validates_better_than_measured():
     # for either rule on this record (identify itself also polishes the
     # least-squares start, ~3 s more from rest); identify's figures are in
     # the benchmarks. Validation: free run from rest over the whole record.
-    from spiralid.report import default_data
+    from spiralid.reproduction import default_data
     from spiralid.sysid import validate
     from spiralid.sysid.estimation.outputerror import local_polish
 

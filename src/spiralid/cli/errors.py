@@ -143,7 +143,7 @@ def _show_warnings(prefix: str, quiet: bool) -> None:
     warnings.simplefilter("once")
 
     def show(message, category, filename, lineno, file=None, line=None):
-        from spiralid.report.progress import before_message
+        from spiralid.outputs.progress import before_message
 
         before_message()  # a line of its own, not after a progress line
         print(f"{prefix}: warning: {_user_message(message)}", file=sys.stderr)

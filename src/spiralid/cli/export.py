@@ -157,7 +157,7 @@ def run(args, argv: list[str]) -> int:
             # goes to the null device so the interpreter's exit stays quiet.
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
-    from spiralid.report.atomic import OutputFile
+    from spiralid.outputs.atomic import OutputFile
 
     with OutputFile(out, args.force) as target:
         _write(fmt, model, tf, target.path, args.model)

@@ -169,7 +169,7 @@ def _detrended(data, fraction: float | None):
 
 def _open_folder(path: str, force: bool):
     """The output folder, locked and proved writable before any computation."""
-    from spiralid.report.atomic import OutputFolder
+    from spiralid.outputs.atomic import OutputFolder
 
     return OutputFolder(path, force).open()
 
@@ -191,7 +191,7 @@ def _progress(args):
     """The command's progress on standard error (a status line on a
     terminal, a few plain lines in a log; nothing with --quiet), which
     also times its phases for timings.json."""
-    from spiralid.report.progress import Progress
+    from spiralid.outputs.progress import Progress
 
     return Progress(f"spiralid {args.command}", enabled=not args.quiet)
 

@@ -21,7 +21,8 @@ from .options import (
 
 def run(args, argv: list[str]) -> int:
     from spiralid import datasets
-    from spiralid.report import reproduce, summary_text, write_reproduction
+    from spiralid.report import summary_text, write_reproduction
+    from spiralid.reproduction import reproduce
 
     data = source = None
     if args.data is None and (

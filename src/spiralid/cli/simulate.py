@@ -24,7 +24,7 @@ def run(args, argv: list[str]) -> int:
             f"--width applies to --signal {' and '.join(_PULSES)}; --signal "
             f"{args.signal} has no pulses"
         )
-    from spiralid.report.atomic import OutputFile
+    from spiralid.outputs.atomic import OutputFile
 
     with _progress(args) as progress, OutputFile(args.out, args.force) as target:
         progress.phase("simulation", f"simulating {args.duration:g} s of the rig")

@@ -1,22 +1,10 @@
-"""The paper-reproduction experiment, its figures and its report."""
+"""The reproduction's and the study's figures, HTML report and files.
 
-from spiralid.report.experiment import (
-    CONFIGURATIONS,
-    Configuration,
-    Reproduction,
-    Run,
-    default_data,
-    reproduce,
-)
+The report only draws and writes: the experiment it reports is
+:mod:`spiralid.reproduction`, and the atomic folders it writes into are
+:mod:`spiralid.outputs`.
+"""
+
 from spiralid.report.output import summary_text, write_reproduction
 
-__all__ = [
-    "CONFIGURATIONS",
-    "Configuration",
-    "Reproduction",
-    "Run",
-    "default_data",
-    "reproduce",
-    "summary_text",
-    "write_reproduction",
-]
+__all__ = ["summary_text", "write_reproduction"]

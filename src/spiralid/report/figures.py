@@ -1,6 +1,6 @@
 """Figures of the paper reproduction (Figures 6 and 7 and what we add).
 
-Each function takes a :class:`~spiralid.report.experiment.Reproduction` and
+Each function takes a :class:`~spiralid.reproduction.Reproduction` and
 returns a matplotlib ``Figure``; the plotting itself is
 :mod:`spiralid.sysid.validation.plots`.
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from spiralid.report.experiment import Reproduction
+from spiralid.reproduction import Reproduction
 from spiralid.study.spec import BASELINES
 from spiralid.sysid import plots
 

@@ -3,7 +3,7 @@
 The output folder must be new or empty unless ``force`` is given; with
 ``force`` the files this module writes are replaced and nothing else in the
 folder is touched. The files are written atomically
-(:class:`~spiralid.report.atomic.OutputFolder`): all of them or none.
+(:class:`~spiralid.outputs.atomic.OutputFolder`): all of them or none.
 """
 
 from __future__ import annotations
@@ -15,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from spiralid.report.atomic import OutputFolder
-from spiralid.report.experiment import Reproduction
+from spiralid.outputs.atomic import OutputFolder
 from spiralid.report.html import figure, page, png, table
+from spiralid.reproduction import Reproduction
 from spiralid.sysid.models.polynomials import format_pole_radius
 
 __all__ = [
@@ -31,6 +31,8 @@ __all__ = [
 ]
 
 OUTPUT_FILES = ("results.json", "report.html")
+# What the report names as its command when it was not given one.
+REPRODUCE_CALL = "spiralid.reproduction.reproduce()"
 
 # The numbers the paper reports in Table-2, shown beside ours.
 PAPER_TABLE2 = {
@@ -385,7 +387,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         "flexible manipulator system</i>, with the statistics over seeds the paper "
         "lacks and least-squares (LS) and output-error (OE) baselines beside the "
         "metaheuristics.</p>",
-        f"<p>Command: <code>{e(command or 'spiralid.report.reproduce()')}</code><br>"
+        f"<p>Command: <code>{e(command or REPRODUCE_CALL)}</code><br>"
         f"Data: {e(rep.data.input_label)} &rarr; {e(rep.data.output_label)}, "
         f"{rep.data.n} samples at ts = {rep.data.ts:g} s; first "
         f"{rep.estimation.n} to estimate, last {rep.validation.n} to validate.<br>"

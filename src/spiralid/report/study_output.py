@@ -10,7 +10,7 @@ import html
 import json
 from pathlib import Path
 
-from spiralid.report.atomic import OutputFolder
+from spiralid.outputs.atomic import OutputFolder
 from spiralid.report.html import figure, page, png, table
 from spiralid.report.output import versions
 from spiralid.study import StudyResults

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from patience import allowance
 
-from spiralid.report.atomic import OutputError, OutputFile, OutputFolder
+from spiralid.outputs.atomic import OutputError, OutputFile, OutputFolder
 
 
 def _leftovers(parent: Path) -> list[str]:
@@ -65,7 +65,7 @@ def test_lock_taken_in_another_process_is_refused(tmp_path):
     code = textwrap.dedent(
         f"""
         import sys, time
-        from spiralid.report.atomic import OutputFolder
+        from spiralid.outputs.atomic import OutputFolder
         with OutputFolder({str(tmp_path / "out")!r}):
             print("locked", flush=True)
             sys.stdin.readline()

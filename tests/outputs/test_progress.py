@@ -2,8 +2,8 @@ import io
 
 from patience import until
 
-import spiralid.report.progress as progress_module
-from spiralid.report.progress import Progress
+import spiralid.outputs.progress as progress_module
+from spiralid.outputs.progress import Progress
 
 
 class Terminal(io.StringIO):

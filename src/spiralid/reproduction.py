@@ -5,7 +5,8 @@ seeds with an equal budget of cost evaluations, adds the least-squares and
 output-error baselines, and returns a :class:`Reproduction` holding every
 model and every number. It computes only: figures are drawn by
 :mod:`spiralid.report.figures` and files written by
-:mod:`spiralid.report.output` and the command line.
+:mod:`spiralid.report.output` and the command line. It sits above the study
+(it runs the study's tasks with the study's runner) and below the report.
 """
 
 from __future__ import annotations
@@ -47,8 +48,23 @@ __all__ = [
 class Configuration:
     """One arm of the comparison: an optimiser, what it searches, the gain.
 
-    ``safe_start`` None takes the method's default (off for the paper's
-    methods, see :mod:`spiralid.sysid.estimation.estimators`).
+    Attributes
+    ----------
+    label : str
+        The name the figures, tables and ``results.json`` give the arm.
+    method : str
+        A method of :func:`spiralid.sysid.identify` (``"sda"``, ``"ebsda"``,
+        ``"de"``, ``"spiral"`` ...).
+    parametrization : str, default the package's default parametrisation
+        What the search moves (``"coefficients"``, ``"reflection"``,
+        ``"modal"``).
+    gain_scale : float, default 1.0
+        Factor on the paper's gain ``w`` in the search's cost.
+    refine : bool, default False
+        Polish the search's result locally.
+    safe_start : bool or None, default None
+        None takes the method's default (off for the paper's methods, see
+        :mod:`spiralid.sysid.estimation.estimators`).
     """
 
     label: str
@@ -89,6 +105,17 @@ class Run:
     gain (``w`` auto), whatever gain the search used, so that runs compare on
     one scale; ``fit_val`` is the validation fit % of the free-run simulation
     over the whole record, scored on the validation part.
+
+    Attributes
+    ----------
+    label : str
+        The configuration's label, or ``"LS"``/``"OE"`` for a baseline.
+    seed : int or None
+        None for a baseline.
+    model : IdentifiedModel
+    cost, fit_val : float
+    times : ndarray or None
+        Wall seconds at each entry of the model's history.
     """
 
     label: str
@@ -139,6 +166,8 @@ class Reproduction:
     seeds : list of int
     options : dict
         The optimiser settings every spiral run shared.
+    configurations : tuple of Configuration
+        The arms that ran.
     runs : dict of str to list of Run
         Per configuration label, one run per seed (in seed order).
     baselines : dict of str to Run
@@ -146,6 +175,8 @@ class Reproduction:
     validations : dict of str to (Validation, Validation)
         For the best run of each configuration and each baseline: the
         estimation part and the validation part.
+    source : dict
+        How the record was obtained (see :func:`reproduce`).
     elapsed : float
         Wall time of the whole experiment in seconds.
     """
@@ -236,7 +267,8 @@ def default_data(seed: int = 0) -> IOData:
 
 
 def default_data_source(seed: int = 0) -> dict:
-    """What :func:`default_data` simulates: every rig and experiment setting."""
+    """What :func:`default_data` simulates: every rig and experiment setting,
+    with `seed` as the noise seed."""
     from dataclasses import asdict
 
     from spiralid.fms import FlexibleManipulator, paper_experiment

@@ -8,8 +8,8 @@ from scipy import stats
 from scipy.signal import lfilter
 
 from spiralid import ARX, IOData
-from spiralid.report import Configuration, reproduce
 from spiralid.report.output import results_dict, summary_text, verdict
+from spiralid.reproduction import Configuration, reproduce
 
 CONFIGS = (Configuration("SDA", "sda"), Configuration("Eb-SDA", "ebsda"))
 
