@@ -62,12 +62,32 @@ def _time_constant(text: str) -> float | str | None:
     return v
 
 
+def _integrator_count(text: str) -> int:
+    """--integrator K: a count of known integrators, 0 or more."""
+    try:
+        count = int(text)
+    except ValueError:
+        count = -1
+    if count < 0:
+        import argparse
+
+        raise argparse.ArgumentTypeError(
+            f"must be a count of integrators >= 0; got {text!r}"
+        )
+    return count
+
+
 def _narx_structure(args):
     """--model narx / polynomial: --na past outputs, --nb past inputs."""
     from spiralid.sysid import NARX, PolynomialNARX
 
     if args.na < 1:
         raise UsageError(f"--model {args.model} needs --na >= 1; got {args.na}")
+    if args.integrator > 1:
+        raise UsageError(
+            f"--model {args.model} takes one integrator; got --integrator "
+            f"{args.integrator}"
+        )
     if args.model == "narx":
         return NARX(
             args.na,
@@ -75,7 +95,7 @@ def _narx_structure(args):
             args.nk,
             hidden=(args.hidden,),
             activation=args.activation,
-            integrator=args.integrator,
+            integrator=bool(args.integrator),
         )
     return PolynomialNARX(
         args.na,
@@ -83,7 +103,7 @@ def _narx_structure(args):
         args.nk,
         degree=args.degree,
         n_terms=args.terms,
-        integrator=args.integrator,
+        integrator=bool(args.integrator),
     )
 
 
@@ -447,9 +467,14 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--integrator",
-        action="store_true",
-        help="the output integrates (a known pole at z = 1, e.g. the rig's hub "
-        "angle): --na counts it, the method estimates the other poles",
+        nargs="?",
+        type=_integrator_count,
+        const=1,
+        default=0,
+        metavar="K",
+        help="the output integrates (K known poles at z = 1, default 1; 2 for "
+        "the rig's hub angle from torque): --na counts them, the method "
+        "estimates the other poles",
     )
     p.add_argument("--points", type=_positive_int, default=50, help="search points")
     p.add_argument(

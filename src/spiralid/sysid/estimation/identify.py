@@ -53,7 +53,7 @@ from ..data import IOData
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from ..models.narx import NARX, PolynomialNARX
-from ..models.polynomials import with_integrator
+from ..models.polynomials import integrator_count, with_integrator
 from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS, Problem
@@ -114,7 +114,7 @@ def identify(
     bounds=None,
     initial: str = "rest",
     safe_start: bool | None = None,
-    integrator: bool = False,
+    integrator: bool | int = False,
     max_time_constant: float | str | None = AUTO,
     cancel: bool | None = None,
     **optimiser_options,
@@ -177,16 +177,19 @@ def identify(
         either (see :mod:`spiralid.sysid.estimation.estimators`). Default: the method's
         (off for the paper's ``"sda"``, ``"ebsda"`` and for ``"lasda"``,
         ``"de"``). Ignored by ``"ls"`` and ``"oe"``.
-    integrator : bool
+    integrator : bool or int
         The output integrates (a pole at z = 1 known beforehand, as the
-        rig's hub angle integrates its velocity): ``arx.na`` counts it, the
-        estimation chooses the other ``na - 1`` poles. For the free run from
-        rest, ``B / (A' (1 - z^-1))`` applied to ``u`` is ``B / A'`` applied
-        to the running sum of ``u``, so any method estimates ``B / A'`` from
-        (running sum of ``u``, ``y``) with its cost unchanged, and the model
-        is composed back. Needs ``predictor="simulation"`` and
-        ``initial="rest"``. The model is marginally stable by design: its
-        stability verdict is on the other poles.
+        rig's hub velocity integrates its torque): ``arx.na`` counts it, the
+        estimation chooses the other ``na - 1`` poles. A count ``k`` asks
+        for ``k`` poles at ``z = 1``: ``2`` for a double integrator, as the
+        rig's hub angle from torque (a rigid-body mode); ``True`` is 1. For
+        the free run from rest, ``B / (A' (1 - z^-1)^k)`` applied to ``u``
+        is ``B / A'`` applied to the ``k``-fold running sum of ``u``, so any
+        method estimates ``B / A'`` from (summed ``u``, ``y``) with its cost
+        unchanged, and the model is composed back. Needs
+        ``predictor="simulation"`` and ``initial="rest"``. The model is
+        marginally stable by design: its stability verdict is on the other
+        poles.
     max_time_constant : float, "auto" or None, default "auto"
         A stability margin tied to the data, in seconds: every pole inside
         the radius ``r_max = exp(-ts / T)``, the pole of a continuous mode
@@ -263,8 +266,7 @@ def identify(
         raise ValueError(
             f"`arx` must be an ARX, NARX or PolynomialNARX; got {type(arx).__name__}"
         )
-    if not isinstance(integrator, bool | np.bool_):
-        raise ValueError(f"`integrator` must be True or False; got {integrator!r}")
+    integrator = integrator_count(integrator, arx.na)
     if isinstance(method, str):
         # As minimize and scipy.optimize.minimize: names in any case.
         method = method.lower()
@@ -272,6 +274,7 @@ def identify(
         return _identify_integrating(
             data,
             arx,
+            integrator,
             dict(
                 method=method,
                 predictor=predictor,
@@ -478,11 +481,12 @@ def _is_default(value, default) -> bool:
     return isinstance(default, str) and isinstance(value, str) and value == default
 
 
-def _identify_integrating(data: IOData, arx: ARX, options: dict) -> IdentifiedModel:
-    """`identify` with a known integrator: ``B / A'`` from the running sum
-    of the input, composed back into ``B / (A' (1 - z^-1))``."""
-    if arx.na < 1:
-        raise ValueError(f"`integrator` needs a denominator (na >= 1); got {arx}")
+def _identify_integrating(
+    data: IOData, arx: ARX, count: int, options: dict
+) -> IdentifiedModel:
+    """`identify` with `count` known integrators: ``B / A'`` from the
+    `count`-fold running sum of the input, composed back into
+    ``B / (A' (1 - z^-1)^count)``."""
     if options["predictor"] != "simulation" or options["initial"] != "rest":
         raise ValueError(
             "`integrator` needs predictor='simulation' and initial='rest' (the "
@@ -490,14 +494,17 @@ def _identify_integrating(data: IOData, arx: ARX, options: dict) -> IdentifiedMo
             f"rest); got predictor={options['predictor']!r}, "
             f"initial={options['initial']!r}"
         )
-    summed = replace(data, u=np.cumsum(data.u))
-    inner = identify(summed, ARX(arx.na - 1, arx.nb, arx.nk), **options)
-    theta = np.r_[with_integrator(inner.theta[: arx.na - 1]), inner.theta[arx.na - 1 :]]
+    u = data.u
+    for _ in range(count):
+        u = np.cumsum(u)
+    inner = identify(replace(data, u=u), ARX(arx.na - count, arx.nb, arx.nk), **options)
+    free = inner.theta[: arx.na - count]
+    theta = np.r_[with_integrator(free, count), inner.theta[arx.na - count :]]
     return replace(
         inner,
         theta=theta,
         arx=arx,
         input_unit=data.input_unit,
         u_offset=data.u_offset,
-        integrator=True,
+        integrator=count,
     )

@@ -24,8 +24,9 @@ stability penalty exactly as printed and no margin; a value other than
 for ``"ls"`` (see :func:`~spiralid.sysid.estimation.identify.identify`).
 
 A plant that integrates is not approximated by a pole near ``z = 1``: say
-so with ``integrator=True``, which factors the pole at ``z = 1`` out before
-estimation; the margin is on the other poles.
+so with ``integrator=True`` (or ``integrator=2`` for a double integrator,
+such as the rig's hub angle driven by torque), which factors the poles at
+``z = 1`` out before estimation; the margin is on the other poles.
 
 Where the margin acts, so that no evaluation is spent outside it:
 

@@ -13,7 +13,13 @@ from ..data import IOData
 from . import _fields
 from .arx import ARX, INITIAL_CONDITIONS
 from .modes import ModeTable, mode_table
-from .polynomials import deflate_integrator, is_stable_polynomial, max_pole_radius
+from .polynomials import (
+    deflate_integrator,
+    integrator_count,
+    is_stable_polynomial,
+    max_pole_radius,
+    with_integrator,
+)
 
 __all__ = ["IdentifiedModel"]
 
@@ -66,15 +72,16 @@ class IdentifiedModel:
     fraction : float or None
         The share of the record that estimated the model (the CLI's
         ``--fraction``), when known.
-    integrator : bool
-        A known integrator (pole at ``z = 1``) was factored out before
-        estimation (``identify(integrator=True)``): the model is marginally
-        stable by design, not unstable.
+    integrator : int
+        The number of known integrators (poles at ``z = 1``) factored out
+        before estimation (``identify(integrator=True)`` is 1, ``2`` a
+        double integrator such as torque to angle): the model is marginally
+        stable by design, not unstable. 0 (or False): none.
     covariance : ndarray or None, shape (p', p')
         The covariance of the estimated parameters, ``s^2 (J^T J)^-1`` at the
         optimum (:func:`~spiralid.sysid.estimation.uncertainty.parameter_covariance`),
-        over ``[free_denominator, b]`` (``p' = p - 1`` with a known
-        integrator, whose pole is not estimated); None when not computed.
+        over ``[free_denominator, b]`` (``p' = p - integrator``: a known
+        integrator's pole is not estimated); None when not computed.
     covariance_factor : ndarray or None, shape (k, p')
         A square-root factor ``R`` of :attr:`covariance` (``C = R^T R``),
         which the mode intervals use for precision; not saved in model.json
@@ -119,10 +126,10 @@ class IdentifiedModel:
     u_offset: float = 0.0
     y_offset: float = 0.0
     fraction: float | None = None
-    # A known integrator (a pole at z = 1) factored out of the denominator
-    # before estimation (`identify(integrator=True)`): the model is then
+    # Known integrators (poles at z = 1) factored out of the denominator
+    # before estimation (`identify(integrator=...)`): the model is then
     # marginally stable by design, not unstable.
-    integrator: bool = False
+    integrator: int = 0
     covariance: np.ndarray | None = None
     covariance_factor: np.ndarray | None = None
     noise_variance: float = float("nan")
@@ -144,16 +151,22 @@ class IdentifiedModel:
             raise ValueError(
                 f"`theta` must be finite; got {self.theta[bad]!r} at index {bad}"
             )
+        self.integrator = integrator_count(self.integrator, self.arx.na)
         if self.integrator:
-            a = np.r_[1.0, self.theta[: self.arx.na]]
-            if self.arx.na < 1 or abs(a.sum()) > 1e-9 * np.abs(a).sum():
+            a = self.theta[: self.arx.na]
+            back = with_integrator(
+                deflate_integrator(a, self.integrator), self.integrator
+            )
+            if not np.allclose(
+                back, a, rtol=0.0, atol=1e-9 * np.abs(np.r_[1.0, a]).sum()
+            ):
                 raise ValueError(
-                    "`integrator` needs a denominator with a pole at z = 1 "
-                    f"(A(1) = 0); got A(1) = {a.sum():.3g}"
+                    f"`integrator` = {self.integrator} needs a denominator with "
+                    f"that many poles at z = 1; got A(1) = {1.0 + a.sum():.3g}"
                 )
         if self.covariance is not None:
             self.covariance = np.asarray(self.covariance, dtype=float)
-            free = self.arx.n_params - int(bool(self.integrator))
+            free = self.arx.n_params - self.integrator
             if self.covariance.shape != (free, free):
                 raise ValueError(
                     f"`covariance` must have shape ({free}, {free}) for {self.arx}"
@@ -251,8 +264,7 @@ class IdentifiedModel:
         """The denominator's coefficients ``a_1..`` without the known
         integrator: the poles the estimation chose (all of them when
         ``integrator`` is False)."""
-        a = self.theta[: self.arx.na]
-        return deflate_integrator(a) if self.integrator else a
+        return deflate_integrator(self.theta[: self.arx.na], self.integrator)
 
     @property
     def is_stable(self) -> bool:
@@ -363,7 +375,7 @@ class IdentifiedModel:
             "u_offset": float(self.u_offset),
             "y_offset": float(self.y_offset),
             "fraction": None if self.fraction is None else float(self.fraction),
-            "integrator": bool(self.integrator),
+            "integrator": self.integrator,
             "covariance": None
             if self.covariance is None
             else np.where(np.isfinite(self.covariance), self.covariance, None).tolist(),
@@ -433,7 +445,7 @@ class IdentifiedModel:
                     d, "y_offset", "a finite number", _fields.finite, 0.0
                 ),
                 fraction=fraction,
-                integrator=bool(d.get("integrator", False)),
+                integrator=int(d.get("integrator", 0)),
                 covariance=_covariance_field(d),
                 noise_variance=_fields.number(
                     d,

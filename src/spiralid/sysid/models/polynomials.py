@@ -46,6 +46,7 @@ __all__ = [
     "deflate_integrator",
     "fold_reflection",
     "format_pole_radius",
+    "integrator_count",
     "is_stable_polynomial",
     "max_pole_radius",
     "random_stable_polynomial",
@@ -368,24 +369,57 @@ def random_stable_polynomial(n: int, size: int | None = None, rng=None) -> np.nd
     return a[0] if size is None else a
 
 
-def deflate_integrator(a) -> np.ndarray:
-    """``a'`` with ``1 + a_1 z^-1 + .. = (1 + a'_1 z^-1 + ..)(1 - z^-1)``:
-    the denominator without a known integrator (a root at z = 1).
+def integrator_count(integrator, na: int) -> int:
+    """The number of known integrators that `integrator` asks for, checked
+    against a denominator of order `na`: ``False``/``True`` are 0/1, an
+    integer ``0 <= k <= na`` is ``k`` (``2`` for a double integrator); a
+    one-line ValueError otherwise."""
+    if isinstance(integrator, bool | np.bool_):
+        count = int(integrator)
+    elif isinstance(integrator, int | np.integer):
+        count = int(integrator)
+    else:
+        count = -1
+    if count < 0:
+        raise ValueError(
+            "`integrator` must be True, False or a count of integrators >= 0; "
+            f"got {integrator!r}"
+        )
+    if count > na:
+        raise ValueError(
+            f"`integrator` = {count} needs a denominator of order na >= {count}; "
+            f"got na = {na}"
+        )
+    return count
+
+
+def deflate_integrator(a, count: int = 1) -> np.ndarray:
+    """``a'`` with ``1 + a_1 z^-1 + .. = (1 + a'_1 z^-1 + ..)(1 - z^-1)^count``:
+    the denominator without `count` known integrators (roots at z = 1).
 
     Examples
     --------
     >>> deflate_integrator(np.convolve([1.0, -0.5], [1.0, -1.0])[1:]).tolist()
     [-0.5]
+    >>> deflate_integrator(with_integrator([-0.5], 2), 2).round(12).tolist()
+    [-0.5]
     """
     a = np.r_[1.0, np.asarray(a, dtype=float)]
-    # Synthetic division by (1 - z^-1): the running sum of the coefficients.
-    return np.cumsum(a)[1:-1]
+    for _ in range(int(count)):
+        # Synthetic division by (1 - z^-1): the running sum of the coefficients.
+        a = np.cumsum(a)[:-1]
+    return a[1:]
 
 
-def with_integrator(a) -> np.ndarray:
-    """The coefficients of ``(1 + a_1 z^-1 + ..)(1 - z^-1)`` after the 1.
+def with_integrator(a, count: int = 1) -> np.ndarray:
+    """The coefficients of ``(1 + a_1 z^-1 + ..)(1 - z^-1)^count`` after the 1.
 
     >>> with_integrator([-0.5]).tolist()
     [-1.5, 0.5]
+    >>> with_integrator([], 2).tolist()
+    [-2.0, 1.0]
     """
-    return np.convolve(np.r_[1.0, np.asarray(a, dtype=float)], [1.0, -1.0])[1:]
+    a = np.r_[1.0, np.asarray(a, dtype=float)]
+    for _ in range(int(count)):
+        a = np.convolve(a, [1.0, -1.0])
+    return a[1:]

@@ -323,9 +323,9 @@ class Validation:
         continues from its end.
     output_name, output_unit : str
         The record's output name and unit, for figure labels.
-    integrator : bool
-        The model has a known integrator (pole at ``z = 1``) by design, so
-        ``stable`` is judged without it.
+    integrator : int
+        The number of known integrators (poles at ``z = 1``) the model has
+        by design, so ``stable`` is judged without them.
     initial : {"rest", "warmup"}
         Where the free run started: from rest, or from the state the model
         reached over ``warmup``.
@@ -381,7 +381,7 @@ class Validation:
     y_pred: np.ndarray
     output_name: str = "output"
     output_unit: str = ""
-    integrator: bool = False
+    integrator: int = 0
     initial: str = "rest"
     fit_percent_measured: float = float("nan")
     diverged: bool = False
@@ -490,8 +490,8 @@ class Validation:
                 "stable (max |pole|)",
                 f"{self.stable} ({format_pole_radius(self.max_pole_radius)})"
                 + (
-                    "; and a known integrator (pole at z = 1): marginally "
-                    "stable by design"
+                    f"; and {self.integrator} known integrator(s) (pole at "
+                    "z = 1): marginally stable by design"
                     if self.integrator
                     else ""
                 ),
@@ -569,7 +569,7 @@ class Validation:
             "peaks_model_hz": [float(v) for v in self.peaks_model.frequency],
             "modes": self.modes.to_dict(),
             "stable": bool(self.stable),
-            "integrator": bool(self.integrator),
+            "integrator": int(self.integrator),
             "max_pole_radius": float(self.max_pole_radius),
             "realization": self.realization.to_dict(),
             "poles": cplx(self.poles),
@@ -788,8 +788,8 @@ def validate(
     # The one stability verdict (Schur-Cohn on the coefficients, see
     # spiralid.sysid.models.polynomials), not |np.roots| < 1, which misjudges
     # clustered poles near the circle.
-    # Without a known integrator's pole (z = 1), which the model has by
-    # design (`identify(integrator=True)`).
+    # Without the known integrators' poles (z = 1), which the model has by
+    # design (`identify(integrator=...)`).
     denominator = np.asarray(
         getattr(model, "free_denominator", model.theta[: model.arx.na]), dtype=float
     )
@@ -846,7 +846,7 @@ def validate(
         y=y,
         y_sim=y_sim,
         y_pred=y_pred,
-        integrator=bool(getattr(model, "integrator", False)),
+        integrator=int(getattr(model, "integrator", 0)),
         output_name=str(getattr(data, "output_name", "output")),
         output_unit=str(getattr(data, "output_unit", "")),
         initial="rest" if warmup is None else "warmup",
