@@ -86,23 +86,36 @@ class Subproblems:
 
 
 class Archive:
-    """The non-dominated points of every evaluation, thinned by
-    :func:`~spiralid.optim.front.thin_front` to ``2 m`` whenever they
-    exceed ``4 m``.
+    """The non-dominated points of every evaluation offered to it.
 
-    Like every bounded archive it can deteriorate (Laumanns et al., 2002): a
-    point thinned away no longer keeps out a later point it dominates.
+    With a size ``m`` it is bounded: thinned by
+    :func:`~spiralid.optim.front.thin_front` to ``2 m`` whenever it exceeds
+    ``4 m``, and :meth:`final` gives at most ``m`` points evenly spread. Like
+    every bounded archive it can deteriorate (Laumanns et al., 2002): a point
+    thinned away no longer keeps out a later point it dominates. Without
+    ``m`` it keeps every non-dominated point (``identify_pareto``, where each
+    is a candidate model).
+
+    Parameters
+    ----------
+    x, f : array_like, shape (N, n) and (N, k)
+        The first points and their objectives (N may be 0).
+    m : int, optional
+        The population size the bound is reckoned in; None for no bound.
     """
 
-    def __init__(self, x, f, m: int):
+    def __init__(self, x, f, m: int | None = None):
         self.m = m
+        x, f = np.asarray(x, float), np.asarray(f, float)
         keep = non_dominated(f)
         self.x, self.f = x[keep], f[keep]
 
     def add(self, y, fy) -> None:
+        """Offer the points `y` of objectives `fy`."""
         # The archive is non-dominated already: compare the new points among
         # themselves and against it, O(A B) rather than O((A + B)^2). A new
         # point equal to an archived one counts as dominated (the first kept).
+        y, fy = np.asarray(y, float), np.asarray(fy, float)
         fresh = non_dominated(fy)
         y, fy = y[fresh], fy[fresh]
         old, new_f = self.f[:, None, :], fy[None, :, :]
@@ -111,13 +124,15 @@ class Archive:
         dropped = np.any(dominated, axis=1)
         x = np.concatenate([self.x[~dropped], y[~beaten]])
         f = np.concatenate([self.f[~dropped], fy[~beaten]])
-        if f.shape[0] > _ARCHIVE_SLACK * self.m:
+        if self.m is not None and f.shape[0] > _ARCHIVE_SLACK * self.m:
             keep = thin_front(f, 2 * self.m)
             x, f = x[keep], f[keep]
         self.x, self.f = x, f
 
     def final(self) -> tuple[np.ndarray, np.ndarray]:
-        """At most ``m`` points, evenly spread."""
+        """At most ``m`` points, evenly spread (every point without ``m``)."""
+        if self.m is None:
+            return self.x, self.f
         keep = thin_front(self.f, self.m)
         return self.x[keep], self.f[keep]
 

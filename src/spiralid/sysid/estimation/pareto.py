@@ -65,6 +65,7 @@ import numpy as np
 
 from spiralid._checks import generator, integer
 from spiralid.choices import OBJECTIVES
+from spiralid.optim._decomposition import Archive
 from spiralid.optim.pareto import minimize_pareto, non_dominated
 
 from ..data import IOData
@@ -338,23 +339,6 @@ def _candidates(par, cost: PaperCost):
     return plain
 
 
-class _Archive:
-    """The non-dominated set of every iteration's incumbents (a MOEA/D
-    incumbent that a neighbour replaces can still be on the front)."""
-
-    def __init__(self) -> None:
-        self.x: np.ndarray | None = None
-        self.f: np.ndarray | None = None
-
-    def add(self, intermediate) -> bool:
-        x, f = np.asarray(intermediate.x), np.asarray(intermediate.fun)
-        if self.x is not None:
-            x, f = np.concatenate([self.x, x]), np.concatenate([self.f, f])
-        keep = non_dominated(f)
-        self.x, self.f = x[keep], f[keep]
-        return False
-
-
 def _objective_function(par, cost: PaperCost, error: FrequencyError, searched, gain):
     """``x -> (theta, objectives)`` for a population of searched points, the
     columns in the order of `searched`; an unstable candidate pays the
@@ -379,7 +363,7 @@ def _objective_function(par, cost: PaperCost, error: FrequencyError, searched, g
     return evaluate
 
 
-def _polish_extremes(evaluate, archive: _Archive, box: np.ndarray, budget: int):
+def _polish_extremes(evaluate, archive: Archive, box: np.ndarray, budget: int):
     """Each objective's best archived point polished on that objective alone
     by L-BFGS-B in the box (finite-difference gradient, at most `budget`
     evaluations each); returns the polished points and the evaluations."""
@@ -429,7 +413,9 @@ def _search_structure(
     box = par.default_bounds()
     seeds = _seed_thetas(data, arx, par, initial) if seed_estimates else {}
     x0 = np.array([par.from_theta(t) for t in seeds.values()]) if seeds else None
-    archive = _Archive()
+    # Every incumbent is a candidate model: an unbounded archive of them
+    # (minimize_pareto's own, thinned one is not needed).
+    archive = Archive(np.empty((0, box.shape[0])), np.empty((0, len(searched))))
     res = minimize_pareto(
         lambda x: evaluate(x)[1],
         box,
@@ -440,12 +426,11 @@ def _search_structure(
         rng=gen,
         vectorized=True,
         x0=x0,
-        # Every incumbent is a candidate model: this search keeps its own
-        # unbounded archive, so the thinned one is not needed.
         archive=False,
-        callback=archive.add,
+        # A callback's falsy return lets the search go on.
+        callback=lambda now: archive.add(now.x, now.fun),
     )
-    archive.add(res)
+    archive.add(res.x, res.fun)
     run = _StructureRun(arx, res, cost, box, nfev=res.nfev)
     # Seeds first: of exact twins the first is kept, with its origin.
     points = [] if x0 is None else [(np.clip(x0, box[:, 0], box[:, 1]), list(seeds))]
