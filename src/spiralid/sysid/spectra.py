@@ -24,10 +24,12 @@ __all__ = [
     "PSD",
     "Modes",
     "Peaks",
+    "cross_spectra",
     "default_nperseg",
     "find_resonances",
     "modes_from_poles",
     "psd",
+    "segment_length",
 ]
 
 
@@ -132,6 +134,61 @@ def default_nperseg(n: int) -> int:
     return int(min(n, max(pow2, 256)))
 
 
+def segment_length(nperseg, n: int, minimum: int) -> int:
+    """A Welch segment length checked against a record of `n` samples:
+    :func:`default_nperseg` when `nperseg` is None, else an integer in
+    ``[minimum, n]`` (one-line ValueError naming ``nperseg`` otherwise)."""
+    if nperseg is None:
+        return default_nperseg(n)
+    if isinstance(nperseg, bool) or not isinstance(nperseg, int | np.integer):
+        raise ValueError(f"`nperseg` must be an integer; got {nperseg!r}")
+    if not minimum <= nperseg <= n:
+        raise ValueError(
+            f"`nperseg` must be in [{minimum}, N] = [{minimum}, {n}]; got {nperseg!r}"
+        )
+    return int(nperseg)
+
+
+def _welch_options(fs: float, nperseg: int, nfft: int | None = None) -> dict:
+    # The one windowing of every spectrum here: Hann, half overlap, each
+    # segment's mean removed, densities per Hz.
+    return dict(
+        fs=fs,
+        window="hann",
+        nperseg=nperseg,
+        noverlap=nperseg // 2,
+        nfft=nfft,
+        detrend="constant",
+        scaling="density",
+    )
+
+
+def cross_spectra(u, y, fs: float, *, nperseg: int) -> tuple[np.ndarray, ...]:
+    """Welch auto and cross spectra of an input and an output, as :func:`psd`
+    averages them (without its zero padding).
+
+    Parameters
+    ----------
+    u, y : ndarray, shape (N,)
+        Input and output.
+    fs : float
+        Sampling frequency in Hz.
+    nperseg : int
+        Segment length (checked by the caller, e.g. :func:`segment_length`).
+
+    Returns
+    -------
+    f, suu, syy, suy : ndarray
+        Frequencies in Hz, the input's and output's PSDs and the cross
+        spectrum ``conj(U) Y`` (so the H1 estimate is ``suy / suu``).
+    """
+    opts = _welch_options(_check_fs(fs), nperseg)
+    f, suu = signal.welch(u, **opts)
+    _, syy = signal.welch(y, **opts)
+    _, suy = signal.csd(u, y, **opts)
+    return f, suu, syy, suy
+
+
 def psd(x, fs: float, *, nperseg: int | None = None) -> PSD:
     """Welch power spectral density (Hann window, 50 % overlap, mean removed).
 
@@ -162,25 +219,8 @@ def psd(x, fs: float, *, nperseg: int | None = None) -> PSD:
     """
     x = check_signal(x, "x", min_size=2)
     fs = _check_fs(fs)
-    if nperseg is None:
-        nperseg = default_nperseg(x.size)
-    elif isinstance(nperseg, bool) or not isinstance(nperseg, int | np.integer):
-        raise ValueError(f"`nperseg` must be an integer; got {nperseg!r}")
-    elif not 2 <= nperseg <= x.size:
-        raise ValueError(
-            f"`nperseg` must be in [2, N] = [2, {x.size}]; got {nperseg!r}"
-        )
-    nperseg = int(nperseg)
-    f, p = signal.welch(
-        x,
-        fs=fs,
-        window="hann",
-        nperseg=nperseg,
-        noverlap=nperseg // 2,
-        nfft=4 * nperseg,
-        detrend="constant",
-        scaling="density",
-    )
+    nperseg = segment_length(nperseg, x.size, 2)
+    f, p = signal.welch(x, **_welch_options(fs, nperseg, nfft=4 * nperseg))
     return PSD(f=f, p=p, fs=fs, nperseg=nperseg, resolution=fs / nperseg)
 
 

@@ -5,9 +5,10 @@ The measured frequency response is the H1 estimate of the record,
     H1(f) = S_uy(f) / S_uu(f),
 
 with the cross and auto spectra averaged over Welch segments
-(:func:`scipy.signal.csd`, :func:`scipy.signal.welch`; Hann window, half
-overlap, means removed), i.e. the empirical transfer-function estimate
-averaged over segments. Its magnitude-squared coherence
+(:func:`~spiralid.sysid.spectra.cross_spectra`, the Welch averaging of
+:func:`~spiralid.sysid.spectra.psd`: Hann window, half overlap, means
+removed), i.e. the empirical transfer-function estimate averaged over
+segments. Its magnitude-squared coherence
 
     gamma^2(f) = |S_uy|^2 / (S_uu S_yy)
 
@@ -30,13 +31,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal
 
 from spiralid._checks import positive
 
 from ..data import IOData
 from ..models.arx import ARX
-from ..spectra import default_nperseg
+from ..spectra import cross_spectra, segment_length
 
 __all__ = ["FrequencyError", "FrequencyEstimate", "h1_estimate"]
 
@@ -131,14 +131,7 @@ def h1_estimate(
     """
     if not isinstance(data, IOData):
         raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
-    n = data.n
-    if nperseg is None:
-        nperseg = default_nperseg(n)
-    elif isinstance(nperseg, bool) or not isinstance(nperseg, int | np.integer):
-        raise ValueError(f"`nperseg` must be an integer; got {nperseg!r}")
-    elif not 8 <= nperseg <= n:
-        raise ValueError(f"`nperseg` must be in [8, N] = [8, {n}]; got {nperseg!r}")
-    nperseg = int(nperseg)
+    nperseg = segment_length(nperseg, data.n, 8)
     fs = 1.0 / data.ts
     nyquist = fs / 2.0
     lo = fs / nperseg if fmin is None else _frequency(fmin, "fmin", nyquist)
@@ -156,16 +149,7 @@ def h1_estimate(
         raise ValueError(
             f"`min_coherence` must be a number in [0, 1); got {min_coherence!r}"
         )
-    opts = dict(
-        fs=fs,
-        window="hann",
-        nperseg=nperseg,
-        noverlap=nperseg // 2,
-        detrend="constant",
-    )
-    f, suu = signal.welch(data.u, **opts)
-    _, syy = signal.welch(data.y, **opts)
-    _, suy = signal.csd(data.u, data.y, **opts)  # conj(U) Y: H1 = S_uy / S_uu
+    f, suu, syy, suy = cross_spectra(data.u, data.y, fs, nperseg=nperseg)
     with np.errstate(divide="ignore", invalid="ignore"):
         h = suy / suu
         coh = np.abs(suy) ** 2 / (suu * syy)
