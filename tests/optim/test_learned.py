@@ -204,8 +204,8 @@ def test_restarts_alternate_polls_and_population_periods():
 
     regimes = []
 
-    def hook(search):
-        regimes.append(search.regime)
+    def hook(intermediate):
+        regimes.append(intermediate.search.regime)
 
     res = minimize(
         rastrigin,
@@ -214,7 +214,7 @@ def test_restarts_alternate_polls_and_population_periods():
         max_nfev=20_000,
         rng=3,
         restarts=Restarts(),
-        on_iteration=hook,
+        callback=hook,
     )
     assert res.n_restarts >= 2
     assert {"poll", "population"} <= set(regimes)

@@ -8,10 +8,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import Bounds
 
+import spiralid.optim
 from spiralid.optim import (
     ConstantSpiral,
     ExponentialSpiral,
-    SpiralResult,
+    OptimiserResult,
     SpiralRule,
     SpiralSearch,
     minimize,
@@ -301,7 +302,7 @@ def test_callback_receives_results_and_stops():
     seen = []
 
     def cb(intermediate):
-        assert isinstance(intermediate, SpiralResult)
+        assert isinstance(intermediate, OptimiserResult)
         seen.append((intermediate.nit, intermediate.fun, len(intermediate.history)))
         return intermediate.nit == 7
 
@@ -310,6 +311,41 @@ def test_callback_receives_results_and_stops():
     assert [s[2] for s in seen] == list(range(2, 9))
     assert res.nit == 7 and not res.success
     assert res.message == "The callback requested a stop."
+
+
+def test_the_callback_may_move_the_centre_of_the_search_it_is_given():
+    # One hook: the intermediate result carries the live search, so a
+    # callback can polish the centre (the memetic search does) and the
+    # evaluations it reports count toward the budget.
+    moved = []
+
+    def polish(intermediate):
+        search = intermediate.search
+        assert intermediate.nit == search.nit
+        if search.nit == 3:
+            moved.append(search.move_centre(np.zeros(2), 0.0, nfev=5))
+
+    res = minimize(
+        sphere,
+        [(-5, 5)] * 2,
+        "sda",
+        rng=0,
+        vectorized=True,
+        max_iter=4,
+        callback=polish,
+    )
+    assert moved == [True] and res.fun == 0.0
+    assert res.nfev == 50 + 4 * 49 + 5
+
+
+def test_the_removed_hook_and_alias_name_their_replacement():
+    with pytest.raises(TypeError, match=r"^`on_iteration` was removed: use `callback`"):
+        minimize(sphere, [(-5, 5)] * 2, on_iteration=print)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'callbak'"):
+        minimize(sphere, [(-5, 5)] * 2, callbak=print)
+    with pytest.raises(AttributeError, match="returns `OptimiserResult`"):
+        spiralid.optim.SpiralResult  # noqa: B018
+    assert "SpiralResult" not in spiralid.optim.__all__
 
 
 def test_callback_sees_the_iteration_that_reaches_the_target():

@@ -31,7 +31,7 @@ from spiralid.optim.rules import (
     exponential_rule,
     rank_condition,
 )
-from spiralid.optim.spiral import RULES, SpiralResult, SpiralSearch, minimize
+from spiralid.optim.spiral import RULES, SpiralSearch, minimize
 
 __all__ = [
     "RULES",
@@ -46,7 +46,6 @@ __all__ = [
     "OptimiserResult",
     "PeriodicSpiral",
     "Restarts",
-    "SpiralResult",
     "SpiralRule",
     "SpiralSearch",
     "StepRateRule",
@@ -64,3 +63,12 @@ __all__ = [
     "testfunctions",
     "thin_front",
 ]
+
+
+def __getattr__(name: str):
+    # One public name per type: the alias is gone, so say which name to use.
+    if name == "SpiralResult":
+        raise AttributeError(
+            "`SpiralResult` was removed: every optimiser returns `OptimiserResult`"
+        )
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -25,6 +25,7 @@ calls (``step``, ``restart``, ``collapsed``, ``next_step_cost``,
 import math
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -56,7 +57,7 @@ from spiralid.optim.rules import (
     StepRateRule,
 )
 
-__all__ = ["RULES", "SpiralResult", "SpiralSearch", "minimize"]
+__all__ = ["RULES", "SpiralSearch", "minimize"]
 
 _METHODS = {
     "sda": ConstantSpiral,
@@ -74,11 +75,6 @@ require_names(_METHODS, RULE_NAMES, "spiralid.optim.RULES")
 # The rules by name: minimize() accepts them, and spiralid.sysid.identify()
 # offers each as an identification method.
 RULES = _METHODS
-
-
-# minimize's result: the one optimiser result type, under the name the
-# spiral searches have always given it.
-SpiralResult = OptimiserResult
 
 
 def _parse_method(method) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
@@ -423,6 +419,124 @@ def _fixed_rotation(rule: StepRateRule, n: int) -> np.ndarray:
     return R
 
 
+# Keywords minimize() no longer takes, and what replaced each.
+_REMOVED = {
+    "on_iteration": (
+        "`on_iteration` was removed: use `callback`, whose "
+        "`intermediate_result.search` is the search the hook received"
+    ),
+}
+
+
+def _refuse_removed(removed: dict) -> None:
+    """A one-line error for a removed keyword, Python's own for any other."""
+    for name in removed:
+        if name in _REMOVED:
+            raise TypeError(_REMOVED[name])
+        raise TypeError(f"minimize() got an unexpected keyword argument {name!r}")
+
+
+def _target(target) -> float | None:
+    """`target` as a float (None: no target), or a ValueError naming it."""
+    if target is None:
+        return None
+    try:
+        value = float(target)
+    except (TypeError, ValueError):
+        value = math.nan
+    if math.isnan(value):
+        raise ValueError(f"`target` must be a real number or None; got {target!r}")
+    return value
+
+
+@dataclass
+class _Budget:
+    """When :func:`minimize` stops: its caps, time limit and target."""
+
+    max_iter: int
+    n_points: int
+    max_nfev: int | None
+    max_time: float | None
+    target: float | None
+    start: float
+    # A learned-metric period's evaluations, whatever the population; None
+    # for a spiral, whose iteration moves every point but the centre.
+    poll_cost: int | None = None
+
+    @classmethod
+    def check(cls, max_iter, n_points, max_nfev, max_time, target, start):
+        """The budget from minimize's arguments, each checked by name."""
+        max_iter = integer(max_iter, "max_iter", 1)
+        m = integer(n_points, "n_points", 2)
+        if max_nfev is not None:
+            max_nfev = integer(max_nfev, "max_nfev", m)
+        max_time = check_max_time(max_time)
+        return cls(max_iter, m, max_nfev, max_time, _target(target), start)
+
+    def per_step(self, m: int) -> int:
+        """Evaluations an iteration of a population of m points costs."""
+        return m - 1 if self.poll_cost is None else self.poll_cost
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.start
+
+    def iterations_left(self, m: int, nit: int, nfev: int) -> int:
+        """What the budget allows a population of m after nit iterations and
+        nfev evaluations: a step-rate rule's schedule spans it."""
+        left = self.max_iter - nit
+        if self.max_nfev is not None:
+            left = min(left, (self.max_nfev - nfev) // self.per_step(m))
+        return left
+
+    def reached(self, search) -> bool:
+        return self.target is not None and search.fun <= self.target
+
+    def exhausted(self, search) -> str | None:
+        """The cap the next iteration would pass, if any."""
+        if search.nit >= self.max_iter:
+            return "max_iter"
+        if (
+            self.max_nfev is not None
+            and search.nfev + search.next_step_cost() > self.max_nfev
+        ):
+            return "max_nfev"
+        return None
+
+    def after_step(self, search, stop: bool) -> str | None:
+        """Why to stop after an iteration; the target outranks the callback."""
+        if self.reached(search):
+            return "target"
+        if stop:
+            return "callback"
+        if self.max_time is not None and self.elapsed() > self.max_time:
+            return "max_time"
+        return None
+
+
+def _restart(search, restarts: Restarts | None, budget: _Budget) -> bool:
+    """Restart a collapsed run if its grown population can still make
+    ``MIN_ITER`` iterations; whether it did."""
+    if restarts is None or not search.collapsed(restarts):
+        return False
+    grown = restarts.next_size(search.n_points)
+    left = budget.iterations_left(grown, search.nit, search.nfev + grown)
+    if left < MIN_ITER:
+        return False
+    search.restart(grown, max_iter=left)
+    return True
+
+
+def _call_back(callback, search, budget: _Budget) -> bool:
+    """Run the callback on the result so far; whether it asked to stop."""
+    # It sees every iteration, the last one included, so that callers can
+    # time-stamp each entry of `history`.
+    if callback is None:
+        return False
+    intermediate = search.result("running", budget.elapsed())
+    intermediate.search = search
+    return bool(callback(intermediate))
+
+
 def minimize(
     fun: Callable,
     bounds,
@@ -439,7 +553,7 @@ def minimize(
     callback: Callable | None = None,
     bounds_policy: str = "none",
     restarts: bool | Restarts = False,
-    on_iteration: Callable | None = None,
+    **_removed,
 ) -> OptimiserResult:
     """Minimise ``fun`` with a spiral dynamic algorithm (SDA, Eb-SDA, LASDA).
 
@@ -495,7 +609,12 @@ def minimize(
         ``callback(intermediate_result)`` after every iteration (the last
         one included) with the result so far; returning True stops the
         search. If ``target`` is reached in the same iteration, the stop is
-        reported as reaching the target.
+        reported as reaching the target. ``intermediate_result.search`` is
+        the live search (a :class:`SpiralSearch` or
+        :class:`~spiralid.optim.LearnedMetricSearch`): the callback may move
+        its centre (:meth:`SpiralSearch.move_centre`, e.g. a local polish of
+        it, as the memetic identification search does) or restart it; the
+        evaluations it reports there count toward `max_nfev`.
     bounds_policy : {"none", "clip", "reflect"}
         What to do with points that leave the box. The paper has no bound
         handling, so ``"none"`` (the default) lets them go.
@@ -507,13 +626,6 @@ def minimize(
         configurations). A restart happens only if its population can still
         make 10 iterations within the budget. The learned-metric rule
         alternates fresh polls with population periods (see its module).
-    on_iteration : callable, optional
-        ``on_iteration(search)`` with the :class:`SpiralSearch` after every
-        iteration, before `callback`: a hook that may move the centre
-        (:meth:`SpiralSearch.move_centre`, e.g. a local polish of it, as the
-        memetic identification search does); the evaluations it reports
-        there count toward `max_nfev`.
-
     Returns
     -------
     OptimiserResult
@@ -547,45 +659,18 @@ def minimize(
     ('Target cost reached.', True)
     """
     start = time.perf_counter()
-    max_iter = integer(max_iter, "max_iter", 1)
-    m = integer(n_points, "n_points", 2)
-    if max_nfev is not None:
-        max_nfev = integer(max_nfev, "max_nfev", m)
-    max_time = check_max_time(max_time)
-    if target is not None:
-        try:
-            target = float(target)
-        except (TypeError, ValueError):
-            raise ValueError(
-                f"`target` must be a real number or None; got {target!r}"
-            ) from None
-        if math.isnan(target):
-            raise ValueError(f"`target` must be a real number or None; got {target!r}")
+    _refuse_removed(_removed)
+    budget = _Budget.check(max_iter, n_points, max_nfev, max_time, target, start)
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
-    if on_iteration is not None and not callable(on_iteration):
-        raise ValueError(
-            f"`on_iteration` must be callable or None; got {on_iteration!r}"
-        )
     restarts = parse_restarts(restarts)
-
     rule = _parse_method(method)
     n = box_bounds(bounds)[0].size
     learned = isinstance(rule, LearnedMetricSpiral)
+    if learned:
+        budget.poll_cost = rule.poll_cost(n)
     Search = LearnedMetricSearch if learned else SpiralSearch
-
-    def per_step(m: int) -> int:
-        # A step-rate rule's schedule spans the iterations a run can make.
-        return rule.poll_cost(n) if learned else m - 1
-
-    def iterations_left(m: int, nit: int, nfev: int) -> int:
-        # What the budget allows a population of m after nit iterations and
-        # nfev evaluations: a step-rate rule's schedule spans it.
-        left = max_iter - nit
-        if max_nfev is not None:
-            left = min(left, (max_nfev - nfev) // per_step(m))
-        return left
-
+    m = budget.n_points
     search = Search(
         fun,
         bounds,
@@ -595,39 +680,16 @@ def minimize(
         vectorized=vectorized,
         x0=x0,
         bounds_policy=bounds_policy,
-        max_iter=max(iterations_left(m, 0, m), 1),
+        max_iter=max(budget.iterations_left(m, 0, m), 1),
     )
-    status = None
-    if target is not None and search.fun <= target:
-        status = "target"
+    status = "target" if budget.reached(search) else None
     while status is None:
-        if search.nit >= max_iter:
-            status = "max_iter"
+        status = budget.exhausted(search)
+        if status is not None:
             break
-        m = search.n_points
-        if max_nfev is not None and search.nfev + search.next_step_cost() > max_nfev:
-            status = "max_nfev"
-            break
-        if restarts is not None and search.collapsed(restarts):
-            grown = restarts.next_size(m)
-            left = iterations_left(grown, search.nit, search.nfev + grown)
-            if left >= MIN_ITER:
-                search.restart(grown, max_iter=left)
-                if target is not None and search.fun <= target:
-                    status = "target"
-                continue
+        if _restart(search, restarts, budget):
+            status = "target" if budget.reached(search) else None
+            continue
         search.step()
-        if on_iteration is not None:
-            on_iteration(search)
-        # The callback sees every iteration, the last one included, so that
-        # callers can time-stamp each entry of `history`.
-        stop = callback is not None and callback(
-            search.result("running", time.perf_counter() - start)
-        )
-        if target is not None and search.fun <= target:
-            status = "target"
-        elif stop:
-            status = "callback"
-        elif max_time is not None and time.perf_counter() - start > max_time:
-            status = "max_time"
-    return search.result(status, time.perf_counter() - start, target)
+        status = budget.after_step(search, _call_back(callback, search, budget))
+    return search.result(status, budget.elapsed(), budget.target)

@@ -681,9 +681,7 @@ METHODS: dict[str, Method] = {
             partial(_estimate_spiral, rule=name),
             # The rule is the method's own, so a method bound to one rule
             # cannot be re-ruled.
-            options=_keyword_options(
-                minimize, own=("method", "rng", "vectorized", "on_iteration")
-            ),
+            options=_keyword_options(minimize, own=("method", "rng", "vectorized")),
             narx=partial(_narx.estimate_search, rule=name),
         )
         for name in RULES

@@ -102,9 +102,9 @@ def projected_spiral(
 ) -> OptimiserResult:
     """Spiral search over denominator coordinates, numerator projected out.
 
-    :func:`spiralid.optim.minimize` drives the search (its budget and
-    callback); the memetic polish and the restarts are its per-iteration
-    hook.
+    :func:`spiralid.optim.minimize` drives the search (its budget); the
+    memetic polish and the restarts are its callback, which then calls
+    `callback`.
     The settings have no defaults here: the recommended method's are
     :func:`~spiralid.sysid.estimation.estimators._estimate_recommended`'s.
 
@@ -165,8 +165,10 @@ def projected_spiral(
     def fun(z):
         return cost(parametrization.to_denominator(z))
 
-    def after_step(search: SpiralSearch) -> None:
+    def after_step(intermediate) -> bool:
         nonlocal n_polish, stalled, before
+        called = time.perf_counter()
+        search: SpiralSearch = intermediate.search
         due = polish_every and search.nit % polish_every == 0
         if due and search.nfev + polish_nfev <= max_nfev:
             res = gauss_newton_polish(cost, parametrization, search.centre, polish_nfev)
@@ -180,6 +182,14 @@ def projected_spiral(
             if search.nfev + 2 * n_points - 1 <= max_nfev:
                 search.restart(n_points)
                 stalled = 0
+        if callback is None:
+            return False
+        # The caller's callback sees the search after the polish and restart.
+        now = search.result(
+            "running", intermediate.elapsed + time.perf_counter() - called
+        )
+        now.search = search
+        return callback(now)
 
     res = minimize(
         fun,
@@ -191,9 +201,8 @@ def projected_spiral(
         rng=rng,
         vectorized=True,
         x0=x0,
-        callback=callback,
+        callback=after_step,
         bounds_policy="clip",
-        on_iteration=after_step,
     )
     z, nfev = res.x, res.nfev
     if polish_every and res.status != 0 and nfev + polish_nfev <= max_nfev:

@@ -420,7 +420,7 @@ def plot_convergence(
     ----------
     histories : mapping of str to history or list of histories
         A history is the best cost after each iteration, index 0 the initial
-        population (``SpiralResult.history``); a result object with a
+        population (``OptimiserResult.history``); a result object with a
         ``history`` attribute is accepted in its place. Histories of one method
         may differ in length; the statistics at an iteration use the runs that
         reached it.
