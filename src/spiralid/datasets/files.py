@@ -7,19 +7,10 @@ go through, so a file that one of them reads, all of them read the same way.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
-from spiralid.sysid.data import (
-    IOData,
-    NoSampleTimeError,
-    _csv_column,
-    _csv_lookup,
-    _csv_table,
-)
+from spiralid.sysid.data import IOData, _csv_table
 
 __all__ = ["read_record"]
 
@@ -88,42 +79,20 @@ def read_record(
                 f"`input` and `output` must be variable names for {suffix} files"
             )
         loader = IOData.from_npz if suffix == ".npz" else IOData.from_mat
-        try:
-            return loader(file, input=input, output=output, ts=ts)
-        except NoSampleTimeError:
-            if default_ts is None:
-                raise
-            # The file carries no `ts`: fall back to the caller's default.
-            return loader(file, input=input, output=output, ts=default_ts)
+        return loader(file, input=input, output=output, ts=ts, default_ts=default_ts)
     raise ValueError(f"data file {str(source)!r} must end in .csv, .npz or .mat")
 
 
 def _read_csv(file: Path, input, output, ts, default_ts) -> IOData:
+    """IOData's CSV reader on a table read once, with the column names and
+    units of a file that ``spiralid simulate`` wrote."""
     header, rows = _csv_table(file)
-    header = header or []
-    written_by_us = "torque_Nm" in header
+    written_by_us = "torque_Nm" in (header or [])
     if input is None:
         input = "torque_Nm" if written_by_us else "u"
     if output is None:
         output = "end_acceleration_m_s2" if written_by_us else "y"
-    time = _csv_lookup(header, "time_s", repr(str(file)))
-    ts_file = None if time is None else _csv_sample_time(file, rows, time)
-    if (
-        ts is not None
-        and ts_file is not None
-        and not math.isclose(ts, ts_file, rel_tol=1e-5, abs_tol=1e-8)
-    ):
-        raise ValueError(
-            f"`ts` {ts:g} contradicts the time_s column of {str(file)!r} (steps "
-            f"of {ts_file:g} s); leave `ts` out or correct the file"
-        )
-    ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
-    if ts is None:
-        raise ValueError(
-            f"`ts` is required for {str(file)!r}: a CSV file carries no sample "
-            "time (or give a 'time_s' column)"
-        )
-    data = IOData.from_csv(file, input=input, output=output, ts=ts)
+    data = IOData._from_table(header, rows, input, output, ts, default_ts, file)
     if written_by_us:
         data = replace(
             data,
@@ -131,32 +100,3 @@ def _read_csv(file: Path, input, output, ts, default_ts) -> IOData:
             output_unit=SIMULATE_UNITS.get(data.output_name, data.output_unit),
         )
     return data
-
-
-def _csv_sample_time(file: Path, rows: list, j: int) -> float:
-    """The step of the evenly spaced ``time_s`` column `j` of `rows`.
-
-    Every way the column can fail is said of the column, not of ``--ts``
-    (which the user did not give) or of IOData's `ts` it would become."""
-    where = f"the time_s column of {str(file)!r}"
-    t = _csv_column(rows, j, "time_s", repr(str(file)))
-    if t.size < 2:
-        raise ValueError(f"{where} needs at least 2 samples to give a sample time")
-    bad = ~np.isfinite(t)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise ValueError(
-            f"{where} must be finite; got {float(t[i])!r} on line {rows[i][0]}"
-        )
-    steps = np.diff(t)
-    back = steps <= 0
-    if back.any():
-        i = int(np.argmax(back))
-        raise ValueError(
-            f"{where} must increase from sample to sample; it goes from "
-            # + 0.0: a -0.0 says "0".
-            f"{t[i] + 0.0:g} to {t[i + 1] + 0.0:g} s on line {rows[i + 1][0]}"
-        )
-    if not np.allclose(steps, steps[0], rtol=1e-6):
-        raise ValueError(f"{where} is not evenly spaced")
-    return float(steps.mean())

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import codecs
 import csv
+import math
 import os
 from dataclasses import dataclass, field
 
@@ -301,8 +302,10 @@ class IOData:
         output: str | int = "y",
         ts: float | None = None,
         delimiter: str = ",",
+        *,
+        default_ts: float | None = None,
     ) -> IOData:
-        """Read two columns of a delimited text file.
+        """Read two columns of a delimited text file (opened once).
 
         Parameters
         ----------
@@ -313,18 +316,39 @@ class IOData:
         may carry units as ``name [unit]`` or ``name (unit)``; the column is
         then named by either the whole header or ``name``, and the unit goes
         to ``input_unit`` / ``output_unit``.
-        ts : float
-            Sample time in seconds; required, as a CSV file carries none.
+        ts : float, optional
+            Sample time in seconds; default the step of an evenly spaced
+            ``time_s`` column, else `default_ts`.
         delimiter : str
             Field separator.
+        default_ts : float, optional
+            The sample time when neither `ts` nor a ``time_s`` column gives
+            one (:class:`NoSampleTimeError` when none does).
         """
-        if ts is None:
-            raise ValueError(
-                "`ts` must be given for a CSV file (the sample time in seconds); "
-                "got None"
-            )
-        where = repr(str(path))
         header, rows = _csv_table(path, delimiter)
+        return cls._from_table(header, rows, input, output, ts, default_ts, path)
+
+    @classmethod
+    def _from_table(cls, header, rows, input, output, ts, default_ts, path) -> IOData:
+        """:meth:`from_csv` on a table :func:`_csv_table` has read."""
+        where = repr(str(path))
+        time = None if header is None else _csv_lookup(header, "time_s", where)
+        ts_file = None if time is None else _csv_sample_time(where, rows, time)
+        if (
+            ts is not None
+            and ts_file is not None
+            and not math.isclose(ts, ts_file, rel_tol=1e-5, abs_tol=1e-8)
+        ):
+            raise ValueError(
+                f"`ts` {ts:g} contradicts the time_s column of {where} (steps "
+                f"of {ts_file:g} s); leave `ts` out or correct the file"
+            )
+        ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
+        if ts is None:
+            raise NoSampleTimeError(
+                f"`ts` is required for {where}: a CSV file carries no sample "
+                "time (or give a 'time_s' column)"
+            )
         ncol = len(header) if header is not None else len(rows[0][1])
 
         def column(key, argname):
@@ -368,10 +392,13 @@ class IOData:
         input: str = "u",
         output: str = "y",
         ts: float | None = None,
+        *,
+        default_ts: float | None = None,
     ) -> IOData:
         """Read arrays from a NumPy ``.npz`` archive (never unpickles objects).
 
-        ``ts=None`` reads the sample time from a scalar array named ``ts``.
+        ``ts=None`` reads the sample time from a scalar array named ``ts``,
+        else takes `default_ts`.
         """
         try:
             with open(path, "rb") as fh:
@@ -400,7 +427,7 @@ class IOData:
             raise ValueError(
                 f"{str(path)!r} is not a readable .npz file ({exc})"
             ) from None
-        return cls._from_mapping(mapping, input, output, ts, path)
+        return cls._from_mapping(mapping, input, output, ts, path, default_ts)
 
     @classmethod
     def from_mat(
@@ -409,10 +436,13 @@ class IOData:
         input: str = "u",
         output: str = "y",
         ts: float | None = None,
+        *,
+        default_ts: float | None = None,
     ) -> IOData:
         """Read variables from a MATLAB ``.mat`` file (``scipy.io.loadmat``).
 
-        ``ts=None`` reads the sample time from a scalar variable named ``ts``.
+        ``ts=None`` reads the sample time from a scalar variable named ``ts``,
+        else takes `default_ts`.
         """
         from scipy.io import loadmat
         from scipy.io.matlab import MatReadError
@@ -445,16 +475,18 @@ class IOData:
                 f"{where} is not a readable .mat file (it is truncated or corrupt)"
             ) from None
         mat = {k: v for k, v in raw.items() if not k.startswith("__")}
-        return cls._from_mapping(mat, input, output, ts, path)
+        return cls._from_mapping(mat, input, output, ts, path, default_ts)
 
     @classmethod
-    def _from_mapping(cls, mapping, input, output, ts, path) -> IOData:
+    def _from_mapping(cls, mapping, input, output, ts, path, default_ts) -> IOData:
         names = sorted(mapping)
         for key, arg in ((input, "input"), (output, "output")):
             if key not in mapping:
                 raise ValueError(
                     f"`{arg}` must be one of the variables {names}; got {key!r}"
                 )
+        if ts is None and "ts" not in mapping and default_ts is not None:
+            ts = default_ts
         if ts is None:
             if "ts" not in mapping:
                 raise NoSampleTimeError(
@@ -505,6 +537,35 @@ def _csv_table(path, delimiter: str = ",") -> tuple[list[str] | None, list]:
         header = [c.strip() for c in rows[0][1]]
         rows = rows[1:]
     return header, rows
+
+
+def _csv_sample_time(where: str, rows: list, j: int) -> float:
+    """The step of the evenly spaced ``time_s`` column `j` of `rows`.
+
+    Every way the column can fail is said of the column, not of ``--ts``
+    (which the user did not give) or of IOData's `ts` it would become."""
+    what = f"the time_s column of {where}"
+    t = _csv_column(rows, j, "time_s", where)
+    if t.size < 2:
+        raise ValueError(f"{what} needs at least 2 samples to give a sample time")
+    bad = ~np.isfinite(t)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"{what} must be finite; got {float(t[i])!r} on line {rows[i][0]}"
+        )
+    steps = np.diff(t)
+    back = steps <= 0
+    if back.any():
+        i = int(np.argmax(back))
+        raise ValueError(
+            f"{what} must increase from sample to sample; it goes from "
+            # + 0.0: a -0.0 says "0".
+            f"{t[i] + 0.0:g} to {t[i + 1] + 0.0:g} s on line {rows[i + 1][0]}"
+        )
+    if not np.allclose(steps, steps[0], rtol=1e-6):
+        raise ValueError(f"{what} is not evenly spaced")
+    return float(steps.mean())
 
 
 def _csv_lookup(header: list[str], key, where: str, argname: str = "") -> int | None:
