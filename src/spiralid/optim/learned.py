@@ -55,24 +55,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid._checks import box_bounds, generator, integer, positive
+from spiralid._checks import integer, positive
 from spiralid.optim._loop import (
     Trace,
     apply_bounds,
     check_costs,
-    check_objective,
-    check_policy,
     point_in_box,
     seed_points,
     stop_report,
 )
+from spiralid.optim._search import _SCALAR, SearchBase
 from spiralid.optim.encoding import AdaptiveEncoding
 from spiralid.optim.restarts import Restarts
 from spiralid.optim.result import OptimiserResult
 
 __all__ = ["LearnedMetricSearch", "LearnedMetricSpiral"]
 
-_SCALAR = "a scalar when vectorized=False (pass vectorized=True for batches)"
 # A basis conditioned beyond this has lost the directions it learned to
 # rounding; the run counts as collapsed.
 _MAX_CONDITION = 1e14
@@ -153,7 +151,7 @@ def default_population(n: int) -> int:
     return 2 * (4 + int(3.0 * math.log(n)))
 
 
-class LearnedMetricSearch:
+class LearnedMetricSearch(SearchBase):
     """The learned-metric search you can step yourself;
     :func:`~spiralid.optim.minimize` drives one for a
     :class:`LearnedMetricSpiral`.
@@ -186,23 +184,22 @@ class LearnedMetricSearch:
         bounds_policy: str = "none",
         max_iter: int | None = None,
     ):
-        self.vectorized = check_objective(fun, vectorized)
+        super().__init__(
+            fun,
+            bounds,
+            rng=rng,
+            vectorized=vectorized,
+            bounds_policy=bounds_policy,
+            max_iter=max_iter,
+        )
         if not isinstance(method, LearnedMetricSpiral):
             raise ValueError(f"`method` must be a LearnedMetricSpiral; got {method!r}")
-        self._fun = fun
         self.rule = method
-        self._lo, self._hi = box_bounds(bounds)
         self._width = self._hi - self._lo
-        self.bounds_policy = check_policy(bounds_policy)
-        self._rng = generator(rng)
-        self._k_max = None if max_iter is None else integer(max_iter, "max_iter", 1)
         if not method.success_steps and self._k_max is None:
             raise ValueError("`max_iter` is required when success_steps=False")
         n = self._lo.size
         m = integer(n_points, "n_points", 1)
-        self.nfev = 0
-        self.nit = 0
-        self.restarts = 0
         self._best = (None, math.inf)
         self._spent = {"poll": 0, "population": 0}
         self._population = default_population(n) // 2
@@ -216,15 +213,8 @@ class LearnedMetricSearch:
     # -- evaluation ----------------------------------------------------------
     def _evaluate(self, x: np.ndarray) -> np.ndarray:
         """Costs of the rows of `x`, non-finite as inf; keeps the best."""
-        k = x.shape[0]
-        if self.vectorized:
-            out = check_costs(self._fun(x.copy()), (k,), self._batch_shape(x))
-            out = np.array(out, np.float64)
-        else:
-            out = np.empty(k)
-            for i in range(k):
-                out[i] = check_costs(self._fun(x[i].copy()), (), _SCALAR)
-        self.nfev += k
+        out = self._costs(x)
+        self.nfev += x.shape[0]
         out[~np.isfinite(out)] = math.inf
         best = int(np.argmin(out))
         if out[best] < self._best[1] or self._best[0] is None:
@@ -247,19 +237,11 @@ class LearnedMetricSearch:
             self._best = (pair[0 if a <= b else 1].copy(), min(a, b))
         return a, b
 
-    @staticmethod
-    def _batch_shape(x: np.ndarray) -> str:
-        k, n = x.shape
-        return f"shape ({k},) for a ({k}, {n}) batch when vectorized=True"
-
     # -- runs ------------------------------------------------------------------
     def _start_poll(self, seeds: np.ndarray, m: int) -> None:
         """Start a poll from the best of `m` points (`seeds` first)."""
         n = self._lo.size
-        x = np.empty((m, n))
-        k = seeds.shape[0]
-        x[:k] = seeds
-        x[k:] = self._rng.uniform(self._lo, self._hi, size=(m - k, n))
+        x = self._draw(seeds, m)
         f = self._evaluate(x)
         best = int(np.argmin(f))  # the first of equal costs, a seed if any
         self._c = x[best].copy()
@@ -295,8 +277,7 @@ class LearnedMetricSearch:
         those have spent fewer evaluations; the best point so far stays
         :attr:`x`."""
         m = integer(n_points, "n_points", 1)
-        if max_iter is not None:
-            self._k_max = integer(max_iter, "max_iter", 1)
+        self._set_budget(max_iter)
         self._spent[self._regime] += self.nfev - self._run_nfev
         if self.rule.populations and self._spent["population"] <= self._spent["poll"]:
             self._population *= 2

@@ -29,20 +29,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid._checks import box_bounds, generator, integer, real_array
+from spiralid._checks import box_bounds, integer, real_array
 from spiralid.choices import RULE_NAMES, require_names
 from spiralid.optim import _kernels
 from spiralid.optim._loop import (
     apply_bounds,
-    check_costs,
     check_max_time,
-    check_objective,
-    check_policy,
     finite_or_inf,
     point_in_box,
     seed_points,
     stop_report,
 )
+from spiralid.optim._search import SearchBase
 from spiralid.optim.learned import LearnedMetricSearch, LearnedMetricSpiral
 from spiralid.optim.restarts import MIN_ITER, Restarts, parse_restarts
 from spiralid.optim.result import OptimiserResult
@@ -111,7 +109,7 @@ def _rule_output(out, k: int) -> tuple:
     return tuple(checked)
 
 
-class SpiralSearch:
+class SpiralSearch(SearchBase):
     """A spiral search you can step yourself; :func:`minimize` drives one.
 
     Constructing it draws the initial population and evaluates it
@@ -151,9 +149,14 @@ class SpiralSearch:
         bounds_policy: str = "none",
         max_iter: int | None = None,
     ):
-        self.vectorized = check_objective(fun, vectorized)
-        self._fun = fun
-        self._lo, self._hi = box_bounds(bounds)
+        super().__init__(
+            fun,
+            bounds,
+            rng=rng,
+            vectorized=vectorized,
+            bounds_policy=bounds_policy,
+            max_iter=max_iter,
+        )
         self.rule = _parse_method(method)
         if isinstance(self.rule, LearnedMetricSpiral):
             raise ValueError(
@@ -162,10 +165,8 @@ class SpiralSearch:
             )
         self._builtin_rule = type(self.rule) in _BUILTIN
         m = integer(n_points, "n_points", 2)
-        self.bounds_policy = check_policy(bounds_policy)
         n = self._lo.size
         seeds = seed_points(x0, self._lo, self._hi, m)
-        self._rng = generator(rng)
         self._planes = _sweep_order(n)
         self._matrix = (None, None)
         self._fixed = None
@@ -176,10 +177,6 @@ class SpiralSearch:
                     f"step-rate rule such as {type(self.rule).__name__}"
                 )
             self._fixed = _fixed_rotation(self.rule, n)
-        self._k_max = None if max_iter is None else integer(max_iter, "max_iter", 1)
-        self.nfev = 0
-        self.nit = 0
-        self.restarts = 0
         # The best of earlier runs (restarts), as (x, f); row 0 is this run's.
         self._archive = (None, math.inf)
         self._populate(seeds, m)
@@ -190,12 +187,7 @@ class SpiralSearch:
 
     def _populate(self, seeds: np.ndarray, m: int) -> None:
         """Draw and evaluate a new run's population; ``seeds`` come first."""
-        n = self._lo.size
-        x = np.empty((m, n))
-        k = seeds.shape[0]
-        x[:k] = seeds
-        x[k:] = self._rng.uniform(self._lo, self._hi, size=(m - k, n))
-        self._x = x
+        self._x = x = self._draw(seeds, m)
         self._f = self._evaluate(x)
         self.nfev += m
         self._promote()
@@ -211,8 +203,7 @@ class SpiralSearch:
         the new run's iteration budget for step-rate rules.
         """
         m = integer(n_points, "n_points", 2)
-        if max_iter is not None:
-            self._k_max = integer(max_iter, "max_iter", 1)
+        self._set_budget(max_iter)
         f0 = float(self._f[0])
         if math.isfinite(f0) and f0 < self._archive[1]:
             self._archive = (self._x[0].copy(), f0)
@@ -221,19 +212,7 @@ class SpiralSearch:
         self.history.append(self._best_cost())
 
     def _evaluate(self, pts: np.ndarray) -> np.ndarray:
-        k = pts.shape[0]
-        if self.vectorized:
-            what = (
-                f"shape ({k},) for a ({k}, {pts.shape[1]}) batch when vectorized=True"
-            )
-            # A copy: the search reorders its costs in place, and the caller
-            # may keep the array it returned.
-            return np.array(check_costs(self._fun(pts.copy()), (k,), what), np.float64)
-        what = "a scalar when vectorized=False (pass vectorized=True for batches)"
-        out = np.empty(k)
-        for i in range(k):
-            out[i] = check_costs(self._fun(pts[i].copy()), (), what)
-        return out
+        return self._costs(pts)
 
     def _promote(self) -> None:
         """Move the best finite point to row 0 (ties keep the incumbent)."""
@@ -338,12 +317,6 @@ class SpiralSearch:
         self.last_move = self.nit
         self.history[-1] = self._best_cost()
         return True
-
-    def __iter__(self):
-        return self
-
-    def __next__(self) -> tuple[np.ndarray, float]:
-        return self.step()
 
     @property
     def x(self) -> np.ndarray:
