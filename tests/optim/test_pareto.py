@@ -284,3 +284,50 @@ def test_learned_metric_poll_finds_the_segment_between_two_rotated_minima():
 def test_archive_must_be_a_bool():
     with pytest.raises(ValueError, match="`archive` must be True or False"):
         minimize_pareto(_zdt1, [(0, 1)] * 2, n_points=10, max_nfev=40, archive=1)
+
+
+@pytest.mark.parametrize("option", ["populations", "model_step", "success_steps"])
+def test_single_objective_options_of_the_learned_metric_rule_are_refused(option):
+    rule = LearnedMetricSpiral(**{option: False})
+    with pytest.raises(ValueError) as refused:
+        minimize_pareto(_zdt1, [(0, 1)] * 2, rule, n_points=10, max_nfev=40)
+    message = str(refused.value)
+    assert message.startswith(f"`{option}` of LearnedMetricSpiral does not apply")
+    assert "minimize_pareto" in message and "basis, grow and shrink" in message
+    # The options that apply are taken, and a default passed by value is
+    # the default.
+    rule = LearnedMetricSpiral(basis=False, grow=3.0, **{option: True})
+    minimize_pareto(_zdt1, [(0, 1)] * 2, rule, n_points=10, max_nfev=40, rng=0,
+                    vectorized=True)  # fmt: skip
+
+
+def test_arguments_and_the_objective_count_are_checked_before_spending():
+    calls = []
+
+    def four(x):
+        calls.append(x)
+        return [x[0], 1 - x[0], 0.0, 0.0]
+
+    with pytest.raises(ValueError, match="`ref_point` must be a finite vector"):
+        minimize_pareto(four, [(0, 1)] * 2, n_points=10, ref_point=[1.0] * 4)
+    assert calls == []
+    with pytest.raises(ValueError, match="2 or 3 objectives; got 4"):
+        minimize_pareto(four, [(0, 1)] * 2, n_points=10, max_nfev=40, rng=0)
+    assert len(calls) == 1  # one point, not the whole population
+    with pytest.raises(ValueError, match="finite vector of length 2; got"):
+        minimize_pareto(_zdt1, [(0, 1)] * 2, n_points=10, ref_point=[1, 1, 1],
+                        vectorized=True)  # fmt: skip
+
+
+def test_nfev_counts_every_evaluation_with_three_objectives():
+    # 100 points draw 100 evaluations, for 91 subproblems.
+    seen = []
+
+    def three(x):
+        seen.append(x.shape[0])
+        return np.c_[x[:, 0], 1 - x[:, 0], x[:, 1]]
+
+    res = minimize_pareto(three, [(0, 1)] * 3, n_points=100, max_nfev=400,
+                          rng=0, vectorized=True)  # fmt: skip
+    assert seen[0] == 100 and res.weights.shape[0] == 91
+    assert res.nfev == sum(seen) <= 400

@@ -46,7 +46,7 @@ from spiralid.optim._decomposition import (
     SpiralMoves,
     Subproblems,
 )
-from spiralid.optim._loop import STOPS, check_max_time, check_objective
+from spiralid.optim._loop import STATUS_CODE, STOPS, check_max_time, check_objective
 from spiralid.optim.front import (
     hypervolume,
     non_dominated,
@@ -68,19 +68,25 @@ __all__ = [
 ]
 
 
+def _point_wise(fun, x: np.ndarray, k: int | None) -> np.ndarray:
+    """The objective vectors of `fun` called on each row of `x` in turn,
+    every one of the same length (`k` when known)."""
+    rows = [np.asarray(fun(row.copy()), dtype=float) for row in x]
+    shapes = {r.shape for r in rows} | ({(k,)} if k is not None else set())
+    if len(shapes) != 1:
+        raise ValueError(
+            "`fun` must return the same number of objectives for every "
+            f"point; got shapes {sorted(shapes)}"
+        )
+    return np.array(rows)
+
+
 def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray:
     """The objective vectors of the rows of `x`, checked: (m, k), finite."""
     if vectorized:
         f = np.asarray(fun(x.copy()), dtype=float)
     else:
-        rows = [np.asarray(fun(row.copy()), dtype=float) for row in x]
-        shapes = {r.shape for r in rows}
-        if len(shapes) != 1:
-            raise ValueError(
-                "`fun` must return the same number of objectives for every "
-                f"point; got shapes {sorted(shapes)}"
-            )
-        f = np.array(rows)
+        f = _point_wise(fun, x, k)
     if f.ndim != 2 or f.shape[0] != x.shape[0] or (k is not None and f.shape[1] != k):
         want = f"({x.shape[0]}, {'k' if k is None else k})"
         raise ValueError(
@@ -96,6 +102,13 @@ def _evaluate(fun, x: np.ndarray, vectorized: bool, k: int | None) -> np.ndarray
     return f
 
 
+# The learned-metric options that belong to the single-objective search (its
+# model step, its population periods, its step schedule without success
+# steps): the poll per subproblem has no counterpart, so they are refused
+# rather than ignored. Only `basis`, `grow` and `shrink` apply.
+_SINGLE_OBJECTIVE_ONLY = ("populations", "model_step", "success_steps")
+
+
 def _parse_rule(method) -> SpiralRule | LearnedMetricSpiral:
     # A name is checked against the Pareto rules first: the single-objective
     # list (with the step-rate rules) would offer names refused here.
@@ -106,6 +119,15 @@ def _parse_rule(method) -> SpiralRule | LearnedMetricSpiral:
             f"`method` must be one of {', '.join(PARETO_METHODS)}, a SpiralRule "
             f"or a LearnedMetricSpiral; got {method!r}"
         )
+    if isinstance(rule, LearnedMetricSpiral):
+        default = LearnedMetricSpiral()
+        for name in _SINGLE_OBJECTIVE_ONLY:
+            if getattr(rule, name) != getattr(default, name):
+                raise ValueError(
+                    f"`{name}` of LearnedMetricSpiral does not apply to "
+                    "minimize_pareto (only basis, grow and shrink do); got "
+                    f"{name}={getattr(rule, name)!r}"
+                )
     return rule
 
 
@@ -139,17 +161,48 @@ def _initial_points(gen, lo, hi, m: int, x0) -> np.ndarray:
     return x
 
 
-def _reference_point(ref_point, f: np.ndarray) -> np.ndarray:
-    k = f.shape[1]
+def _check_ref_point(ref_point, k: int | None = None) -> np.ndarray | None:
+    """`ref_point` as a finite vector of length `k` (2 or 3 before the
+    objective count is known), or a ValueError naming it."""
     if ref_point is None:
-        spread = f.max(axis=0) - f.min(axis=0)
-        return f.max(axis=0) + 0.1 * np.where(spread > 0, spread, 1.0)
-    ref = np.asarray(ref_point, dtype=float)
+        return None
+    try:
+        ref = np.asarray(ref_point, dtype=float)
+    except (TypeError, ValueError):
+        ref = np.full(0, np.nan)
+    if k is None and ref.shape in ((2,), (3,)):
+        k = ref.size
     if ref.shape != (k,) or not np.all(np.isfinite(ref)):
+        length = "2 or 3" if k is None else k
         raise ValueError(
-            f"`ref_point` must be a finite vector of length {k}; got {ref_point!r}"
+            f"`ref_point` must be a finite vector of length {length}; got {ref_point!r}"
         )
     return ref
+
+
+def _reference_point(ref: np.ndarray | None, f: np.ndarray) -> np.ndarray:
+    """The hypervolume's reference point: `ref`, checked against the
+    objective count, or the initial population's worst plus a tenth of its
+    range."""
+    if ref is not None:
+        return _check_ref_point(ref, f.shape[1])
+    spread = f.max(axis=0) - f.min(axis=0)
+    return f.max(axis=0) + 0.1 * np.where(spread > 0, spread, 1.0)
+
+
+def _first_population(fun, x: np.ndarray, vectorized: bool) -> np.ndarray:
+    """The initial population's objective vectors, the objective count
+    checked as soon as it is known: after the first point when `fun` takes
+    one point at a time (no evaluation is spent on the rest), after the one
+    call when it takes a batch."""
+    first = x if vectorized else x[:1]
+    f = _evaluate(fun, first, vectorized, None)
+    k = f.shape[1]
+    if k not in (2, 3):
+        raise ValueError(f"`fun` must return 2 or 3 objectives; got {k}")
+    if vectorized:
+        return f
+    return np.vstack([f, _evaluate(fun, x[1:], vectorized, k)])
 
 
 def minimize_pareto(
@@ -176,6 +229,9 @@ def minimize_pareto(
         ``fun(x) -> (k,)`` objective values to minimise for ``x`` of shape
         (n,), or with ``vectorized=True`` ``fun(X) -> (m, k)`` for ``X`` of
         shape (m, n); ``k`` is 2 or 3. A non-finite value is an error.
+        Every other argument is checked before `fun` is first called, and
+        ``k`` as soon as it returns: after one point, or after the first
+        batch when vectorised.
     bounds : sequence of (low, high), (n, 2) array or scipy.optimize.Bounds
         The search box; points are kept inside it.
     method : str, SpiralRule or LearnedMetricSpiral
@@ -183,11 +239,18 @@ def minimize_pareto(
         spiral rule (see :func:`spiralid.optim.minimize`), with the paper's
         constants; ``"learned-metric"`` polls a pair of directions
         per subproblem with a step per direction from success (its
-        ``basis``, ``grow`` and ``shrink`` options apply; the others belong
-        to the single-objective search).
+        ``basis``, ``grow`` and ``shrink`` options apply; ``populations``,
+        ``model_step`` and ``success_steps`` belong to the single-objective
+        search, and a rule that turns one off is refused).
     n_points : int
         Population size: one subproblem each (for 3 objectives the largest
         simplex lattice that fits), and the most points the result holds.
+        Default 100, twice :func:`~spiralid.optim.minimize`'s 50, because
+        it is also the front's resolution: 100 is MOEA/D's population for
+        two objectives (Zhang and Li 2007) and gives 91 subproblems for
+        three. With the default budget that is 100 iterations, as
+        :func:`~spiralid.sysid.identify_pareto`'s 50 points make with its
+        5,000 evaluations.
     max_nfev : int
         Budget of objective evaluations (at least two populations).
     max_time : float, optional
@@ -230,6 +293,8 @@ def minimize_pareto(
         when the budget ended it, 3 the time limit, 0 the callback),
         ``message``, ``nit``, ``nfev``,
         ``n_restarts`` (points, or polls, started again), ``elapsed``.
+        ``nfev`` counts every evaluation, the initial population's included
+        (with 3 objectives more points than subproblems may be drawn).
 
     Examples
     --------
@@ -254,64 +319,92 @@ def minimize_pareto(
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
     vectorized = check_objective(fun, vectorized)
+    ref = _check_ref_point(ref_point)
 
     x = _initial_points(gen, lo, hi, m, x0)
-    f = _evaluate(fun, x, vectorized, None)
-    k = f.shape[1]
-    if k not in (2, 3):
-        raise ValueError(f"`fun` must return 2 or 3 objectives; got {k}")
-    sub = Subproblems(k, m, neighbours, x, f)
-    m = sub.size
-    nfev = m
-    ref = _reference_point(ref_point, sub.f)
-    store = Archive(sub.x, sub.f, m) if archive else None
-    if isinstance(rule, LearnedMetricSpiral):
-        moves = PollMoves(rule, sub, lo, hi, gen)
-    else:
-        moves = SpiralMoves(rule, sub, lo, hi)
-
-    def incumbents() -> tuple[np.ndarray, np.ndarray]:
-        keep = non_dominated(sub.f)
-        return sub.x[keep], sub.f[keep]
-
-    def front() -> tuple[np.ndarray, np.ndarray]:
-        return (store.x, store.f) if store is not None else incumbents()
-
-    history = [hypervolume(front()[1], ref)]
-    nit, status = 0, 1
-    while nfev + moves.batch <= max_nfev:
-        y = moves.propose(sub, gen)
-        fy = _evaluate(fun, y, vectorized, k)
-        nfev += y.shape[0]
-        nit += 1
-        sub.see(fy)
-        moves.learn(sub, y, fy)
-        sub.offer(y, fy, moves.owners, gen)
-        if store is not None:
-            store.add(y, fy)
-        history.append(hypervolume(front()[1], ref))
-        if callback is not None:
-            x_now, f_now = incumbents()
-            if callback(OptimiserResult(x=x_now, fun=f_now, nit=nit)):
-                status = 0
-                break
-        if max_time is not None and time.perf_counter() - t_start > max_time:
-            status = 3
-            break
-    x_front, f_front = store.final() if store is not None else front()
+    f = _first_population(fun, x, vectorized)
+    sub = Subproblems(f.shape[1], m, neighbours, x, f)
+    search = _Search(
+        fun,
+        vectorized,
+        sub,
+        _moves(rule, sub, lo, hi, gen),
+        Archive(sub.x, sub.f, sub.size) if archive else None,
+        _reference_point(ref, sub.f),
+        nfev=x.shape[0],
+    )
+    status = search.run(gen, max_nfev, max_time, callback, t_start)
+    x_front, f_front = search.final()
     return OptimiserResult(
         x=x_front,
         fun=f_front,
         population=sub.x,
         population_fun=sub.f,
         weights=sub.weights,
-        ref_point=ref,
-        status=status,
+        ref_point=search.ref,
+        status=STATUS_CODE[status],
         success=True,
-        message=STOPS[{0: "callback", 1: "max_nfev", 3: "max_time"}[status]],
-        nit=nit,
-        nfev=nfev,
-        n_restarts=moves.n_restarts,
-        history=np.asarray(history),
+        message=STOPS[status],
+        nit=search.nit,
+        nfev=search.nfev,
+        n_restarts=search.moves.n_restarts,
+        history=np.asarray(search.history),
         elapsed=time.perf_counter() - t_start,
     )
+
+
+def _moves(rule, sub: Subproblems, lo, hi, gen) -> PollMoves | SpiralMoves:
+    """How the rule proposes each subproblem's next point."""
+    if isinstance(rule, LearnedMetricSpiral):
+        return PollMoves(rule, sub, lo, hi, gen)
+    return SpiralMoves(rule, sub, lo, hi)
+
+
+class _Search:
+    """The decomposition's state through :func:`minimize_pareto`'s loop: the
+    subproblems, their moves, the archive and the hypervolume history."""
+
+    def __init__(self, fun, vectorized, sub, moves, store, ref, nfev: int):
+        self.fun, self.vectorized = fun, vectorized
+        self.sub, self.moves, self.store, self.ref = sub, moves, store, ref
+        self.nfev, self.nit = nfev, 0
+        self.history = [hypervolume(self.front()[1], ref)]
+
+    def incumbents(self) -> tuple[np.ndarray, np.ndarray]:
+        keep = non_dominated(self.sub.f)
+        return self.sub.x[keep], self.sub.f[keep]
+
+    def front(self) -> tuple[np.ndarray, np.ndarray]:
+        if self.store is None:
+            return self.incumbents()
+        return self.store.x, self.store.f
+
+    def final(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.front() if self.store is None else self.store.final()
+
+    def step(self, gen) -> None:
+        """One iteration: a point per subproblem, evaluated and offered."""
+        sub, moves = self.sub, self.moves
+        y = moves.propose(sub, gen)
+        fy = _evaluate(self.fun, y, self.vectorized, sub.f.shape[1])
+        self.nfev += y.shape[0]
+        self.nit += 1
+        sub.see(fy)
+        moves.learn(sub, y, fy)
+        sub.offer(y, fy, moves.owners, gen)
+        if self.store is not None:
+            self.store.add(y, fy)
+        self.history.append(hypervolume(self.front()[1], self.ref))
+
+    def run(self, gen, max_nfev: int, max_time, callback, t_start: float) -> str:
+        """Iterate until the budget, the time limit or the callback stops
+        it; why it stopped (a key of ``STOPS``)."""
+        while self.nfev + self.moves.batch <= max_nfev:
+            self.step(gen)
+            if callback is not None:
+                x_now, f_now = self.incumbents()
+                if callback(OptimiserResult(x=x_now, fun=f_now, nit=self.nit)):
+                    return "callback"
+            if max_time is not None and time.perf_counter() - t_start > max_time:
+                return "max_time"
+        return "max_nfev"
