@@ -455,93 +455,27 @@ def plot_convergence(
     >>> len(fig.axes)
     2
     """
-    if not isinstance(histories, Mapping) or not histories:
-        raise ValueError(
-            "`histories` must be a non-empty mapping of label to history "
-            f"(or list of histories); got {histories!r:.60}"
-        )
+    runs = _histories(histories)
     lo_q, hi_q = band
     if not 0.0 <= lo_q < hi_q <= 100.0:
         raise ValueError(
             f"`band` must be percentiles 0 <= lo < hi <= 100; got {band!r}"
         )
-    runs = {str(k): _runs(v, "histories") for k, v in histories.items()}
-    time_runs = {}
-    if times is not None:
-        if not isinstance(times, Mapping) or set(map(str, times)) != set(runs):
-            raise ValueError(
-                "`times` must be a mapping with the same labels as `histories` "
-                f"({sorted(runs)}); got {times!r:.80}"
-            )
-        for k, v in times.items():
-            k = str(k)
-            if len(runs[k]) == 1:
-                # One run: its total, its per-entry times, or a one-item list.
-                per = [v[0]] if np.ndim(v) == 1 and np.size(v) == 1 else [v]
-            elif np.ndim(v) == 0:
-                per = [v]  # rejected below: one entry for several runs
-            else:
-                per = list(v)
-            if len(per) != len(runs[k]):
-                raise ValueError(
-                    f"`times` for {k!r} must give one entry per history "
-                    f"({len(runs[k])}); got {len(per)}"
-                )
-            tr = []
-            for tv, h in zip(per, runs[k], strict=True):
-                if np.ndim(tv) == 0:
-                    total = float(tv)
-                    if not (np.isfinite(total) and total > 0):
-                        raise ValueError(
-                            f"`times` totals must be positive; got {tv!r} for {k!r}"
-                        )
-                    tr.append(np.linspace(0.0, total, h.size))
-                else:
-                    tv = np.asarray(tv, dtype=float).ravel()
-                    if tv.size != h.size or np.any(np.diff(tv) < 0):
-                        raise ValueError(
-                            f"`times` for {k!r} must be non-decreasing and as long "
-                            f"as its history ({h.size}); got {tv.size} entries"
-                        )
-                    tr.append(tv)
-            time_runs[k] = tr
+    time_runs = {} if times is None else _time_runs(times, runs)
 
     fig = figure
     if fig is None:
         fig = Figure(figsize=(8, 6.5 if time_runs else 3.8), layout="constrained")
     axes = fig.subplots(2 if time_runs else 1, 1, squeeze=False)[:, 0]
-
-    def draw(ax, x, stack, label):
-        if stack.shape[0] == 1:
-            ax.plot(x, stack[0], lw=1.2, label=label)
-            return
-        count = np.sum(np.isfinite(stack), axis=0)
-        ok = count > 0
-        x, stack = x[ok], stack[:, ok]
-        med = np.nanmedian(stack, axis=0)
-        lo = np.nanpercentile(stack, lo_q, axis=0)
-        hi = np.nanpercentile(stack, hi_q, axis=0)
-        (line,) = ax.plot(x, med, lw=1.2, label=f"{label} (median of {len(stack)})")
-        ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.25, lw=0)
-
     for label, hs in runs.items():
-        n = max(h.size for h in hs)
-        stack = np.full((len(hs), n), np.nan)
-        for i, h in enumerate(hs):
-            stack[i, : h.size] = h
-        draw(axes[0], np.arange(n), stack, label)
+        stack, x = _padded(hs)
+        _draw_runs(axes[0], x, stack, label, band)
     axes[0].set_xlabel("iteration")
     if time_runs:
-        ax = axes[1]
         for label, hs in runs.items():
-            tr = time_runs[label]
-            end = max(t[-1] for t in tr)
-            grid = np.linspace(0.0, end, 400) if len(hs) > 1 else tr[0]
-            stack = np.vstack(
-                [_step_on_grid(t, h, grid) for t, h in zip(tr, hs, strict=True)]
-            )
-            draw(ax, grid, stack, label)
-        ax.set_xlabel("wall time (s)")
+            grid, stack = _on_time_grid(time_runs[label], hs)
+            _draw_runs(axes[1], grid, stack, label, band)
+        axes[1].set_xlabel("wall time (s)")
     for ax in axes:
         ax.set_ylabel(cost_label)
         if log:
@@ -549,6 +483,101 @@ def plot_convergence(
         ax.legend(loc="best", fontsize="small")
     axes[0].set_title("Convergence")
     return fig
+
+
+def _histories(histories) -> dict[str, list[np.ndarray]]:
+    """`histories` of :func:`plot_convergence` as each label's runs."""
+    if not isinstance(histories, Mapping) or not histories:
+        raise ValueError(
+            "`histories` must be a non-empty mapping of label to history "
+            f"(or list of histories); got {histories!r:.60}"
+        )
+    return {str(k): _runs(v, "histories") for k, v in histories.items()}
+
+
+def _time_runs(times, runs: dict) -> dict[str, list[np.ndarray]]:
+    """`times` of :func:`plot_convergence` as each run's time per entry."""
+    if not isinstance(times, Mapping) or set(map(str, times)) != set(runs):
+        raise ValueError(
+            "`times` must be a mapping with the same labels as `histories` "
+            f"({sorted(runs)}); got {times!r:.80}"
+        )
+    out = {}
+    for k, v in times.items():
+        k = str(k)
+        per = _times_per_run(k, v, len(runs[k]))
+        out[k] = [_entry_times(k, tv, h) for tv, h in zip(per, runs[k], strict=True)]
+    return out
+
+
+def _times_per_run(label: str, value, n_runs: int) -> list:
+    """One label's `times` split into one item per run."""
+    if n_runs == 1:
+        # One run: its total, its per-entry times, or a one-item list.
+        per = [value[0]] if np.ndim(value) == 1 and np.size(value) == 1 else [value]
+    elif np.ndim(value) == 0:
+        per = [value]  # rejected below: one entry for several runs
+    else:
+        per = list(value)
+    if len(per) != n_runs:
+        raise ValueError(
+            f"`times` for {label!r} must give one entry per history "
+            f"({n_runs}); got {len(per)}"
+        )
+    return per
+
+
+def _entry_times(label: str, value, history: np.ndarray) -> np.ndarray:
+    """The time of every entry of one run's history: given, or its total
+    spread evenly over the entries."""
+    if np.ndim(value) == 0:
+        total = float(value)
+        if not (np.isfinite(total) and total > 0):
+            raise ValueError(
+                f"`times` totals must be positive; got {value!r} for {label!r}"
+            )
+        return np.linspace(0.0, total, history.size)
+    tv = np.asarray(value, dtype=float).ravel()
+    if tv.size != history.size or np.any(np.diff(tv) < 0):
+        raise ValueError(
+            f"`times` for {label!r} must be non-decreasing and as long "
+            f"as its history ({history.size}); got {tv.size} entries"
+        )
+    return tv
+
+
+def _padded(hs: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Runs of different lengths as rows padded with NaN, and the
+    iterations."""
+    n = max(h.size for h in hs)
+    stack = np.full((len(hs), n), np.nan)
+    for i, h in enumerate(hs):
+        stack[i, : h.size] = h
+    return stack, np.arange(n)
+
+
+def _on_time_grid(tr: list[np.ndarray], hs: list[np.ndarray]):
+    """Several runs as step functions on a common time grid (one run: its
+    own times)."""
+    end = max(t[-1] for t in tr)
+    grid = np.linspace(0.0, end, 400) if len(hs) > 1 else tr[0]
+    stack = np.vstack([_step_on_grid(t, h, grid) for t, h in zip(tr, hs, strict=True)])
+    return grid, stack
+
+
+def _draw_runs(ax, x, stack: np.ndarray, label: str, band) -> None:
+    """One run as a line; several as their median and a shaded band."""
+    if stack.shape[0] == 1:
+        ax.plot(x, stack[0], lw=1.2, label=label)
+        return
+    count = np.sum(np.isfinite(stack), axis=0)
+    ok = count > 0
+    x, stack = x[ok], stack[:, ok]
+    med = np.nanmedian(stack, axis=0)
+    lo = np.nanpercentile(stack, band[0], axis=0)
+    hi = np.nanpercentile(stack, band[1], axis=0)
+    (line,) = ax.plot(x, med, lw=1.2, label=f"{label} (median of {len(stack)})")
+    ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.25, lw=0)
 
 
 def plot_validations(validations, *, fmax: float | None = None) -> dict[str, Figure]:
