@@ -169,6 +169,84 @@ def _mlp_free_run(
             past[ny + t] = s
 
 
+@numba.njit(cache=True, inline="always")
+def _fill_regressors(reg, past, ulag, t, ny):  # pragma: no cover - compiled
+    """Step ``t``'s regressors: the ``ny`` outputs before it, newest first,
+    then its inputs."""
+    for i in range(ny):
+        reg[i] = past[ny + t - 1 - i]
+    for i in range(ulag.shape[1]):
+        reg[ny + i] = ulag[t, i]
+
+
+@numba.njit(cache=True, inline="always")
+def _mlp_output(p, reg, h, kind, linear, act):  # pragma: no cover - compiled
+    """The network's output at ``reg``, its hidden activations left in
+    ``act`` for the derivatives."""
+    n = reg.size
+    ob = h * n
+    ov = ob + h
+    oc = ov + h
+    ol = oc + 1
+    s = p[oc]
+    if linear:
+        for i in range(n):
+            s += p[ol + i] * reg[i]
+    for k in range(h):
+        z = p[ob + k]
+        row = k * n
+        for i in range(n):
+            z += p[row + i] * reg[i]
+        act[k] = _act(z, kind)
+        s += p[ov + k] * act[k]
+    return s
+
+
+@numba.njit(cache=True, inline="always")
+def _direct_sensitivity(
+    p, reg, act, h, kind, linear, grad
+):  # pragma: no cover - compiled
+    """``grad = d out / d p`` with the regressors held fixed."""
+    n = reg.size
+    ob = h * n
+    ov = ob + h
+    oc = ov + h
+    ol = oc + 1
+    for q in range(p.size):
+        grad[q] = 0.0
+    for k in range(h):
+        g = p[ov + k] * _dact(act[k], kind)
+        row = k * n
+        for i in range(n):
+            grad[row + i] = g * reg[i]
+        grad[ob + k] = g
+        grad[ov + k] = act[k]
+    grad[oc] = 1.0
+    if linear:
+        for i in range(n):
+            grad[ol + i] = reg[i]
+
+
+@numba.njit(cache=True, inline="always")
+def _feedback_sensitivity(
+    p, act, h, kind, linear, n, ny, t, dreg, sens
+):  # pragma: no cover - compiled
+    """Add to ``sens[t]`` the chain through the ``ny`` fed-back outputs:
+    ``d out[t] / d reg[i]`` times the earlier ``sens[t - 1 - i]``."""
+    ol = h * n + 2 * h + 1
+    ov = h * n + h
+    for i in range(ny):
+        d = p[ol + i] if linear else 0.0
+        for k in range(h):
+            d += p[ov + k] * _dact(act[k], kind) * p[k * n + i]
+        dreg[i] = d
+    for i in range(ny):
+        if t - 1 - i < 0 or dreg[i] == 0.0:
+            continue
+        for q in range(p.size):
+            sens[t, q] += dreg[i] * sens[t - 1 - i, q]
+
+
 @numba.njit(cache=True)
 def _mlp_sensitivity(
     p, ulag, hist, ny, h, kind, linear, out, sens
@@ -178,13 +256,7 @@ def _mlp_sensitivity(
     recurrent learning): the direct derivative plus the chain through the
     ``ny`` fed-back outputs."""
     n_t = ulag.shape[0]
-    nu = ulag.shape[1]
-    n = ny + nu
-    ob = h * n
-    ov = ob + h
-    oc = ov + h
-    ol = oc + 1
-    npar = p.size
+    n = ny + ulag.shape[1]
     reg = np.empty(n)
     act = np.empty(h)
     dreg = np.empty(ny)  # d out[t] / d reg[i] for the fed-back outputs
@@ -192,48 +264,12 @@ def _mlp_sensitivity(
     for i in range(ny):
         past[i] = hist[i]
     for t in range(n_t):
-        for i in range(ny):
-            reg[i] = past[ny + t - 1 - i]
-        for i in range(nu):
-            reg[ny + i] = ulag[t, i]
-        s = p[oc]
-        if linear:
-            for i in range(n):
-                s += p[ol + i] * reg[i]
-        for k in range(h):
-            z = p[ob + k]
-            row = k * n
-            for i in range(n):
-                z += p[row + i] * reg[i]
-            act[k] = _act(z, kind)
-            s += p[ov + k] * act[k]
+        _fill_regressors(reg, past, ulag, t, ny)
+        s = _mlp_output(p, reg, h, kind, linear, act)
         out[t] = s
         past[ny + t] = s
-        # Direct part.
-        for q in range(npar):
-            sens[t, q] = 0.0
-        for k in range(h):
-            g = p[ov + k] * _dact(act[k], kind)
-            row = k * n
-            for i in range(n):
-                sens[t, row + i] = g * reg[i]
-            sens[t, ob + k] = g
-            sens[t, ov + k] = act[k]
-        sens[t, oc] = 1.0
-        if linear:
-            for i in range(n):
-                sens[t, ol + i] = reg[i]
-        # Through the fed-back outputs.
-        for i in range(ny):
-            d = p[ol + i] if linear else 0.0
-            for k in range(h):
-                d += p[ov + k] * _dact(act[k], kind) * p[k * n + i]
-            dreg[i] = d
-        for i in range(ny):
-            if t - 1 - i < 0 or dreg[i] == 0.0:
-                continue
-            for q in range(npar):
-                sens[t, q] += dreg[i] * sens[t - 1 - i, q]
+        _direct_sensitivity(p, reg, act, h, kind, linear, sens[t])
+        _feedback_sensitivity(p, act, h, kind, linear, n, ny, t, dreg, sens)
 
 
 @numba.njit(cache=True)
