@@ -93,40 +93,57 @@ def budget_verdicts(cells: dict, readings, claim, full_budget: int, n_points: in
         verdict changes.
     """
     ladder = sorted({*(b for b in budgets if b < full_budget), int(full_budget)})
-    rows = []
-    for rd in readings:
-        if (rd, claim[0]) not in cells or (rd, claim[1]) not in cells:
-            continue
-        at = {}
-        for label in claim:
-            cell = cells[rd, label]
-            curves = [
-                (np.asarray(h, dtype=float), evaluations(n_points, int(f), len(h)))
-                for h, f in zip(cell["history"], cell["nfev"], strict=True)
-            ]
-            at[label] = [[best_at(h, c, b) for h, c in curves] for b in ladder]
-        for i, b in enumerate(ladder):
-            x, y = np.array(at[claim[0]][i]), np.array(at[claim[1]][i])
-            if np.isnan(x).any() or np.isnan(y).any():
-                continue  # a budget below the initial population
-            t = rank_sum(x, y)
-            rows.append({"reading": rd, "budget": b, **t})
+    rows = [
+        row
+        for rd in readings
+        if (rd, claim[0]) in cells and (rd, claim[1]) in cells
+        for row in _reading_rows(cells, rd, claim, ladder, n_points)
+    ]
     adjusted = holm([r["p_two_sided"] for r in rows]) if rows else []
-    crossovers = {}
     for r, p in zip(rows, adjusted, strict=True):
         r["p_holm"] = float(p)
         r["verdict"] = _verdict(r["p_holm"], r["a12"], claim, alpha)
-    for rd in readings:
-        mine = [r for r in rows if r["reading"] == rd]
-        if mine:
-            crossovers[rd] = crossover(
-                [r["budget"] for r in mine], [r["verdict"] for r in mine]
-            )
     return {
         "budgets": ladder,
         # What the histories' evaluation counts are read with (the figures).
         "n_points": n_points,
         "family": len(rows),
         "rows": rows,
-        "crossovers": crossovers,
+        "crossovers": _crossovers(rows, readings),
     }
+
+
+def _best_per_budget(cell: dict, ladder, n_points: int) -> list[list[float]]:
+    """Each run's best cost at each budget of the ladder (rows: budgets)."""
+    curves = [
+        (np.asarray(h, dtype=float), evaluations(n_points, int(f), len(h)))
+        for h, f in zip(cell["history"], cell["nfev"], strict=True)
+    ]
+    return [[best_at(h, c, b) for h, c in curves] for b in ladder]
+
+
+def _reading_rows(cells: dict, rd, claim, ladder, n_points: int) -> list[dict]:
+    """The rank-sum test of one reading's claim at every budget its initial
+    populations fit in (Holm's correction comes later, over the family)."""
+    ours, theirs = (
+        _best_per_budget(cells[rd, label], ladder, n_points) for label in claim
+    )
+    rows = []
+    for b, x, y in zip(ladder, ours, theirs, strict=True):
+        x, y = np.array(x), np.array(y)
+        if np.isnan(x).any() or np.isnan(y).any():
+            continue  # a budget below the initial population
+        rows.append({"reading": rd, "budget": b, **rank_sum(x, y)})
+    return rows
+
+
+def _crossovers(rows: list[dict], readings) -> dict:
+    """Per reading tested, the budgets where its verdict changes."""
+    crossovers = {}
+    for rd in readings:
+        mine = [r for r in rows if r["reading"] == rd]
+        if mine:
+            crossovers[rd] = crossover(
+                [r["budget"] for r in mine], [r["verdict"] for r in mine]
+            )
+    return crossovers
