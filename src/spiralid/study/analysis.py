@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .anytime import budget_verdicts
+from .anytime import budget_verdicts, verdict
 from .spec import StudySpec
 from .statistics import holm, rank_sum
 
@@ -89,12 +89,6 @@ class StudyResults:
         }
 
 
-def _verdict(p_holm: float, effect: float, claim, alpha: float) -> str:
-    if p_holm >= alpha:
-        return "no significant difference"
-    return f"{claim[0]} better" if effect > 0.5 else f"{claim[1]} better"
-
-
 def _orders(spec: StudySpec | None) -> tuple[dict, dict]:
     """Rank of each reading and label in the specification (its own order)."""
     if spec is None:
@@ -133,40 +127,14 @@ def analyse(
     """
     if not 0 < alpha < 1:
         raise ValueError(f"`alpha` must be in (0, 1); got {alpha!r}")
-    reading_rank, label_rank = _orders(spec)
-    grouped: dict = {}
-    for r in sorted(
-        (r for r in rows if r["seed"] is not None), key=lambda r: r["seed"]
-    ):
-        reading = (r["data"], r["predictor"], r["parametrization"])
-        grouped.setdefault((reading, r["label"]), []).append(r)
-    readings = sorted(
-        {rd for rd, _ in grouped}, key=lambda rd: (reading_rank.get(rd, 1 << 30), rd)
-    )
-    labels = sorted(
-        {label for _, label in grouped},
-        key=lambda label: (label_rank.get(label, 1 << 30), label),
-    )
-    cells = {
-        key: {
-            "seeds": np.array([r["seed"] for r in group]),
-            "cost": np.array([r["cost"] for r in group]),
-            "fit_val": np.array([r["fit_val"] for r in group]),
-            "seconds": np.array([r["seconds"] for r in group]),
-            "history": [r["model"]["history"] for r in group],
-            "nfev": [r["nfev"] for r in group],
-        }
-        for key, group in grouped.items()
-    }
-    baselines: dict = {}
-    for r in rows:
-        if r["seed"] is None:
-            baselines.setdefault((r["data"], r["predictor"]), {})[r["label"]] = r
+    grouped = _group(rows)
+    readings, labels = _in_order(grouped, spec)
+    cells = {key: _cell(group) for key, group in grouped.items()}
     res = StudyResults(
         readings,
         labels,
         cells,
-        baselines,
+        _baselines(rows),
         claim=tuple(claim),
         alpha=alpha,
         stored_runs=len(rows),
@@ -175,28 +143,80 @@ def analyse(
     tested = [
         rd for rd in readings if (rd, claim[0]) in cells and (rd, claim[1]) in cells
     ]
-    tests = [
-        rank_sum(cells[rd, claim[0]]["cost"], cells[rd, claim[1]]["cost"])
-        for rd in tested
-    ]
-    adjusted = holm([t["p_two_sided"] for t in tests]) if tests else []
-    for rd, t, p_adj in zip(tested, tests, adjusted, strict=True):
-        res.claims.append(
-            {
-                "data": rd[0],
-                "predictor": rd[1],
-                "parametrization": rd[2],
-                "n": [int(cells[rd, c]["cost"].size) for c in claim],
-                f"median {claim[0]}": t["median_x"],
-                f"median {claim[1]}": t["median_y"],
-                "p_two_sided": t["p_two_sided"],
-                "p_holm": float(p_adj),
-                "a12": t["a12"],
-                "verdict": _verdict(float(p_adj), t["a12"], claim, alpha),
-            }
-        )
+    res.claims = _claims(cells, tested, claim, alpha)
     if spec is not None and tested:
         res.anytime = budget_verdicts(
             cells, tested, tuple(claim), spec.budget, spec.points, alpha=alpha
         )
     return res
+
+
+def _group(rows: list[dict]) -> dict:
+    """The seeded rows by (reading, label), each group in seed order."""
+    grouped: dict = {}
+    for r in sorted(
+        (r for r in rows if r["seed"] is not None), key=lambda r: r["seed"]
+    ):
+        reading = (r["data"], r["predictor"], r["parametrization"])
+        grouped.setdefault((reading, r["label"]), []).append(r)
+    return grouped
+
+
+def _in_order(grouped: dict, spec: StudySpec | None) -> tuple[list, list]:
+    """The readings and labels present, in the specification's order (the
+    rest after them, by name)."""
+    reading_rank, label_rank = _orders(spec)
+    readings = sorted(
+        {rd for rd, _ in grouped}, key=lambda rd: (reading_rank.get(rd, 1 << 30), rd)
+    )
+    labels = sorted(
+        {label for _, label in grouped},
+        key=lambda label: (label_rank.get(label, 1 << 30), label),
+    )
+    return readings, labels
+
+
+def _cell(group: list[dict]) -> dict:
+    """One configuration's runs on one reading as arrays over seeds."""
+    return {
+        "seeds": np.array([r["seed"] for r in group]),
+        "cost": np.array([r["cost"] for r in group]),
+        "fit_val": np.array([r["fit_val"] for r in group]),
+        "seconds": np.array([r["seconds"] for r in group]),
+        "history": [r["model"]["history"] for r in group],
+        "nfev": [r["nfev"] for r in group],
+    }
+
+
+def _baselines(rows: list[dict]) -> dict:
+    """The unseeded rows (baselines) by (data, predictor), then label."""
+    baselines: dict = {}
+    for r in rows:
+        if r["seed"] is None:
+            baselines.setdefault((r["data"], r["predictor"]), {})[r["label"]] = r
+    return baselines
+
+
+def _claims(cells: dict, tested: list, claim, alpha: float) -> list[dict]:
+    """The claim's rank-sum test per reading tested, Holm-adjusted over
+    them all."""
+    tests = [
+        rank_sum(cells[rd, claim[0]]["cost"], cells[rd, claim[1]]["cost"])
+        for rd in tested
+    ]
+    adjusted = holm([t["p_two_sided"] for t in tests]) if tests else []
+    return [
+        {
+            "data": rd[0],
+            "predictor": rd[1],
+            "parametrization": rd[2],
+            "n": [int(cells[rd, c]["cost"].size) for c in claim],
+            f"median {claim[0]}": t["median_x"],
+            f"median {claim[1]}": t["median_y"],
+            "p_two_sided": t["p_two_sided"],
+            "p_holm": float(p_adj),
+            "a12": t["a12"],
+            "verdict": verdict(float(p_adj), t["a12"], claim, alpha),
+        }
+        for rd, t, p_adj in zip(tested, tests, adjusted, strict=True)
+    ]

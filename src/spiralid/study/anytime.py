@@ -60,7 +60,9 @@ def crossover(budgets, verdicts) -> list[int]:
     ]
 
 
-def _verdict(p: float, a12: float, claim, alpha: float) -> str:
+def verdict(p: float, a12: float, claim, alpha: float) -> str:
+    """The verdict on `claim` (better, reference) from a Holm-adjusted
+    p-value and the A12 effect size, at level `alpha`."""
     if p >= alpha:
         return "no significant difference"
     return f"{claim[0]} better" if a12 > 0.5 else f"{claim[1]} better"
@@ -102,7 +104,7 @@ def budget_verdicts(cells: dict, readings, claim, full_budget: int, n_points: in
     adjusted = holm([r["p_two_sided"] for r in rows]) if rows else []
     for r, p in zip(rows, adjusted, strict=True):
         r["p_holm"] = float(p)
-        r["verdict"] = _verdict(r["p_holm"], r["a12"], claim, alpha)
+        r["verdict"] = verdict(r["p_holm"], r["a12"], claim, alpha)
     return {
         "budgets": ladder,
         # What the histories' evaluation counts are read with (the figures).
