@@ -100,34 +100,15 @@ def _write_front(staged, front) -> None:
 
 def run(args, argv: list[str]) -> int:
     from spiralid.report.pareto_figures import front_figure
-    from spiralid.sysid import ARX, choose_order, identify_pareto
 
     # Every option is checked before the search, which may take minutes.
-    if args.orders is not None and _given(args, "--na", "--nb"):
-        raise UsageError("--orders replaces --na and --nb (each order n is ARX(n, n))")
-    if args.max_frequency is not None and args.by_fit is not None:
-        raise UsageError("give --max-frequency or --by-fit, not both")
-    if args.by_fit is not None and (args.orders is None or len(args.orders) < 2):
-        raise UsageError("--by-fit chooses among orders: give --orders")
-    if "frequency" not in args.objectives:
-        if args.max_frequency is not None:
-            raise UsageError("--max-frequency needs the frequency objective")
-        _refuse_unused(
-            _given(args, "--min-coherence"),
-            "to the frequency objective; --objectives "
-            f"{','.join(args.objectives)} has none",
-        )
+    _refuse_conflicts(args)
     with _progress(args) as progress:
         progress.phase("load", "loading the data")
         data = _load_data(args)
         if args.detrend:
             data = _detrended(data, args.fraction)
-        if args.orders is None:
-            structure = ARX(args.na, args.nb, args.nk)
-            structures = [structure]
-        else:
-            structure = args.orders
-            structures = [ARX(n, n, args.nk) for n in structure]
+        structure, structures = _structures(args)
         est, val = data.split(args.fraction)
         for arx in structures:
             arx.check_length(est, "estimation part of DATA")
@@ -136,34 +117,9 @@ def run(args, argv: list[str]) -> int:
             progress.phase(
                 "search", f"searching the front of {what}", unit="evaluations"
             )
-            front = identify_pareto(
-                est,
-                structure,
-                args.objectives,
-                method=args.method,
-                rng=args.seed,
-                max_nfev=args.budget,
-                n_points=args.points,
-                nk=args.nk,
-                parametrization=args.parametrization,
-                seed_estimates=not args.no_seeds,
-                polish_nfev=args.polish,
-                min_coherence=args.min_coherence,
-                progress=progress,
-            )
+            front = _search(args, est, structure, progress)
             progress.phase("validation", "choosing a point and validating it")
-            if args.max_frequency is not None:
-                chosen = front.choose(max_frequency=args.max_frequency)
-                why = f"lowest cost with frequency error <= {args.max_frequency:g} dB"
-            elif args.by_fit is not None:
-                chosen = choose_order(front, val, warmup=est, tolerance=args.by_fit)
-                why = (
-                    f"lowest order within {args.by_fit:g} points of the best "
-                    "validation fit, chosen on the validation part (its fit is "
-                    "optimistic)"
-                )
-            else:
-                chosen, why = front.knee, "the knee"
+            chosen, why = _choose(args, front, est, val)
             model = front.models[chosen]
             v_est, v_val = _validated(model, est, val, f"point {chosen}")
             progress.phase("writing", "writing the front, files and figures")
@@ -171,17 +127,7 @@ def run(args, argv: list[str]) -> int:
             _write_front(staged, front)
             model.fraction = args.fraction
             front_figure(front, chosen).savefig(staged / "front.png", dpi=110)
-            values = ", ".join(
-                _SAID[n][1].format(v)
-                for n, v in zip(front.names, front.objectives[chosen], strict=True)
-            )
-            objectives = ", ".join(_SAID[n][0] for n in front.names)
-            headline = (
-                f"Pareto front of {len(front)} stable models ({objectives}) by "
-                f"{args.method} on {args.data}, {front.nfev} evaluations; point "
-                f"{chosen} ({why}): {model.arx}, {values}, H(z) = "
-                f"{model.tf_string()}"
-            )
+            headline = _headline(args, front, chosen, why)
             summary = write_arx_model(staged, model, v_est, v_val, headline)
             _write_timings(staged, progress)
             # With --force, an earlier and larger front's surplus points go.
@@ -196,6 +142,91 @@ def run(args, argv: list[str]) -> int:
         )
         print(f"\nwrote {points}, {_listing(files, args.out)}")
     return 0
+
+
+def _refuse_conflicts(args) -> None:
+    """Options that contradict each other, or that the objectives leave
+    unused, end the command before anything is loaded."""
+    if args.orders is not None and _given(args, "--na", "--nb"):
+        raise UsageError("--orders replaces --na and --nb (each order n is ARX(n, n))")
+    if args.max_frequency is not None and args.by_fit is not None:
+        raise UsageError("give --max-frequency or --by-fit, not both")
+    if args.by_fit is not None and (args.orders is None or len(args.orders) < 2):
+        raise UsageError("--by-fit chooses among orders: give --orders")
+    if "frequency" not in args.objectives:
+        if args.max_frequency is not None:
+            raise UsageError("--max-frequency needs the frequency objective")
+        _refuse_unused(
+            _given(args, "--min-coherence"),
+            "to the frequency objective; --objectives "
+            f"{','.join(args.objectives)} has none",
+        )
+
+
+def _structures(args) -> tuple:
+    """What identify_pareto is given (one ARX, or the orders) and the ARX
+    structures it searches."""
+    from spiralid.sysid import ARX
+
+    if args.orders is None:
+        structure = ARX(args.na, args.nb, args.nk)
+        return structure, [structure]
+    return args.orders, [ARX(n, n, args.nk) for n in args.orders]
+
+
+def _search(args, est, structure, progress):
+    """The front, by identify_pareto with the command's options."""
+    from spiralid.sysid import identify_pareto
+
+    return identify_pareto(
+        est,
+        structure,
+        args.objectives,
+        method=args.method,
+        rng=args.seed,
+        max_nfev=args.budget,
+        n_points=args.points,
+        nk=args.nk,
+        parametrization=args.parametrization,
+        seed_estimates=not args.no_seeds,
+        polish_nfev=args.polish,
+        min_coherence=args.min_coherence,
+        progress=progress,
+    )
+
+
+def _choose(args, front, est, val) -> tuple[int, str]:
+    """The point to validate and write, and why it was chosen."""
+    from spiralid.sysid import choose_order
+
+    if args.max_frequency is not None:
+        chosen = front.choose(max_frequency=args.max_frequency)
+        return chosen, f"lowest cost with frequency error <= {args.max_frequency:g} dB"
+    if args.by_fit is not None:
+        chosen = choose_order(front, val, warmup=est, tolerance=args.by_fit)
+        return chosen, (
+            f"lowest order within {args.by_fit:g} points of the best "
+            "validation fit, chosen on the validation part (its fit is "
+            "optimistic)"
+        )
+    return front.knee, "the knee"
+
+
+def _headline(args, front, chosen: int, why: str) -> str:
+    """The summary's first line: the front, and the chosen point's model and
+    objectives with their units."""
+    model = front.models[chosen]
+    values = ", ".join(
+        _SAID[n][1].format(v)
+        for n, v in zip(front.names, front.objectives[chosen], strict=True)
+    )
+    objectives = ", ".join(_SAID[n][0] for n in front.names)
+    return (
+        f"Pareto front of {len(front)} stable models ({objectives}) by "
+        f"{args.method} on {args.data}, {front.nfev} evaluations; point "
+        f"{chosen} ({why}): {model.arx}, {values}, H(z) = "
+        f"{model.tf_string()}"
+    )
 
 
 def add_parser(sub) -> None:
