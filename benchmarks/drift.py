@@ -80,6 +80,7 @@ METHODS = {
     "default": {},
     "OE": {"method": "oe"},
     "unconstrained": {"max_time_constant": None, "cancel": False},
+    "by cost": {"holdback": None},
 }
 
 
@@ -155,9 +156,16 @@ def main(argv=None) -> None:
         action="store_true",
         help="also the default method without the margin and the cancellation",
     )
+    ap.add_argument(
+        "--by-cost",
+        action="store_true",
+        help="also the default method choosing by the estimation cost alone "
+        "(holdback=None)",
+    )
     args = ap.parse_args(argv)
     orders = [int(v) for v in args.orders.split(",")]
     methods = ["default", "OE"] + (["unconstrained"] if args.unconstrained else [])
+    methods += ["by cost"] if args.by_cost else []
     tasks = [(s, n, m) for n in orders for s in range(args.seeds) for m in methods]
     t0 = time.perf_counter()
     if args.workers > 1:

@@ -78,7 +78,7 @@ def test_integrator_refuses_what_it_cannot_do():
         identify(est, ARX(3, 3, 0), method="oe", integrator="yes")
     with pytest.raises(ValueError, match="`integrator` must be True, False or a count"):
         identify(est, ARX(3, 3, 0), method="oe", integrator=-1)
-    with pytest.raises(ValueError, match="`integrator` = 4 needs .* na >= 4"):
+    with pytest.raises(ValueError, match=r"`integrator` = 4 needs .* na >= 4"):
         identify(est, ARX(3, 3, 0), method="oe", integrator=4)
     with pytest.raises(ValueError, match="poles at z = 1"):
         IdentifiedModel([-1.6, 0.89, 0.0, 0.02, 0.015], arx=ARX(2, 3, 0),

@@ -81,6 +81,16 @@ def _runs(kind: str) -> list[tuple[object, dict[str, float]]]:
     return out
 
 
+def _lowest_cost(fit) -> float:
+    """The estimate's cost before the cancellation, or the lowest-cost
+    minimum's when the held-back choice (estimation/heldback.py) took
+    another."""
+    sel = fit.selection
+    if sel is not None and sel["chosen"] != sel["lowest_cost"]:
+        return min(c["cost"] for c in sel["candidates"])
+    return fit.result.get("fun_full", fit.cost)
+
+
 @pytest.mark.parametrize("kind", RECORDS)
 def test_spiral_never_ends_above_the_best_baseline(kind):
     # Output error inside the spiral method is the same computation as
@@ -88,11 +98,12 @@ def test_spiral_never_ends_above_the_best_baseline(kind):
     # only lets the search's own result tie. The promise is on the estimate
     # before the pole-zero cancellation (`fun_full` when a pair was
     # removed), which then trades at most CANCEL_COST_SHARE of its cost for
-    # a lower order (and OE need not remove the same pair).
+    # a lower order (and OE need not remove the same pair), and on the
+    # lowest-cost minimum when the held-back choice took another.
     above = [
         (seed, fit.cost, base)
         for seed, (fit, base) in enumerate(_runs(kind))
-        if fit.result.get("fun_full", fit.cost) > min(base.values()) * (1 + 1e-12)
+        if _lowest_cost(fit) > min(base.values()) * (1 + 1e-12)
     ]
     assert not above
     for fit, _ in _runs(kind):

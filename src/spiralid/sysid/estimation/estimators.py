@@ -86,7 +86,7 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
@@ -98,10 +98,16 @@ from spiralid.optim.result import STATUS, OptimiserResult
 
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
+from . import heldback
 from . import narx as _narx
 from .cost import PaperCost
+from .heldback import HOLDBACK
 from .outputerror import local_polish, steiglitz_mcbride
-from .parametrizations import DEFAULT_PARAMETRIZATION, Parametrization
+from .parametrizations import (
+    DEFAULT_PARAMETRIZATION,
+    Parametrization,
+    make_parametrization,
+)
 
 __all__ = [
     "DEFAULT_METHOD",
@@ -187,6 +193,27 @@ class Problem:
     # pairs are cancelled after the estimate.
     max_radius: float | None = None
     cancel: bool = False
+
+    def restricted(self, data: IOData) -> Problem:
+        """The same problem on another record (a part of this one): its cost
+        and parametrisation rebuilt on `data`, the margin, box and
+        randomness kept."""
+        par = self.parametrization
+        return replace(
+            self,
+            data=data,
+            cost=PaperCost(
+                self.arx,
+                data,
+                predictor=self.predictor,
+                gain=self.gain,
+                penalty=self.penalty,
+                initial=self.initial,
+            ),
+            parametrization=make_parametrization(
+                par.name, data, self.arx, par.max_radius
+            ),
+        )
 
     def simulation_cost(self) -> PaperCost:
         """The simulation cost output error minimises, whatever `predictor`."""
@@ -296,7 +323,7 @@ def _polish(
     never on validation data."""
     t0 = time.perf_counter()
     best = None
-    costs = {}
+    costs, thetas = {}, {}
     for name, start in starts.items():
         theta, res = local_polish(
             start,
@@ -307,6 +334,7 @@ def _polish(
             max_radius=problem.max_radius,
         )
         costs[name] = float(cost(theta))
+        thetas[name] = theta
         if best is None or costs[name] < best[0]:
             best = (costs[name], name, theta, res)
     _, name, theta, res = best
@@ -332,6 +360,7 @@ def _polish(
         elapsed=time.perf_counter() - t0,
         start=name,
         starts=costs,
+        thetas=thetas,
         raw=res,
     )
 
@@ -531,6 +560,7 @@ def _estimate_recommended(
     polish_nfev: int = 10,
     restart_after: int | None = 20,
     frequency_seeds: int = 0,
+    holdback: float | None = HOLDBACK,
     x0=None,
     max_iter: int | None = None,
     callback=None,
@@ -549,21 +579,28 @@ def _estimate_recommended(
     the first population. With the safe start (the default) the search's
     best is then polished by Levenberg-Marquardt beside output error from
     the stabilised least-squares and Steiglitz-McBride starts (as
-    ``refine=True``), and the lowest cost is kept: the result is never above
-    output error's (unless ``polish_every=None``, which asks for no
-    gradient step at all) before the pole-zero cancellation (``cancel``),
-    which may then trade at most 1 % of that cost for a lower order
-    (``fun_full`` is the cost before). The search, its polish and output
-    error keep the stability margin (``max_time_constant``). Default budget
-    ``max_nfev = 10_000`` evaluations of the search, its polish steps
-    included (``benchmarks/identification.py``
-    measures what each ingredient does). An FIR structure (``na = 0``) has no
-    modes: its cost is quadratic in the numerator and the exact minimiser is
-    returned without a search.
+    ``refine=True``): the result is never above output error's cost (unless
+    ``polish_every=None``, which asks for no gradient step at all), unless
+    the held-back choice below says otherwise.
+
+    With `holdback` ``h`` (default 0.2) all this runs on the first ``1 -
+    h`` of the estimation record; each distinct minimum (the polished search
+    best, output error from least squares and from Steiglitz-McBride) is
+    scored by its simulation error on the held-back end and refitted on the
+    whole record, and the lowest whole-record cost is kept unless another
+    minimum validates clearly better on the held-back end
+    (:mod:`~spiralid.sysid.estimation.heldback`; ``result.selection`` and
+    the message say which and why). ``holdback=None`` (or 0) chooses by the
+    whole-record cost alone. The pole-zero cancellation (``cancel``) may
+    then trade at most 1 % of the cost for a lower order (``fun_full`` is
+    the cost before). The search, its polish and output error keep the
+    stability margin (``max_time_constant``). Default budget ``max_nfev =
+    10_000`` evaluations of the search, its polish steps included
+    (``benchmarks/identification.py`` measures what each ingredient does).
+    An FIR structure (``na = 0``) has no modes: its cost is quadratic in the
+    numerator and the exact minimiser is returned without a search.
     """
     from spiralid.optim.spiral import _parse_method
-
-    from .memetic import projected_spiral
 
     try:
         _parse_method(rule)
@@ -577,27 +614,130 @@ def _estimate_recommended(
 
     if problem.arx.na == 0:
         return _estimate_fir(problem)
-    t0 = time.perf_counter()
-    par = problem.parametrization
-    if not isinstance(par, Modal):
+    if not isinstance(problem.parametrization, Modal):
         raise ValueError(
             "`parametrization` must be 'modal' for method 'spiral' (it searches "
-            f"the modes with the numerator projected out); got {par.name!r}"
+            "the modes with the numerator projected out); got "
+            f"{problem.parametrization.name!r}"
         )
+    holdback = _holdback_share(holdback)
+    if frequency_seeds:
+        frequency_seeds = integer(frequency_seeds, "frequency_seeds", 0)
+    settings = dict(
+        rule=rule,
+        n_points=n_points,
+        max_nfev=10_000 if max_nfev is None else max_nfev,
+        polish_every=polish_every,
+        polish_nfev=polish_nfev,
+        restart_after=restart_after,
+        frequency_seeds=frequency_seeds,
+        x0=x0,
+        max_iter=max_iter,
+        callback=callback,
+    )
+    start = None
+    if holdback and problem.safe_start and polish_every is not None:
+        # Enough samples before the held-back end for the structure to be
+        # estimated at all (its lags plus two samples a parameter).
+        least = problem.arx.max_lag + 2 * problem.arx.n_params
+        start = heldback.split(problem.data, holdback, least)
+    if start is None:
+        result = _spiral_search(problem, **settings)
+        if holdback and problem.safe_start and polish_every is not None:
+            result.message = (
+                f"{result.message} The record is too short to hold back "
+                f"{holdback:g} of it for {problem.arx}: chosen by the cost alone."
+            )
+    else:
+        result = _choose_held_back(problem, start, holdback, settings)
+    if problem.cancel:
+        _cancel(problem, result, problem.cost)
+    return result
+
+
+def _holdback_share(holdback) -> float:
+    """`holdback` checked: a share in [0, 0.5), None being 0."""
+    if holdback is None:
+        return 0.0
+    bad = isinstance(holdback, bool | np.bool_ | str)
+    try:
+        share = float(holdback)
+    except (TypeError, ValueError):
+        bad = True
+    if bad or not 0.0 <= share < 0.5:
+        raise ValueError(
+            "`holdback` of method 'spiral' must be a share in [0, 0.5) of the "
+            f"estimation record, or None; got {holdback!r}"
+        )
+    return share
+
+
+def _choose_held_back(
+    problem: Problem, start: int, holdback: float, settings: dict
+) -> EstimatorResult:
+    """The search and its polish on the whole record, each distinct minimum
+    refitted locally on ``data[:start]`` and scored on ``data[start:]``,
+    then the held-back choice (:mod:`~spiralid.sysid.estimation.heldback`)."""
+    result = _spiral_search(problem, **settings)
+    t0 = time.perf_counter()
+    minima = dict(result.refine.thetas)
+    costs = dict(result.refine.starts)
+    if not result.refine.accepted:
+        # The search's own best undercut its polish: that is the minimum.
+        minima["search"], costs["search"] = result.x, result.fun
+    part = problem.restricted(problem.data[:start])
+    found = []
+    for name, theta in minima.items():
+        # A local refit without the held-back end stays in the minimum's
+        # basin: the held-back error then judges the basin, not the data it
+        # was fitted to.
+        refit = _polish(part, {name: theta}, part.predictor, part.cost)
+        held = heldback.held_back_rms(refit.x, problem.cost, start)
+        found.append(heldback.Candidate(name, refit.x, held, theta, costs[name]))
+    candidates = heldback.distinct(found, problem.cost)
+    chosen, lowest = heldback.select(candidates)
+    selection = heldback.Selection(
+        holdback, problem.data.n - start, candidates, chosen, lowest
+    )
+    winner = next(c for c in candidates if c.name == chosen)
+    result.x, result.fun, result.start = winner.theta, winner.cost, chosen
+    result.selection = selection
+    result.message = f"{result.message} Then {selection.sentence()}."
+    result.elapsed += time.perf_counter() - t0
+    return result
+
+
+def _spiral_search(
+    problem: Problem,
+    *,
+    rule,
+    n_points,
+    max_nfev,
+    polish_every,
+    polish_nfev,
+    restart_after,
+    frequency_seeds,
+    x0,
+    max_iter,
+    callback,
+) -> EstimatorResult:
+    """The search with its safe starts and the final polish beside output
+    error (:func:`_estimate_recommended`), on `problem`'s record."""
+    from .memetic import projected_spiral
+
+    t0 = time.perf_counter()
+    par = problem.parametrization
     cost = par.projected(problem.cost)
     box = par.default_bounds() if problem.bounds is None else problem.bounds
     modes = copy.copy(par.modes)
     modes.bounds = box
-    budget = 10_000 if max_nfev is None else max_nfev
-    if frequency_seeds:
-        frequency_seeds = integer(frequency_seeds, "frequency_seeds", 0)
     start, safe = _modal_starts(problem, modes, n_points, frequency_seeds, x0)
     raw = projected_spiral(
         cost,
         modes,
         rule,
         n_points=n_points,
-        max_nfev=budget,
+        max_nfev=max_nfev,
         polish_every=polish_every,
         polish_nfev=polish_nfev,
         restart_after=restart_after,
@@ -639,8 +779,6 @@ def _estimate_recommended(
         # own best (the search's LM steps are capped, OE's run to its
         # tolerances). `polish_every=None` asks for no gradient step at all.
         _refine(problem, result)
-    if problem.cancel:
-        _cancel(problem, result, problem.cost)
     return result
 
 

@@ -376,6 +376,7 @@ def identify(
         covariance_factor=root,
         noise_variance=s2,
         cancellations=tuple(cancelled),
+        selection=None if res.get("selection") is None else res.selection.to_dict(),
         **data.provenance(),
     )
 

@@ -98,6 +98,14 @@ class IdentifiedModel:
         ``distance``, the ``tolerance`` and the ``cost_increase`` (a share
         of the cost). The removed coefficients are zeros at the end of
         ``a`` and ``b``; :attr:`effective_order` is what is left.
+    selection : dict or None
+        How the recommended method chose among its distinct minima on the
+        held-back end of the estimation record
+        (:mod:`~spiralid.sysid.estimation.heldback`): the ``holdback``
+        share, ``n_held`` samples, the ``candidates`` (``start``,
+        ``held_back_rms``, whole-record ``cost``), the ``chosen`` one, the
+        ``lowest_cost`` one and a ``note`` in words; None when the method
+        chose by the cost alone.
     """
 
     theta: np.ndarray
@@ -134,6 +142,7 @@ class IdentifiedModel:
     covariance_factor: np.ndarray | None = None
     noise_variance: float = float("nan")
     cancellations: tuple = ()
+    selection: dict | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
@@ -381,6 +390,7 @@ class IdentifiedModel:
             else np.where(np.isfinite(self.covariance), self.covariance, None).tolist(),
             "noise_variance": _finite_or_none(self.noise_variance),
             "cancellations": [dict(c) for c in self.cancellations],
+            "selection": self.selection,
             "modes": self.modes.to_dict(),
             "result": summary,
         }
@@ -445,7 +455,7 @@ class IdentifiedModel:
                     d, "y_offset", "a finite number", _fields.finite, 0.0
                 ),
                 fraction=fraction,
-                integrator=int(d.get("integrator", 0)),
+                integrator=_integrator_field(d),
                 covariance=_covariance_field(d),
                 noise_variance=_fields.number(
                     d,
@@ -457,6 +467,7 @@ class IdentifiedModel:
                 if d.get("noise_variance") is not None
                 else math.nan,
                 cancellations=_cancellations_field(d),
+                selection=_selection_field(d),
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None
@@ -477,6 +488,27 @@ def _finite_or_none(value: float) -> float | None:
 def _root_text(root) -> str:
     re, im = (float(v) for v in root)
     return f"{re:.4g}" if im == 0.0 else f"{re:.4g} +- {abs(im):.4g}j"
+
+
+def _integrator_field(d: dict) -> int:
+    """The file's ``integrator``: a count (``true`` is 1, as older files
+    wrote it)."""
+    value = d.get("integrator", 0)
+    if not isinstance(value, bool | int):
+        raise ValueError(
+            f"field 'integrator' must be a count >= 0 or true/false; got {value!r}"
+        )
+    return int(value)
+
+
+def _selection_field(d: dict) -> dict | None:
+    """The file's ``selection``: an object with a ``note``, or null."""
+    value = d.get("selection")
+    if value is not None and not (isinstance(value, dict) and "note" in value):
+        raise ValueError(
+            f"field 'selection' must be an object with a 'note' or null; got {value!r}"
+        )
+    return value
 
 
 def _cancellations_field(d: dict) -> tuple:

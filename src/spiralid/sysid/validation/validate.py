@@ -348,6 +348,10 @@ class Validation:
     reduction : str or None
         What the estimation's pole-zero cancellation removed
         (:attr:`~spiralid.sysid.IdentifiedModel.reduction`), or None.
+    choice : str or None
+        How the estimation chose among its distinct minima on the held-back
+        end of its record (the ``note`` of
+        :attr:`~spiralid.sysid.IdentifiedModel.selection`), or None.
     """
 
     label: str
@@ -388,6 +392,7 @@ class Validation:
     output_error: bool = False
     mode_table: ModeTable | None = None
     reduction: str | None = None
+    choice: str | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -505,6 +510,8 @@ class Validation:
         advice = self.order_advice
         if advice is not None:
             rows.append(("order", advice))
+        if self.choice is not None:
+            rows.append(("estimate chosen by", self.choice))
         width = max(len(k) for k, _ in rows)
         title = f"Validation of {self.label}" if self.label else "Validation"
         lines = [title, "-" * max(len(title), width + 30)]
@@ -554,6 +561,7 @@ class Validation:
             "fit_percent": float(self.fit_percent),
             "fit_percent_one_step": float(self.fit_percent_one_step),
             "order_advice": self.order_advice,
+            "choice": self.choice,
             "rmse": float(self.rmse),
             "rmse_one_step": float(self.rmse_one_step),
             "cost": float(self.cost),
@@ -855,6 +863,7 @@ def validate(
         output_error=_fitted_error(model) == "simulation",
         mode_table=_mode_table(model),
         reduction=getattr(model, "reduction", None),
+        choice=(getattr(model, "selection", None) or {}).get("note"),
     )
 
 

@@ -1,0 +1,161 @@
+"""Choosing among an estimation's distinct minima on held-back data.
+
+A lower estimation cost is not a better model: the simulation error of a
+flexible structure has several local minima, and the lowest one on the
+estimation record may owe its edge to fitting that record's drift or noise
+(a pole slower than the record, a near-cancelling pole-zero pair). The
+recommended method (``"spiral"``, :func:`~spiralid.sysid.estimation.
+estimators._estimate_recommended` with ``holdback``) therefore takes each
+distinct minimum it found on the whole estimation record (the search's
+best, output error from least squares and from Steiglitz-McBride), refits
+it locally on the first ``1 - h`` of the record (a Levenberg-Marquardt
+polish from that minimum, so it stays in the minimum's basin), and scores
+the refit by its simulation error on the held-back end ``h``. It keeps the
+lowest whole-record cost unless another minimum's held-back error is lower
+by more than :data:`MARGIN` (a relative share): the held-back part decides
+only when it sees a real difference, so a record with one minimum keeps its
+cost, and the chosen model is that minimum's whole-record fit.
+
+The reported cost stays the paper's (eq. (2)-(3) over the whole estimation
+record); the held-back scores are a choice, not a cost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..data import IOData
+from .cost import PaperCost
+
+__all__ = ["HOLDBACK", "MARGIN", "Candidate", "Selection", "held_back_rms", "select"]
+
+#: The recommended method's default share of the estimation record held back
+#: (as NARX's early stopping holds back 0.2).
+HOLDBACK = 0.2
+
+#: How much lower (relatively) another minimum's held-back RMS error must be
+#: than the lowest-cost one's before it is chosen instead. Two points of
+#: validation fit on a record where the errors are a few percent of the
+#: output are a few percent of the error; below that the held-back part is
+#: too short to tell minima apart.
+MARGIN = 0.05
+
+
+@dataclass
+class Candidate:
+    """One distinct minimum: where it came from, its local refit on the
+    first part and that refit's held-back RMS error, and the whole-record
+    fit with its cost."""
+
+    name: str
+    theta_part: np.ndarray
+    held_rms: float
+    theta: np.ndarray
+    cost: float
+
+
+@dataclass
+class Selection:
+    """What the held-back choice saw and decided (``result.selection``)."""
+
+    holdback: float
+    n_held: int
+    candidates: list[Candidate] = field(default_factory=list)
+    chosen: str = ""
+    lowest_cost: str = ""
+
+    @property
+    def overrode_cost(self) -> bool:
+        """The held-back choice is not the lowest whole-record cost."""
+        return self.chosen != self.lowest_cost
+
+    def to_dict(self) -> dict:
+        return {
+            "holdback": self.holdback,
+            "n_held": self.n_held,
+            "chosen": self.chosen,
+            "lowest_cost": self.lowest_cost,
+            "candidates": [
+                {"start": c.name, "held_back_rms": c.held_rms, "cost": c.cost}
+                for c in self.candidates
+            ],
+            "note": self.sentence(),
+        }
+
+    def sentence(self) -> str:
+        """One line for a summary: what was chosen and why."""
+        by_name = {c.name: c for c in self.candidates}
+        chosen, lowest = by_name[self.chosen], by_name[self.lowest_cost]
+        if not self.overrode_cost:
+            return (
+                f"{len(self.candidates)} distinct minim"
+                f"{'um' if len(self.candidates) == 1 else 'a'}; the lowest cost "
+                f"({_words(self.chosen)}) also validates best on the held-back "
+                f"{100 * self.holdback:.0f} % of the estimation record"
+            )
+        return (
+            f"the held-back {100 * self.holdback:.0f} % of the estimation record: "
+            f"{_words(self.chosen)} (cost {chosen.cost:.4g}, held-back RMS "
+            f"{chosen.held_rms:.3g}) over the lowest cost, {_words(self.lowest_cost)} "
+            f"(cost {lowest.cost:.4g}, held-back RMS {lowest.held_rms:.3g})"
+        )
+
+
+#: The candidates' names in words.
+_IN_WORDS = {
+    "search": "the search's best",
+    "ls": "output error from least squares",
+    "steiglitz-mcbride": "output error from Steiglitz-McBride",
+}
+
+
+def _words(name: str) -> str:
+    return _IN_WORDS.get(name, name)
+
+
+def held_back_rms(theta, cost: PaperCost, start: int) -> float:
+    """RMS of the simulation error over samples ``start..N-1`` of `cost`'s
+    record, the model run over the whole record (so the held-back part
+    starts from the state the earlier samples left, not from rest)."""
+    y_sim = cost.simulate(theta)
+    y = cost.data.y[cost.t0 :]
+    e = (y - y_sim)[max(start - cost.t0, 0) :]
+    rms = float(np.sqrt(np.mean(e**2)))
+    return rms if np.isfinite(rms) else float("inf")
+
+
+def split(data: IOData, holdback: float, min_samples: int) -> int | None:
+    """The first held-back sample, or None when the first part would be
+    shorter than `min_samples` (the record is too short to hold any back)."""
+    start = round((1.0 - holdback) * data.n)
+    if start < min_samples or data.n - start < 2:
+        return None
+    return start
+
+
+def distinct(candidates: list[Candidate], cost: PaperCost) -> list[Candidate]:
+    """Candidates whose simulated outputs (of the whole-record fits)
+    differ: two runs closer than 1e-6 of the output's RMS are one minimum,
+    found twice, and the one with the lower cost is kept (ties: the first),
+    so the lowest cost among the distinct minima is the lowest of all."""
+    scale = float(np.sqrt(np.mean(cost.data.y**2))) or 1.0
+    kept, runs = [], []
+    for c in sorted(candidates, key=lambda c: c.cost):
+        run = cost.simulate(c.theta)
+        if all(np.sqrt(np.mean((run - r) ** 2)) > 1e-6 * scale for r in runs):
+            kept.append(c)
+            runs.append(run)
+    return kept
+
+
+def select(candidates: list[Candidate]) -> tuple[str, str]:
+    """``(chosen, lowest_cost)``: the lowest whole-record cost, unless
+    another candidate's held-back RMS is lower by more than :data:`MARGIN`
+    (then the lowest held-back RMS)."""
+    lowest = min(candidates, key=lambda c: c.cost)
+    best = min(candidates, key=lambda c: c.held_rms)
+    if best.held_rms < (1.0 - MARGIN) * lowest.held_rms:
+        return best.name, lowest.name
+    return lowest.name, lowest.name
