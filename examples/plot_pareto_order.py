@@ -7,10 +7,11 @@ objectives at once: the simulation cost of the paper's eq. (2) and a
 frequency-domain error (the coherence-weighted RMS of the model's gain
 against the record's measured frequency response, in dB). Given several
 orders, it searches each and merges them with the number of parameters as
-a third objective. The front then offers three ways to pick a model: its
-knee, the lowest cost under a bound on the frequency error
-(:meth:`~spiralid.sysid.ParetoIdentification.choose`), and the lowest order
-that validates within a point of the best (:func:`spiralid.choose_order`).
+a third objective. The front then offers three ways to pick a model, all
+in :mod:`spiralid.sysid.validation.selection`: its knee, the lowest cost
+under a bound on the frequency error (:func:`spiralid.choose`), and the
+lowest order that validates within a point of the best
+(:func:`spiralid.choose_order`).
 
 This is the README's example ("Choosing a model from a Pareto front") on
 the shipped DaISy robot arm: orders 2 to 8, 2,000 evaluations and 30 points
@@ -40,13 +41,13 @@ print(f"{front.nfev} evaluations in {front.elapsed:.1f} s")
 # -------------
 # The knee is the point farthest from the plane through the front's
 # extremes: a geometric property of the front, not a statement about
-# validation. ``choose(max_frequency=4.0)`` is the lowest cost whose
+# validation. ``choose(front, max_frequency=4.0)`` is the lowest cost whose
 # frequency-response error is at most 4 dB. ``choose_order`` validates each
 # order's lowest-cost model on the held-out third and takes the lowest order
 # within one point of the best; as it is chosen on that third, the fit it
 # reports there is optimistic.
 knee = front.knee_model
-pick_index = front.choose(max_frequency=4.0)
+pick_index = sid.choose(front, max_frequency=4.0)
 pick = front.models[pick_index]
 by_fit = front.models[sid.choose_order(front, val, warmup=est)]
 for name, model in (("knee", knee), ("<= 4 dB", pick), ("choose_order", by_fit)):

@@ -29,6 +29,7 @@ _NAMES = {
     "steiglitz_mcbride": "sysid",
     "identify": "sysid",
     "identify_pareto": "sysid",
+    "choose": "sysid",
     "choose_order": "sysid",
     "validate": "sysid",
 }

@@ -154,19 +154,36 @@ def test_choose_the_lowest_cost_under_a_bound(front):
     i = choose(front, max_frequency=front.objectives[:, 1].max())
     assert i == 0  # no bound binds: the lowest cost
     bound = np.median(front.objectives[:, 1])
-    j = front.choose(max_frequency=bound)
+    j = choose(front, max_frequency=bound)
     ok = front.objectives[:, 1] <= bound
     assert ok[j] and front.objectives[j, 0] == front.objectives[ok, 0].min()
-    k = front.choose("frequency", max_cost=front.objectives[:, 0].min())
+    k = choose(front, "frequency", max_cost=front.objectives[:, 0].min())
     assert k == 0
     with pytest.raises(ValueError, match="no front point meets"):
-        front.choose(max_frequency=-1.0)
+        choose(front, max_frequency=-1.0)
     with pytest.raises(ValueError, match="max_cost, max_frequency"):
-        front.choose(max_gain=1.0)
+        choose(front, max_gain=1.0)
     with pytest.raises(ValueError, match="`minimise`"):
-        front.choose("order")
+        choose(front, "order")
     with pytest.raises(ValueError, match="`max_cost`"):
-        front.choose(max_cost="a lot")
+        choose(front, max_cost="a lot")
+    with pytest.raises(ValueError, match="`front` must be a ParetoIdentification"):
+        choose(front.objectives)
+
+
+def test_the_selection_rules_are_in_one_module(front):
+    # The knee is front geometry (optim), re-exported beside the rules that
+    # choose by bounds and by held-out fit.
+    from spiralid.sysid.validation import selection
+
+    assert knee_point is sid.optim.knee_point is selection.knee_point
+    assert choose is sid.choose is selection.choose
+    assert sid.choose_order is selection.choose_order
+    assert front.knee == knee_point(front.objectives)
+    with pytest.raises(AttributeError, match=r"use `spiralid\.choose\(front"):
+        front.choose(max_frequency=1.0)
+    with pytest.raises(AttributeError, match="no attribute 'chose'"):
+        front.chose  # noqa: B018
 
 
 def _synthetic_front():

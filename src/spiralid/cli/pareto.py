@@ -197,10 +197,10 @@ def _search(args, est, structure, progress):
 
 def _choose(args, front, est, val) -> tuple[int, str]:
     """The point to validate and write, and why it was chosen."""
-    from spiralid.sysid import choose_order
+    from spiralid.sysid import choose, choose_order
 
     if args.max_frequency is not None:
-        chosen = front.choose(max_frequency=args.max_frequency)
+        chosen = choose(front, max_frequency=args.max_frequency)
         return chosen, f"lowest cost with frequency error <= {args.max_frequency:g} dB"
     if args.by_fit is not None:
         chosen = choose_order(front, val, warmup=est, tolerance=args.by_fit)

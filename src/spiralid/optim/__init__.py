@@ -9,6 +9,7 @@ Knows nothing of system identification. See :func:`minimize`;
 from spiralid.optim import testfunctions
 from spiralid.optim.encoding import AdaptiveEncoding
 from spiralid.optim.evolution import differential_evolution
+from spiralid.optim.front import knee_point
 from spiralid.optim.learned import LearnedMetricSearch, LearnedMetricSpiral
 from spiralid.optim.pareto import (
     hypervolume,
@@ -53,6 +54,7 @@ __all__ = [
     "differential_evolution",
     "exponential_rule",
     "hypervolume",
+    "knee_point",
     "minimize",
     "minimize_pareto",
     "non_dominated",

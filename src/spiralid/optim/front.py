@@ -1,5 +1,5 @@
 """What a Pareto front is: the non-dominated filter, the hypervolume, evenly
-spread weight vectors and the thinning of a front to a given size.
+spread weight vectors, the thinning of a front to a given size and its knee.
 
 :func:`~spiralid.optim.minimize_pareto` builds on these; they are public so
 that a front from any source can be filtered, measured and thinned alike.
@@ -9,7 +9,7 @@ import numpy as np
 
 from spiralid._checks import integer
 
-__all__ = ["hypervolume", "non_dominated", "thin_front", "weight_vectors"]
+__all__ = ["hypervolume", "knee_point", "non_dominated", "thin_front", "weight_vectors"]
 
 
 def non_dominated(objectives) -> np.ndarray:
@@ -209,3 +209,56 @@ def thin_front(objectives, size: int) -> np.ndarray:
         nearest_index[stale] = np.argmin(distance[stale], axis=1)
         nearest[stale] = distance[stale, nearest_index[stale]]
     return np.flatnonzero(alive)
+
+
+def knee_point(objectives) -> int:
+    """The knee of a front: farthest from the extremes' line (plane).
+
+    With the objectives normalised to [0, 1] over the front, the point
+    farthest from the line through the two extreme points (for three
+    objectives the plane through the three), on the side of the ideal point:
+    where a unit of one objective costs most of the others. When the
+    extremes do not span a line (plane), the point nearest the ideal point.
+    Parameter-free and scale-free: a property of the front's shape only.
+
+    Parameters
+    ----------
+    objectives : array_like, shape (m, k)
+        A non-dominated set (minimisation), ``k`` >= 2.
+
+    Returns
+    -------
+    int
+        Row index (the first of equals).
+
+    Examples
+    --------
+    >>> knee_point([[0, 10], [1, 2], [5, 1], [10, 0]])
+    1
+    """
+    f = np.asarray(objectives, dtype=float)
+    if f.ndim != 2 or f.shape[0] < 1 or f.shape[1] < 2 or not np.all(np.isfinite(f)):
+        raise ValueError(
+            "`objectives` must be a finite (m, k) array with m >= 1, k >= 2; got "
+            f"shape {f.shape}"
+        )
+    lo, hi = f.min(axis=0), f.max(axis=0)
+    g = (f - lo) / np.where(hi > lo, hi - lo, 1.0)
+    nearest = int(np.argmin(np.linalg.norm(g, axis=1)))
+    k = g.shape[1]
+    # Each objective's best point (ties: the one best in the others).
+    extremes = [int(np.lexsort((g.sum(axis=1), g[:, j]))[0]) for j in range(k)]
+    if len(set(extremes)) < k:
+        return nearest
+    e = g[extremes]
+    # The hyperplane n . x = 1 through the extremes.
+    try:
+        normal = np.linalg.solve(e, np.ones(k))
+    except np.linalg.LinAlgError:
+        return nearest
+    if not np.all(np.isfinite(normal)) or np.linalg.cond(e) > 1e12:
+        return nearest
+    if np.all(normal <= 0):
+        return nearest
+    distance = (1.0 - g @ normal) / np.linalg.norm(normal)
+    return int(np.argmax(distance))

@@ -14,9 +14,7 @@ from .estimation.outputerror import steiglitz_mcbride as steiglitz_mcbride
 from .estimation.parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
 from .estimation.parametrizations import default_bounds as default_bounds
 from .estimation.pareto import ParetoIdentification as ParetoIdentification
-from .estimation.pareto import choose as choose
 from .estimation.pareto import identify_pareto as identify_pareto
-from .estimation.pareto import knee_point as knee_point
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.identified import IdentifiedModel as IdentifiedModel
@@ -41,8 +39,10 @@ from .validation.correlation import CorrelationTest as CorrelationTest
 from .validation.correlation import independence_test as independence_test
 from .validation.correlation import whiteness_test as whiteness_test
 from .validation.higher_order import billings_voon as billings_voon
+from .validation.selection import choose as choose
 from .validation.selection import choose_order as choose_order
 from .validation.selection import fits_by_order as fits_by_order
+from .validation.selection import knee_point as knee_point
 from .validation.validate import Realization as Realization
 from .validation.validate import Validation as Validation
 from .validation.validate import fit_percent as fit_percent

@@ -44,15 +44,15 @@ joins the candidates. Which candidate each front model came from is its
 ``result.start`` (``"search"``, ``"polish"``, ``"ls"``,
 ``"steiglitz-mcbride"`` or ``"oe"``); every evaluation counts in ``nfev``.
 
-Knee
-----
-:func:`knee_point`: with the objectives normalised to [0, 1] over the
-front, the point farthest from the line through the two extreme points
-(for three objectives the plane through the three), on the side of the
-ideal point: where a unit of one objective costs most of the others.
-When the extremes do not span a line (plane), the point nearest the ideal
-point. :func:`choose` picks instead the lowest value of one objective under
-bounds on the others.
+Choosing a model
+----------------
+The front's :attr:`~ParetoIdentification.knee` is its knee point
+(:func:`spiralid.optim.knee_point`, geometry of the front alone). The
+rules for choosing a model from the front, the knee among them, are in one
+module, :mod:`spiralid.sysid.validation.selection`: :func:`~spiralid.sysid.choose`
+(the lowest value of one objective under bounds on the others) and
+:func:`~spiralid.sysid.choose_order` (the lowest order that validates as
+well on held-out data), which validates and so sits above estimation.
 """
 
 from __future__ import annotations
@@ -66,6 +66,7 @@ import numpy as np
 from spiralid._checks import generator, integer
 from spiralid.choices import OBJECTIVES
 from spiralid.optim._decomposition import Archive
+from spiralid.optim.front import knee_point
 from spiralid.optim.pareto import minimize_pareto, non_dominated
 
 from ..data import IOData
@@ -82,13 +83,7 @@ from .frequency import (
 from .outputerror import steiglitz_mcbride
 from .parametrizations import Modal, make_parametrization
 
-__all__ = [
-    "OBJECTIVES",
-    "ParetoIdentification",
-    "choose",
-    "identify_pareto",
-    "knee_point",
-]
+__all__ = ["OBJECTIVES", "ParetoIdentification", "identify_pareto"]
 
 _SEEDS = ("ls", "steiglitz-mcbride", "oe")
 
@@ -108,7 +103,7 @@ class ParetoIdentification:
     names : tuple of str
         The objectives (keys of :data:`OBJECTIVES`).
     knee : int
-        Index of the knee point (:func:`knee_point`).
+        Index of the knee point (:func:`spiralid.optim.knee_point`).
     hypervolume : dict of str to ndarray
         Each search's hypervolume history (index 0: the initial population),
         by structure, e.g. ``"ARX(8, 8, 0)"``; each in its own objectives
@@ -144,110 +139,17 @@ class ParetoIdentification:
         """The model at the knee point."""
         return self.models[self.knee]
 
-    def choose(self, minimise: str = "cost", **limits: float) -> int:
-        """Index of the lowest `minimise` under upper bounds, see :func:`choose`.
-
-        Parameters
-        ----------
-        minimise : str, default "cost"
-            The objective to minimise.
-        **limits : float
-            ``max_<objective>=bound``, e.g. ``max_frequency=3.0``.
-        """
-        return choose(self, minimise, **limits)
-
-
-def knee_point(objectives) -> int:
-    """The knee of a front: farthest from the extremes' line (plane).
-
-    Parameters
-    ----------
-    objectives : array_like, shape (m, k)
-        A non-dominated set (minimisation), ``k`` >= 2.
-
-    Returns
-    -------
-    int
-        Row index (the first of equals).
-
-    Examples
-    --------
-    >>> knee_point([[0, 10], [1, 2], [5, 1], [10, 0]])
-    1
-    """
-    f = np.asarray(objectives, dtype=float)
-    if f.ndim != 2 or f.shape[0] < 1 or f.shape[1] < 2 or not np.all(np.isfinite(f)):
-        raise ValueError(
-            "`objectives` must be a finite (m, k) array with m >= 1, k >= 2; got "
-            f"shape {f.shape}"
+    def __getattr__(self, name: str):
+        # The selection rules moved to validation/selection.py (one module,
+        # beside choose_order); say where instead of a bare AttributeError.
+        if name == "choose":
+            raise AttributeError(
+                "`ParetoIdentification.choose` was moved: use "
+                "`spiralid.choose(front, minimise, **limits)`"
+            )
+        raise AttributeError(
+            f"{type(self).__name__!r} object has no attribute {name!r}"
         )
-    lo, hi = f.min(axis=0), f.max(axis=0)
-    g = (f - lo) / np.where(hi > lo, hi - lo, 1.0)
-    nearest = int(np.argmin(np.linalg.norm(g, axis=1)))
-    k = g.shape[1]
-    # Each objective's best point (ties: the one best in the others).
-    extremes = [int(np.lexsort((g.sum(axis=1), g[:, j]))[0]) for j in range(k)]
-    if len(set(extremes)) < k:
-        return nearest
-    e = g[extremes]
-    # The hyperplane n . x = 1 through the extremes.
-    try:
-        normal = np.linalg.solve(e, np.ones(k))
-    except np.linalg.LinAlgError:
-        return nearest
-    if not np.all(np.isfinite(normal)) or np.linalg.cond(e) > 1e12:
-        return nearest
-    if np.all(normal <= 0):
-        return nearest
-    distance = (1.0 - g @ normal) / np.linalg.norm(normal)
-    return int(np.argmax(distance))
-
-
-def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int:
-    """Index of the front point with the lowest `minimise` under bounds.
-
-    Parameters
-    ----------
-    front : ParetoIdentification
-        From :func:`identify_pareto`.
-    minimise : str, default "cost"
-        The objective to minimise, one of ``front.names``.
-    **limits : float
-        ``max_<objective>=bound`` for objectives in ``front.names``, e.g.
-        ``choose(front, max_frequency=3.0)``: the lowest-cost model whose
-        frequency-response error is at most 3 dB.
-
-    Returns
-    -------
-    int
-        Row index into ``front.models`` (ties: the first).
-    """
-    if not isinstance(front, ParetoIdentification):
-        raise ValueError(
-            f"`front` must be a ParetoIdentification; got {type(front).__name__}"
-        )
-    names = front.names
-    if minimise not in names:
-        raise ValueError(f"`minimise` must be one of {names}; got {minimise!r}")
-    ok = np.ones(len(front), bool)
-    for key, bound in limits.items():
-        name = key.removeprefix("max_")
-        if not key.startswith("max_") or name not in names:
-            allowed = ", ".join(f"max_{n}" for n in names)
-            raise ValueError(f"limits must be among {allowed}; got `{key}`")
-        try:
-            b = float(bound)
-        except (TypeError, ValueError):
-            b = float("nan")
-        if not np.isfinite(b):
-            raise ValueError(f"`{key}` must be a finite number; got {bound!r}")
-        ok &= front.objectives[:, names.index(name)] <= b
-    if not ok.any():
-        raise ValueError(
-            f"no front point meets {', '.join(f'{k}={v!r}' for k, v in limits.items())}"
-        )
-    column = np.where(ok, front.objectives[:, names.index(minimise)], np.inf)
-    return int(np.argmin(column))
 
 
 def _structures(orders, nk: int) -> list[ARX]:

@@ -1,13 +1,29 @@
-"""Choosing a model order from a Pareto front by held-out fit.
+"""Choosing a model from a Pareto front: every rule in one place.
 
-The knee of :class:`~spiralid.sysid.ParetoIdentification` is a property of
-the front's shape and need not sit at the order where a model stops
-improving on data it was not fitted to (``benchmarks/pareto_identification.py``
-measured it at that order in 2 of 15 runs). :func:`choose_order` asks the data
-instead: each order's lowest-cost model is validated on a held-out record,
-and the lowest order within ``tolerance`` points of fit of the best is
-chosen (the parsimony rule of ``compare`` in MATLAB's System
-Identification Toolbox, applied along the front).
+A :class:`~spiralid.sysid.ParetoIdentification` offers three ways to pick
+its model:
+
+- its knee, ``front.knee`` (``front.knee_model``): where a unit of one
+  objective costs most of the others, :func:`knee_point` on its objectives
+  (front geometry, :func:`spiralid.optim.knee_point`, so
+  :func:`~spiralid.sysid.identify_pareto` can compute it below this
+  module);
+- :func:`choose`: the lowest value of one objective under upper bounds on
+  the others, e.g. the lowest cost whose frequency-response error is at
+  most 3 dB;
+- :func:`choose_order`: the lowest order that validates within a tolerance
+  of the best order on a held-out record.
+
+The knee is a property of the front's shape and need not sit at the order
+where a model stops improving on data it was not fitted to
+(``benchmarks/pareto_identification.py`` measured it at that order in 2 of
+15 runs). :func:`choose_order` asks the data instead: each order's
+lowest-cost model is validated on a held-out record, and the lowest order
+within ``tolerance`` points of fit of the best is chosen (the parsimony
+rule of ``compare`` in MATLAB's System Identification Toolbox, applied
+along the front). It validates, which is why the rules live here and not
+beside :func:`~spiralid.sysid.identify_pareto` (estimation may not import
+validation).
 """
 
 from __future__ import annotations
@@ -15,10 +31,59 @@ from __future__ import annotations
 import numpy as np
 
 from spiralid._checks import nonneg
+from spiralid.optim.front import knee_point
 
+from ..estimation.pareto import ParetoIdentification
 from .validate import validate
 
-__all__ = ["choose_order", "fits_by_order"]
+__all__ = ["choose", "choose_order", "fits_by_order", "knee_point"]
+
+
+def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int:
+    """Index of the front point with the lowest `minimise` under bounds.
+
+    Parameters
+    ----------
+    front : ParetoIdentification
+        From :func:`~spiralid.sysid.identify_pareto`.
+    minimise : str, default "cost"
+        The objective to minimise, one of ``front.names``.
+    **limits : float
+        ``max_<objective>=bound`` for objectives in ``front.names``, e.g.
+        ``choose(front, max_frequency=3.0)``: the lowest-cost model whose
+        frequency-response error is at most 3 dB.
+
+    Returns
+    -------
+    int
+        Row index into ``front.models`` (ties: the first).
+    """
+    if not isinstance(front, ParetoIdentification):
+        raise ValueError(
+            f"`front` must be a ParetoIdentification; got {type(front).__name__}"
+        )
+    names = front.names
+    if minimise not in names:
+        raise ValueError(f"`minimise` must be one of {names}; got {minimise!r}")
+    ok = np.ones(len(front), bool)
+    for key, bound in limits.items():
+        name = key.removeprefix("max_")
+        if not key.startswith("max_") or name not in names:
+            allowed = ", ".join(f"max_{n}" for n in names)
+            raise ValueError(f"limits must be among {allowed}; got `{key}`")
+        try:
+            b = float(bound)
+        except (TypeError, ValueError):
+            b = float("nan")
+        if not np.isfinite(b):
+            raise ValueError(f"`{key}` must be a finite number; got {bound!r}")
+        ok &= front.objectives[:, names.index(name)] <= b
+    if not ok.any():
+        raise ValueError(
+            f"no front point meets {', '.join(f'{k}={v!r}' for k, v in limits.items())}"
+        )
+    column = np.where(ok, front.objectives[:, names.index(minimise)], np.inf)
+    return int(np.argmin(column))
 
 
 def fits_by_order(front, data, *, warmup=None) -> dict[int, tuple[int, float]]:
