@@ -96,7 +96,7 @@ def one(record, seed, orders, budget, points, seeded=True):
         max_nfev=budget,
         n_points=points,
         seed_estimates=seeded,
-        polish_nfev=200 if seeded else 0,
+        extremes_nfev=200 if seeded else 0,
     )
     elapsed = time.perf_counter() - t
     knee = front.knee_model

@@ -29,7 +29,7 @@ from spiralid.report.pareto_figures import front_figure
 # ---------
 # Each order's search is seeded with the least-squares, Steiglitz-McBride
 # and output-error estimates, and each objective's best point is polished
-# locally (``seed_estimates=True`` and ``polish_nfev=200``, the defaults);
+# locally (``seed_estimates=True`` and ``extremes_nfev=200``, the defaults);
 # every model's ``result.start`` says where it came from.
 est, val = sid.datasets.robot_arm().split(2 / 3)
 front = sid.identify_pareto(est, range(2, 9), rng=0, max_nfev=2000, n_points=30)

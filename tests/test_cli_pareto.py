@@ -77,7 +77,7 @@ def test_choosing_the_order_by_validation_fit(tmp_path):
     # The same front in the library, and the same choice on it.
     est, val = sid.datasets.robot_arm().split(2 / 3)
     front = sid.identify_pareto(est, [2, 3, 4], rng=0, max_nfev=300, n_points=12,
-                                polish_nfev=20)  # fmt: skip
+                                extremes_nfev=20)  # fmt: skip
     chosen = front.models[sid.choose_order(front, val, warmup=est)]
     np.testing.assert_allclose(written.theta, chosen.theta, rtol=1e-12)
 

@@ -161,3 +161,48 @@ def box_bounds(bounds, n: int | None = None) -> tuple[np.ndarray, np.ndarray]:
             f"`bounds` must have a finite width high - low; got low={lo!r}, high={hi!r}"
         )
     return lo, hi
+
+
+def is_default(value, default) -> bool:
+    """`value` is an option's default: the same object, or an equal number
+    or string (``penalty=float("1e6")`` is the default 1e6, ``True`` is not
+    ``1``)."""
+    if value is default:
+        return True
+    if isinstance(default, bool):
+        return isinstance(value, bool | np.bool_) and bool(value) == default
+    if isinstance(value, bool | np.bool_):
+        return False
+    if isinstance(default, int | float) and isinstance(value, int | float | np.number):
+        return bool(value == default)
+    return isinstance(default, str) and isinstance(value, str) and value == default
+
+
+def refuse_options(given, applicable, where: str, defaults=None) -> None:
+    """The one rule of every public entry point: an option that does not
+    apply to `where` (a method, a structure) is a one-line ValueError
+    naming it, `where` and the options that do apply, unless it equals its
+    default (`defaults[name]`, compared by value with :func:`is_default`).
+
+    Parameters
+    ----------
+    given : dict
+        The options passed, by name.
+    applicable : iterable of str
+        The options `where` takes.
+    where : str
+        What the options were given to, e.g. ``"method 'ls'"``.
+    defaults : dict, optional
+        Defaults of options that are accepted when left at them.
+    """
+    applicable = tuple(applicable)
+    defaults = {} if defaults is None else defaults
+    for name, value in given.items():
+        if name in applicable:
+            continue
+        if name in defaults and is_default(value, defaults[name]):
+            continue
+        takes = ", ".join(applicable) if applicable else "none"
+        raise ValueError(
+            f"`{name}` does not apply to {where}; the options that do: {takes}"
+        )

@@ -11,7 +11,7 @@ from spiralid.optim.pareto import non_dominated
 from spiralid.sysid import ARX, PaperCost, choose, identify_pareto, knee_point
 from spiralid.sysid.estimation.frequency import FrequencyError
 
-SMALL = dict(max_nfev=600, n_points=20, polish_nfev=50)
+SMALL = dict(max_nfev=600, n_points=20, extremes_nfev=50)
 
 
 @pytest.fixture(scope="module")
@@ -106,7 +106,7 @@ def test_the_paper_coefficients_search_keeps_only_stable_models(arm):
         ({"orders": [2.5]}, "`orders` must be"),
         ({"method": "periodic"}, "`method` must be one of"),
         ({"seed_estimates": "yes"}, "`seed_estimates`"),
-        ({"polish_nfev": -1}, "`polish_nfev`"),
+        ({"extremes_nfev": -1}, "`extremes_nfev`"),
         ({"max_nfev": 10}, "`max_nfev`"),
     ],
 )

@@ -109,7 +109,7 @@ _USER_WORDS = {
     "lags": "the number of residual-test lags (25)",
     "orders": "--orders",
     "objectives": "--objectives",
-    "polish_nfev": "--polish",
+    "extremes_nfev": "--polish",
     "min_coherence": "--min-coherence",
 }
 

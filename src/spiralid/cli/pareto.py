@@ -189,7 +189,7 @@ def _search(args, est, structure, progress):
         nk=args.nk,
         parametrization=args.parametrization,
         seed_estimates=not args.no_seeds,
-        polish_nfev=args.polish,
+        extremes_nfev=args.polish,
         min_coherence=args.min_coherence,
         progress=progress,
     )

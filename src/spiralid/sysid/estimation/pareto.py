@@ -39,7 +39,7 @@ represents its denominator) and a weak search cannot lose it. The search's
 candidates are the non-dominated set of every iteration's incumbents (an
 incumbent that a neighbour replaced can still be on the front). Then each
 searched objective's best candidate is polished on that objective alone by
-L-BFGS-B in the box (``polish_nfev`` evaluations each, 0 for none) and
+L-BFGS-B in the box (``extremes_nfev`` evaluations each, 0 for none) and
 joins the candidates. Which candidate each front model came from is its
 ``result.start`` (``"search"``, ``"polish"``, ``"ls"``,
 ``"steiglitz-mcbride"`` or ``"oe"``); every evaluation counts in ``nfev``.
@@ -63,7 +63,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from spiralid._checks import generator, integer
+from spiralid._checks import generator, integer, refuse_options
 from spiralid.choices import OBJECTIVES
 from spiralid.optim._decomposition import Archive
 from spiralid.optim.front import knee_point
@@ -83,7 +83,7 @@ from .frequency import (
 from .outputerror import steiglitz_mcbride
 from .parametrizations import Modal, make_parametrization
 
-__all__ = ["OBJECTIVES", "ParetoIdentification", "identify_pareto"]
+__all__ = ["OBJECTIVES", "ParetoIdentification", "identify_pareto", "pareto_options"]
 
 _SEEDS = ("ls", "steiglitz-mcbride", "oe")
 
@@ -302,8 +302,7 @@ class _StructureRun:
 
 def _search_structure(
     data, arx, error, searched, method, gen, *, parametrization, cost,
-    seed_estimates, polish_nfev, initial, n_points, max_nfev, neighbours, gain,
-    count=None,
+    seed_estimates, extremes_nfev, initial, search, gain, count=None,
 ) -> _StructureRun:  # fmt: skip
     """Search one structure's front; collect the seeds, the archive of the
     search's incumbents and the polished extremes as candidates. `count`,
@@ -322,9 +321,7 @@ def _search_structure(
         lambda x: evaluate(x)[1],
         box,
         method,
-        n_points=n_points,
-        max_nfev=max_nfev,
-        neighbours=neighbours,
+        **search,
         rng=gen,
         vectorized=True,
         x0=x0,
@@ -337,8 +334,8 @@ def _search_structure(
     # Seeds first: of exact twins the first is kept, with its origin.
     points = [] if x0 is None else [(np.clip(x0, box[:, 0], box[:, 1]), list(seeds))]
     points.append((archive.x, ["search"] * archive.x.shape[0]))
-    if polish_nfev:
-        polished, used = _polish_extremes(evaluate, archive, box, polish_nfev)
+    if extremes_nfev:
+        polished, used = _polish_extremes(evaluate, archive, box, extremes_nfev)
         points.append((polished, ["polish"] * polished.shape[0]))
         run.nfev += used
     for x, origin in points:
@@ -414,6 +411,82 @@ def _front_model(
     )
 
 
+def pareto_options(objectives) -> dict:
+    """The options :func:`identify_pareto` takes through ``**options`` for
+    these objectives, with their defaults: the search's
+    (:func:`~spiralid.optim.pareto.minimize_pareto`'s keyword options less
+    those it sets itself), the models' and, with the ``"frequency"``
+    objective, its H1 estimate's.
+
+    Examples
+    --------
+    >>> sorted(pareto_options(("cost", "one-step")))  # doctest: +NORMALIZE_WHITESPACE
+    ['extremes_nfev', 'max_nfev', 'max_time', 'n_points', 'neighbours',
+     'parametrization', 'seed_estimates']
+    """
+    out = {**_SEARCH_DEFAULTS, **_MODEL_DEFAULTS}
+    if "frequency" in objectives:
+        out.update(_FREQUENCY_DEFAULTS)
+    return out
+
+
+def _search_defaults() -> dict:
+    import inspect
+
+    from .estimators import _keyword_options
+
+    # What each structure's search sets itself (its seeds, its own archive,
+    # the progress callback, the shared generator).
+    own = ("rng", "vectorized", "callback", "x0", "archive", "ref_point")
+    signature = inspect.signature(minimize_pareto).parameters
+    defaults = {
+        name: signature[name].default
+        for name in _keyword_options(minimize_pareto, own=own)
+    }
+    # Per order, half minimize_pareto's 100 points and 10,000 evaluations:
+    # the same 100 iterations per search, and every order is a search of its
+    # own (with its seeds' output-error fits and its polishes besides).
+    defaults.update(n_points=50, max_nfev=5_000)
+    return defaults
+
+
+_SEARCH_DEFAULTS = _search_defaults()
+_MODEL_DEFAULTS = dict(parametrization="modal", seed_estimates=True, extremes_nfev=200)
+_FREQUENCY_DEFAULTS = dict(
+    nperseg=None, fmin=None, fmax=None, min_coherence=DEFAULT_MIN_COHERENCE
+)
+# Names this function no longer takes, and what to use instead.
+_RENAMED = {
+    "polish_nfev": (
+        "`polish_nfev` of identify_pareto is now `extremes_nfev` (each "
+        "extreme's polish); `polish_nfev` is the spiral method's budget per "
+        "polish of its centre"
+    ),
+}
+
+
+def _pareto_settings(method, names, options: dict) -> dict:
+    """`options` checked against :func:`pareto_options` (one line naming an
+    option that does not apply), completed with the defaults."""
+    for name in options:
+        if name in _RENAMED:
+            raise ValueError(_RENAMED[name])
+    applicable = pareto_options(names)
+    everything = {**_SEARCH_DEFAULTS, **_MODEL_DEFAULTS, **_FREQUENCY_DEFAULTS}
+    refuse_options(
+        options,
+        applicable,
+        f"identify_pareto with method {method!r} and objectives {names}",
+        defaults=everything,
+    )
+    settings = {**everything, **options}
+    seeded = settings["seed_estimates"]
+    if not isinstance(seeded, bool | np.bool_):
+        raise ValueError(f"`seed_estimates` must be True or False; got {seeded!r}")
+    settings["extremes_nfev"] = integer(settings["extremes_nfev"], "extremes_nfev", 0)
+    return settings
+
+
 def identify_pareto(
     data: IOData,
     orders,
@@ -421,23 +494,18 @@ def identify_pareto(
     method: str = "ebsda",
     *,
     rng=None,
-    max_nfev: int = 5_000,
-    n_points: int = 50,
     nk: int = 0,
-    parametrization: str = "modal",
-    seed_estimates: bool = True,
-    polish_nfev: int = 200,
     initial: str = "rest",
     gain: str | float = "auto",
     penalty: float = 1e6,
-    nperseg: int | None = None,
-    fmin: float | None = None,
-    fmax: float | None = None,
-    min_coherence: float = DEFAULT_MIN_COHERENCE,
-    neighbours: int = 10,
     progress: Callable[[int, int], None] | None = None,
+    **options,
 ) -> ParetoIdentification:
     """A Pareto front of stable ARX models on an estimation record.
+
+    Its search options are passed as ``identify``'s are, through
+    ``**options``; :func:`pareto_options` lists those that apply to the
+    objectives, and any other is refused in one line naming it.
 
     Parameters
     ----------
@@ -456,40 +524,37 @@ def identify_pareto(
         :func:`~spiralid.optim.pareto.minimize_pareto` takes.
     rng : None, int or numpy.random.Generator
         Seed of the searches (one generator, orders in the given order).
-    max_nfev : int, default 5000
-        Evaluation budget of each order's search.
-    n_points : int, default 50
-        Population size (one subproblem each).
     nk : int, default 0
         Input delay of the structures built from `orders`.
-    parametrization : {"modal", "coefficients", "reflection"}
-        What the search moves (see
-        :mod:`~spiralid.sysid.estimation.parametrizations`); ``"modal"``
-        needs ``initial="rest"``.
-    seed_estimates : bool, default True
-        Seed each search with the least-squares, Steiglitz-McBride and
-        output-error estimates and keep them among the candidates (module
-        docstring).
-    polish_nfev : int, default 200
-        Budget of each extreme's polish (module docstring); 0: no polish.
     initial : {"rest", "measured"}
         Initial condition of the simulation error (see ``identify``).
     gain, penalty
         The cost's gain and stability penalty (:class:`PaperCost`).
-    nperseg : int, optional
-        Welch segment length of the H1 estimate
-        (:func:`~spiralid.sysid.estimation.frequency.h1_estimate`).
-    fmin, fmax : float, optional
-        Band of the frequency objective in Hz (default: one resolution cell
-        to 0.8 of the Nyquist frequency).
-    min_coherence : float, default 0.5
-        Bins with lower coherence are not scored.
-    neighbours : int, default 10
-        Neighbourhood of the decomposition (``minimize_pareto``).
     progress : callable, optional
         ``progress(done, total)`` as the evaluations go: ``total`` is what
-        the budgets allow, ``len(orders) * (max_nfev + polish_nfev * k)``
+        the budgets allow, ``len(orders) * (max_nfev + extremes_nfev * k)``
         for ``k`` searched objectives (``done`` stops there).
+    **options
+        The search's, as :func:`~spiralid.optim.pareto.minimize_pareto`
+        names them: ``max_nfev`` (default 5000, each order's budget),
+        ``n_points`` (default 50, one subproblem each), ``max_time`` and
+        ``neighbours`` (default 10); the models': ``parametrization``
+        (``"modal"``, ``"coefficients"`` or ``"reflection"``, what the
+        search moves, :mod:`~spiralid.sysid.estimation.parametrizations`;
+        ``"modal"``, the default, needs ``initial="rest"``),
+        ``seed_estimates`` (default True: seed each search with the
+        least-squares, Steiglitz-McBride and output-error estimates and keep
+        them among the candidates) and ``extremes_nfev`` (default 200, the
+        budget of each extreme's polish, 0 for none; it was
+        ``polish_nfev``); with the ``"frequency"`` objective, its H1
+        estimate's: ``nperseg`` (Welch segment length), ``fmin``, ``fmax``
+        (its band in Hz, default one resolution cell to 0.8 of the Nyquist
+        frequency) and ``min_coherence`` (default 0.5: bins with lower
+        coherence are not scored;
+        :func:`~spiralid.sysid.estimation.frequency.h1_estimate`). The
+        defaults differ from ``minimize_pareto``'s 100 points and 10,000
+        evaluations because every order is a search of its own: half of
+        each gives the same 100 iterations.
 
     Returns
     -------
@@ -514,21 +579,20 @@ def identify_pareto(
         raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
     structures = _structures(orders, nk)
     names = _names(objectives, len(structures) > 1)
-    if not isinstance(seed_estimates, bool | np.bool_):
-        raise ValueError(
-            f"`seed_estimates` must be True or False; got {seed_estimates!r}"
-        )
-    polish_nfev = integer(polish_nfev, "polish_nfev", 0)
     if isinstance(method, str):
         method = method.lower()
+    settings = _pareto_settings(method, names, options)
+    search = {name: settings[name] for name in _SEARCH_DEFAULTS}
+    parametrization = settings["parametrization"]
     gen = generator(rng)
     estimate = h1_estimate(
-        data, nperseg=nperseg, fmin=fmin, fmax=fmax, min_coherence=min_coherence
+        data, **{name: settings[name] for name in _FREQUENCY_DEFAULTS}
     )
     searched = [n for n in names if n != "order"]
     count = None
     if progress is not None:
-        budget = integer(max_nfev, "max_nfev", 1) + len(searched) * polish_nfev
+        budget = integer(search["max_nfev"], "max_nfev", 1)
+        budget += len(searched) * settings["extremes_nfev"]
         count = _Progress(progress, len(structures) * budget)
     runs = []
     for arx in structures:
@@ -543,12 +607,10 @@ def identify_pareto(
                 gen,
                 parametrization=parametrization,
                 cost=PaperCost(arx, data, gain=gain, penalty=penalty, initial=initial),
-                seed_estimates=seed_estimates,
-                polish_nfev=polish_nfev,
+                seed_estimates=settings["seed_estimates"],
+                extremes_nfev=settings["extremes_nfev"],
                 initial=initial,
-                n_points=n_points,
-                max_nfev=max_nfev,
-                neighbours=neighbours,
+                search=search,
                 gain=gain,
                 count=count,
             )
@@ -589,5 +651,5 @@ def identify_pareto(
         elapsed=time.perf_counter() - t_start,
         n_unstable=n_unstable,
         frequency=estimate,
-        seeded=bool(seed_estimates),
+        seeded=bool(settings["seed_estimates"]),
     )
