@@ -395,39 +395,23 @@ class IOData:
         *,
         default_ts: float | None = None,
     ) -> IOData:
-        """Read arrays from a NumPy ``.npz`` archive (never unpickles objects).
+        """Read two arrays of a NumPy ``.npz`` archive (never unpickles objects).
 
-        ``ts=None`` reads the sample time from a scalar array named ``ts``,
-        else takes `default_ts`.
+        Parameters
+        ----------
+        path : path-like
+            The archive, as :func:`numpy.savez` writes it.
+        input, output : str
+            The names of the input and output arrays; a (1, N) or (N, 1)
+            array is read as a vector.
+        ts : float, optional
+            Sample time in seconds; default the scalar array named ``ts``,
+            else `default_ts`.
+        default_ts : float, optional
+            The sample time when neither `ts` nor the file gives one
+            (:class:`NoSampleTimeError` when none does).
         """
-        try:
-            with open(path, "rb") as fh:
-                magic = fh.read(4)
-        except OSError as exc:
-            raise ValueError(
-                f"{str(path)!r} is not a readable .npz file ({exc.strerror})"
-            ) from None
-        if magic != b"PK\x03\x04":
-            # np.load would take anything else for a pickle.
-            raise ValueError(
-                f"{str(path)!r} is not a .npz archive (a zip of .npy arrays, as "
-                "numpy.savez writes)"
-            )
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                mapping = dict(z.items())
-        except ValueError as exc:
-            if "allow_pickle" not in str(exc):
-                raise
-            raise ValueError(
-                f"{str(path)!r} holds Python objects, which spiralid never "
-                "unpickles (they can run code); save plain numeric arrays"
-            ) from None
-        except (OSError, EOFError) as exc:
-            raise ValueError(
-                f"{str(path)!r} is not a readable .npz file ({exc})"
-            ) from None
-        return cls._from_mapping(mapping, input, output, ts, path, default_ts)
+        return cls._from_mapping(_npz_arrays(path), input, output, ts, path, default_ts)
 
     @classmethod
     def from_mat(
@@ -439,46 +423,17 @@ class IOData:
         *,
         default_ts: float | None = None,
     ) -> IOData:
-        """Read variables from a MATLAB ``.mat`` file (``scipy.io.loadmat``).
-
-        ``ts=None`` reads the sample time from a scalar variable named ``ts``,
-        else takes `default_ts`.
-        """
-        from scipy.io import loadmat
-        from scipy.io.matlab import MatReadError
-
-        where = repr(str(path))
-        try:
-            with open(path, "rb"):
-                pass
-        except OSError as exc:
-            raise ValueError(
-                f"{where} is not a readable .mat file ({exc.strerror or exc})"
-            ) from None
-        try:
-            raw = loadmat(path)
-        except NotImplementedError:
-            # What scipy raises for MATLAB's HDF5-based format.
-            raise ValueError(
-                f"{where} is a MATLAB v7.3 file, which spiralid does not read; "
-                "save it with save(..., '-v7')"
-            ) from None
-        except (MatReadError, ValueError) as exc:
-            raise ValueError(
-                f"{where} is not a readable .mat file ({' '.join(str(exc).split())})"
-            ) from None
-        except Exception:
-            # SciPy's reader meets a truncated or corrupt file wherever its
-            # parsing fails (an OSError "could not read bytes", zlib.error,
-            # IndexError, KeyError...): none of them is a bug of ours.
-            raise ValueError(
-                f"{where} is not a readable .mat file (it is truncated or corrupt)"
-            ) from None
-        mat = {k: v for k, v in raw.items() if not k.startswith("__")}
-        return cls._from_mapping(mat, input, output, ts, path, default_ts)
+        """Read two variables of a MATLAB ``.mat`` file (``scipy.io.loadmat``;
+        MATLAB's v7.3 files are refused), with the arguments of
+        :meth:`from_npz`, variables in place of arrays."""
+        return cls._from_mapping(
+            _mat_variables(path), input, output, ts, path, default_ts
+        )
 
     @classmethod
     def _from_mapping(cls, mapping, input, output, ts, path, default_ts) -> IOData:
+        """The one reader of the formats that hold named arrays (.npz, .mat):
+        `mapping` is the file's arrays by name."""
         names = sorted(mapping)
         for key, arg in ((input, "input"), (output, "output")):
             if key not in mapping:
@@ -514,6 +469,74 @@ class IOData:
         return cls(
             arr(input, "input"), arr(output, "output"), ts, str(input), str(output)
         )
+
+
+def _npz_arrays(path) -> dict:
+    """The arrays of a ``.npz`` archive by name; anything that is not one,
+    or holds Python objects, is refused in one line."""
+    try:
+        with open(path, "rb") as fh:
+            magic = fh.read(4)
+    except OSError as exc:
+        raise ValueError(
+            f"{str(path)!r} is not a readable .npz file ({exc.strerror})"
+        ) from None
+    if magic != b"PK\x03\x04":
+        # np.load would take anything else for a pickle.
+        raise ValueError(
+            f"{str(path)!r} is not a .npz archive (a zip of .npy arrays, as "
+            "numpy.savez writes)"
+        )
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            mapping = dict(z.items())
+    except ValueError as exc:
+        if "allow_pickle" not in str(exc):
+            raise
+        raise ValueError(
+            f"{str(path)!r} holds Python objects, which spiralid never "
+            "unpickles (they can run code); save plain numeric arrays"
+        ) from None
+    except (OSError, EOFError) as exc:
+        raise ValueError(f"{str(path)!r} is not a readable .npz file ({exc})") from None
+    return mapping
+
+
+def _mat_variables(path) -> dict:
+    """The variables of a ``.mat`` file by name (MATLAB's ``__header__``
+    and the like left out); anything scipy cannot read is refused in one
+    line."""
+    from scipy.io import loadmat
+    from scipy.io.matlab import MatReadError
+
+    where = repr(str(path))
+    try:
+        with open(path, "rb"):
+            pass
+    except OSError as exc:
+        raise ValueError(
+            f"{where} is not a readable .mat file ({exc.strerror or exc})"
+        ) from None
+    try:
+        raw = loadmat(path)
+    except NotImplementedError:
+        # What scipy raises for MATLAB's HDF5-based format.
+        raise ValueError(
+            f"{where} is a MATLAB v7.3 file, which spiralid does not read; "
+            "save it with save(..., '-v7')"
+        ) from None
+    except (MatReadError, ValueError) as exc:
+        raise ValueError(
+            f"{where} is not a readable .mat file ({' '.join(str(exc).split())})"
+        ) from None
+    except Exception:
+        # SciPy's reader meets a truncated or corrupt file wherever its
+        # parsing fails (an OSError "could not read bytes", zlib.error,
+        # IndexError, KeyError...): none of them is a bug of ours.
+        raise ValueError(
+            f"{where} is not a readable .mat file (it is truncated or corrupt)"
+        ) from None
+    return {k: v for k, v in raw.items() if not k.startswith("__")}
 
 
 def _csv_table(path, delimiter: str = ",") -> tuple[list[str] | None, list]:
