@@ -90,7 +90,7 @@ from pathlib import Path
 
 import numpy as np
 
-from spiralid.optim import minimize
+from spiralid.optim import Restarts, minimize
 from spiralid.sysid import ARX, IOData, PaperCost, identify
 from spiralid.sysid.estimation.identify import default_bounds
 from spiralid.sysid.estimation.memetic import projected_spiral
@@ -187,9 +187,7 @@ def _projected(parametrization, method="ebsda", **kw):
     def run(est, seed, budget):
         cost = ProjectedCost(ARX_8, est)
         par = parametrization(est)
-        settings = dict(
-            n_points=50, polish_every=None, polish_nfev=10, restart_after=None
-        )
+        settings = dict(n_points=50, polish_every=None, polish_nfev=10, restarts=None)
         res = projected_spiral(
             cost, par, method, max_nfev=budget, rng=seed, **(settings | kw)
         )
@@ -279,12 +277,16 @@ METHODS = {
     "VP": (_projected(lambda est: _Reflection(8)), False, False),
     "modal+VP (SDA)": (_identify("sda", "modal"), False, False),
     "modal+VP": (_identify("ebsda", "modal"), False, False),
-    "modal+VP+restart": (_projected(_modal, restart_after=20), False, False),
+    "modal+VP+restart": (
+        _projected(_modal, restarts=Restarts(growth=1, stall=20)),
+        False,
+        False,
+    ),
     "modal+VP+fseed": (
         _identify(
             "spiral",
             polish_every=None,
-            restart_after=None,
+            restarts=False,
             safe_start=False,
             frequency_seeds=25,
         ),
@@ -292,12 +294,12 @@ METHODS = {
         False,
     ),
     "modal+VP+safe": (
-        _identify("spiral", polish_every=None, restart_after=None),
+        _identify("spiral", polish_every=None, restarts=False),
         False,
         False,
     ),
     "modal+VP+memetic": (
-        _identify("spiral", restart_after=None, safe_start=False),
+        _identify("spiral", restarts=False, safe_start=False),
         True,
         False,
     ),

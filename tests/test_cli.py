@@ -383,6 +383,6 @@ def test_a_search_option_for_a_method_that_searches_nothing_is_refused(tmp_path)
     out = run("identify", "robot_arm", "--method", "LS", "--budget", "100",
               "--seed=3", "--out", "m", cwd=tmp_path)  # fmt: skip
     assert out.returncode == 2 and len(out.stderr.splitlines()) == 1
-    assert "--budget, --seed apply to the search methods" in out.stderr
-    assert "--method ls takes none" in out.stderr
+    assert "--seed, --budget do not apply to --method ls; the options" in out.stderr
+    assert "the options that do: --predictor, --initial, --integrator" in out.stderr
     assert not (tmp_path / "m").exists()

@@ -123,7 +123,7 @@ CASES = [
     ("identify ok.csv --ts 0.01 --points 1", "--points must be an integer >= 2"),
     (
         "identify ok.csv --ts 0.01 --method ls --refine",
-        "--refine applies to the search methods",
+        "--refine does not apply to --method ls; the options that do: --predictor",
     ),
     ("identify ok.csv --ts 0.01 --budget 10", "--budget must be an integer"),
     ("identify ok.csv --ts 0.01 --iterations 0", "--iterations"),
@@ -170,16 +170,16 @@ CASES = [
         "--degree applies to --model polynomial, not to --model arx",
     ),
     (
-        "identify ok.csv --ts 0.01 --method ls --holdout 0.2",
-        "--holdout applies to --model narx and polynomial, not to --model arx",
+        "identify ok.csv --ts 0.01 --method ls --holdout 0.3",
+        "--holdout does not apply to --method ls; the options that do:",
     ),
     (
         "identify ok.csv --ts 0.01 --model polynomial --method ls --budget 10 --seed 5",
-        "--budget, --seed apply to the search methods",
+        "--seed, --budget do not apply to --method ls --model polynomial",
     ),
     (
         "identify ok.csv --ts 0.01 --model narx --method ls --budget 5",
-        "--budget applies to the search methods",
+        "--budget does not apply to --method ls --model narx; the options that do:",
     ),
     (
         "identify ok.csv --ts 0.01 --model narx --degree 4 --terms 3",

@@ -225,11 +225,11 @@ def test_oe_keeps_the_start_with_the_lower_cost(initial):
         ),
         (
             dict(method="ls", n_points=5),
-            "`optimiser_options` apply to the search methods",
+            "`n_points` does not apply to method 'ls'; the options that do: ",
         ),
         (
             dict(method="de", target=1.0),
-            r"`optimiser_options` of method 'de' must be among .*; got \['target'\]",
+            r"`target` does not apply to method 'de'; the options that do: .*max_nfev",
         ),
         (dict(predictor="two-step"), "`predictor` must be one of .*; got 'two-step'"),
         (dict(method="oe", initial="zero"), "`initial` must be one of .*; got 'zero'"),

@@ -4,13 +4,14 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
+from spiralid.optim import Restarts
 from spiralid.sysid import ARX, IOData
 from spiralid.sysid.estimation.memetic import frequency_seeds, projected_spiral
 from spiralid.sysid.estimation.modal import ModalParametrization
 from spiralid.sysid.estimation.varpro import ProjectedCost
 
 # A pure spiral search over the modes; tests set what they exercise.
-PLAIN = dict(n_points=50, polish_every=None, polish_nfev=10, restart_after=None)
+PLAIN = dict(n_points=50, polish_every=None, polish_nfev=10, restarts=None)
 
 
 def _two_modes(n=3000, ts=0.002, noise=0.0, seed=0):
@@ -39,7 +40,9 @@ def test_same_seed_same_result_and_budget_respected():
     data, _ = _two_modes(noise=0.05)
     cost = ProjectedCost(ARX(4, 3, 1), data)
     par = ModalParametrization(4, data.ts)
-    kw = PLAIN | dict(max_nfev=1500, polish_every=5, restart_after=10, rng=7)
+    kw = PLAIN | dict(
+        max_nfev=1500, polish_every=5, restarts=Restarts(growth=1, stall=10), rng=7
+    )
     one = projected_spiral(cost, par, "sda", **kw)
     two = projected_spiral(cost, par, "sda", **kw)
     assert np.array_equal(one.x, two.x) and one.fun == two.fun

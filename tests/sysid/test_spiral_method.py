@@ -63,7 +63,7 @@ def test_modal_parametrization_maps_to_the_projected_model(two_modes):
         (dict(initial="measured"), "`initial` must be 'rest'"),
         (dict(predictor="one-step"), "`predictor` must be 'simulation'"),
         (dict(parametrization="reflection"), "`parametrization` must be 'modal'"),
-        (dict(target=1.0), "`optimiser_options` of method 'spiral'"),
+        (dict(target=1.0), "`target` does not apply to method 'spiral'"),
     ],
 )
 def test_unsupported_settings_are_refused_clearly(two_modes, kwargs, match):
@@ -76,7 +76,8 @@ def test_unsupported_settings_are_refused_clearly(two_modes, kwargs, match):
     [
         (dict(max_nfev=10), "`max_nfev` must be an integer >= 50"),
         (dict(polish_every=0), "`polish_every`"),
-        (dict(restart_after=2.5), "`restart_after`"),
+        (dict(restart_after=2.5), "`restart_after` of method 'spiral' is now"),
+        (dict(restarts=2.5), "`restarts` must be True, False or a Restarts"),
         (dict(frequency_seeds=-1), "`frequency_seeds`"),
         (dict(n_points=1), "`n_points`"),
     ],

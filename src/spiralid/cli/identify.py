@@ -123,33 +123,18 @@ def _load_parts(args, progress, make_structure):
 
 def _run_narx(args) -> int:
     """`spiralid identify --model narx|polynomial`."""
-    from spiralid.sysid import METHODS, identify
+    from spiralid.sysid import identify
 
     with _progress(args) as progress:
         structure, est, val = _load_parts(args, progress, _narx_structure)
-        options = {}
-        if METHODS[args.method].search:
-            options = {"n_points": args.points}
-            if args.budget is not None:
-                options["max_nfev"] = args.budget
-            if args.iterations is not None:
-                options["max_iter"] = args.iterations
+        options = _identify_options(args, structure)
         with _open_folder(args.out, args.force) as folder:
             steps = _search_steps(args, narx=True)
             what = f"estimating {structure} by {args.method}"
             progress.phase("estimation", what, **steps)
             if steps:
                 options["callback"] = _search_callback(progress, steps, args)
-            model = identify(
-                est,
-                structure,
-                method=args.method,
-                predictor=args.predictor,
-                initial=args.initial,
-                rng=args.seed,
-                holdout=args.holdout,
-                **options,
-            )
+            model = identify(est, structure, method=args.method, **options)
             progress.phase("validation", "validating on both parts")
             v_est, v_val = _validated(model, est, val, args.method)
             progress.phase("writing", "writing files and figures")
@@ -261,28 +246,70 @@ def _write_timings(staged, progress, model=None) -> None:
     (staged / "timings.json").write_text(json.dumps(times, indent=2))
 
 
-# The options only a search takes (an MLP NARX draws its initial weights
-# from --seed whatever the method).
-_SEARCH_FLAGS = ("--points", "--iterations", "--budget", "--seed", "--parametrization")
+# The command's flags for identify()'s options: a typed flag is refused
+# exactly when identify() refuses its value for the method and structure
+# (--integrator is the structure's own for a NARX).
+_OPTION_FLAGS = {
+    "--predictor": "predictor",
+    "--initial": "initial",
+    "--seed": "rng",
+    "--integrator": "integrator",
+    "--max-time-constant": "max_time_constant",
+    "--parametrization": "parametrization",
+    "--refine": "refine",
+    "--points": "n_points",
+    "--iterations": "max_iter",
+    "--budget": "max_nfev",
+    "--holdout": "holdout",
+}
+_DESTS = {flag: flag.removeprefix("--").replace("-", "_") for flag in _OPTION_FLAGS}
 
-# The options of one kind of --model: the models they apply to.
+# The structure options of one kind of --model: the models they apply to.
 _MODEL_FLAGS = {
-    "--refine": ("arx",),
-    "--parametrization": ("arx",),
-    "--max-time-constant": ("arx",),
     "--hidden": ("narx",),
     "--activation": ("narx",),
     "--degree": ("polynomial",),
     "--terms": ("polynomial",),
-    "--holdout": ("narx", "polynomial"),
 }
+
+
+def _example_structure(model: str):
+    """A structure of the kind --model asks for (its options' table)."""
+    from spiralid.sysid import ARX, NARX, PolynomialNARX
+
+    kinds = {"arx": ARX, "narx": NARX, "polynomial": PolynomialNARX}
+    return kinds[model](1, 1, 0)
+
+
+def _option_values(args) -> dict:
+    """identify()'s options as the command's flags set them, by name."""
+    values = {name: getattr(args, _DESTS[flag]) for flag, name in _OPTION_FLAGS.items()}
+    if args.model != "arx":
+        del values["integrator"]
+    return values
+
+
+def _identify_options(args, structure) -> dict:
+    """What `run` passes to identify(): the options that apply to the
+    method and structure (identify_options), less the budgets not given."""
+    from spiralid.sysid.estimation.identify import identify_options
+
+    takes = identify_options(args.method, structure, args.refine)
+    return {
+        name: value
+        for name, value in _option_values(args).items()
+        if name in takes
+        and not (value is None and name in ("max_iter", "max_nfev", "parametrization"))
+    }
 
 
 def _check_options(args) -> None:
     """Refuse, before any data is read, what the model and method cannot
-    do and the options they would ignore without a word (identify()
-    refuses the same from Python), given equal to their defaults or not."""
+    do, and every typed option identify() would refuse from Python for this
+    method and structure (identify_options, the one table), with the
+    options that do apply."""
     from spiralid.sysid import METHODS
+    from spiralid.sysid.estimation.identify import identify_options, refused_options
 
     model, method = args.model, args.method
     if model != "arx" and METHODS[method].narx is None:
@@ -296,40 +323,28 @@ def _check_options(args) -> None:
             _given(args, *flags),
             f"to --model {' and '.join(owners)}, not to --model {model}",
         )
-    spec = METHODS[method]
-    if model == "arx" and not (spec.margin or (spec.search and args.refine)):
-        margin = ", ".join(name for name, m in METHODS.items() if m.margin)
-        _refuse_unused(
-            _given(args, "--max-time-constant"),
-            f"to --method {margin} and to --refine's polish, not to --method "
-            f"{method}" + (" without --refine" if spec.search else ""),
-        )
-    if METHODS[method].search:
-        return
-    searches = ", ".join(name for name, m in METHODS.items() if m.search)
-    if model == "arx":
-        flags = [*_given(args, *_SEARCH_FLAGS), *_given(args, "--refine")]
-        _refuse_unused(
-            flags, f"to the search methods {searches}; --method {method} takes none"
-        )
-    elif model == "narx":
-        flags = _given(args, "--points", "--iterations", "--budget")
-        _refuse_unused(
-            flags, f"to the search methods {searches}; --method {method} takes none"
-        )
-    else:
-        # Forward regression chooses its terms deterministically.
-        flags = _given(args, "--points", "--iterations", "--budget", "--seed")
-        seed = " (--seed also to --model narx)" if "--seed" in flags else ""
-        _refuse_unused(
-            flags,
-            f"to the search methods {searches}{seed}; --model polynomial "
-            f"--method {method} takes none",
+    structure = _example_structure(model)
+    values = _option_values(args)
+    typed = {
+        _OPTION_FLAGS[f]: values[_OPTION_FLAGS[f]]
+        for f in _given(args, *_OPTION_FLAGS)
+        if _OPTION_FLAGS[f] in values
+    }
+    refused = refused_options(method, typed, structure)
+    if refused:
+        flags = [f for f, name in _OPTION_FLAGS.items() if name in refused]
+        takes = identify_options(method, structure, args.refine)
+        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
+        kind = "" if model == "arx" else f" --model {model}"
+        verb = "does" if len(flags) == 1 else "do"
+        raise UsageError(
+            f"{', '.join(flags)} {verb} not apply to --method {method}{kind}; "
+            f"the options that do: {', '.join(able)}"
         )
 
 
 def run(args, argv: list[str]) -> int:
-    from spiralid.sysid import METHODS, identify
+    from spiralid.sysid import identify
     from spiralid.sysid.validation.plots import plot_convergence
 
     _check_options(args)
@@ -337,30 +352,14 @@ def run(args, argv: list[str]) -> int:
         return _run_narx(args)
     with _progress(args) as progress:
         arx, est, val = _load_parts(args, progress, _structure)
-        options = {}
-        if METHODS[args.method].search:
-            # The budget rule is identify()'s (estimators.search_options).
-            options = {"n_points": args.points, "max_nfev": args.budget}
-            if args.iterations is not None:
-                options["max_iter"] = args.iterations
+        # The budget rule is identify()'s (estimators.search_options).
+        options = _identify_options(args, arx)
         with _open_folder(args.out, args.force) as folder:
             steps = _search_steps(args)
             progress.phase("estimation", f"estimating {arx} by {args.method}", **steps)
             if steps:
                 options["callback"] = _search_callback(progress, steps, args)
-            model = identify(
-                est,
-                arx,
-                method=args.method,
-                predictor=args.predictor,
-                initial=args.initial,
-                integrator=args.integrator,
-                parametrization=args.parametrization,
-                refine=args.refine,
-                rng=args.seed,
-                max_time_constant=args.max_time_constant,
-                **options,
-            )
+            model = identify(est, arx, method=args.method, **options)
             model.fraction = args.fraction
             progress.phase("validation", "validating on both parts")
             v_est, v_val = _validated(model, est, val, args.method)

@@ -93,7 +93,7 @@ import numpy as np
 
 from spiralid._checks import integer
 from spiralid.choices import DEFAULT_METHOD, METHOD_NAMES, require_names
-from spiralid.optim import RULES, differential_evolution, minimize
+from spiralid.optim import RULES, Restarts, differential_evolution, minimize
 from spiralid.optim.result import STATUS, OptimiserResult
 
 from ..data import IOData
@@ -112,10 +112,12 @@ from .parametrizations import (
 __all__ = [
     "DEFAULT_METHOD",
     "METHODS",
+    "SEARCH_PROBLEM_OPTIONS",
     "STATUS",
     "EstimatorResult",
     "Method",
     "Problem",
+    "method_options",
     "search_options",
 ]
 
@@ -239,9 +241,10 @@ class Method:
     search : bool
         A population search over a parametrisation: takes optimiser options,
         ``rng``, ``bounds``, ``refine`` and ``safe_start``.
-    options : tuple of str or None
-        The optimiser options it accepts; None: any of
-        :func:`spiralid.optim.minimize`'s.
+    options : tuple of str
+        The optimiser options it accepts (the keyword-only parameters of
+        what runs it, :func:`_keyword_options`); empty for a method that
+        does not search.
     safe_start : bool
         Default of ``identify(safe_start=None)`` (see the module docstring).
     parametrization : str
@@ -262,17 +265,21 @@ class Method:
         Default of ``identify(cancel=None)``: remove near-cancelling
         pole-zero pairs after the estimate; False: the option does not
         apply.
+    narx_options : tuple of str
+        The options of its NARX estimator (beside ``identify_narx``'s own
+        ``holdout`` and ``decay``); empty without one.
     """
 
     estimate: Callable[..., EstimatorResult]
     search: bool = True
-    options: tuple[str, ...] | None = None
+    options: tuple[str, ...] = ()
     safe_start: bool = False
     parametrization: str = DEFAULT_PARAMETRIZATION
     narx: Callable[..., OptimiserResult] | None = None
     minimises: str | None = None
     margin: bool = False
     cancel: bool = False
+    narx_options: tuple[str, ...] = ()
 
 
 def search_options(options: dict) -> dict:
@@ -550,6 +557,16 @@ def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
     return np.clip(np.array(rows[:n_points]), box[:, 0], box[:, 1]), safe
 
 
+# The spiral method's restarts: a fresh population of the same size after
+# 20 iterations without progress, not minimize's Restarts() (doubling
+# population, max(30, 4 n) stalled iterations). The memetic polish keeps
+# improving a stalled population by ever smaller steps, so it is cut off
+# sooner, and the budget is one of evaluations, which a growing population
+# would spend on fewer iterations; chosen with benchmarks/identification.py
+# (docs/design-notes.md, "method='spiral'").
+SPIRAL_RESTARTS = Restarts(growth=1.0, stall=20)
+
+
 def _estimate_recommended(
     problem: Problem,
     *,
@@ -558,7 +575,7 @@ def _estimate_recommended(
     max_nfev: int | None = None,
     polish_every: int | None = 5,
     polish_nfev: int = 10,
-    restart_after: int | None = 20,
+    restarts: bool | Restarts = SPIRAL_RESTARTS,
     frequency_seeds: int = 0,
     holdback: float | None = HOLDBACK,
     x0=None,
@@ -572,8 +589,11 @@ def _estimate_recommended(
     (:class:`~spiralid.sysid.estimation.parametrizations.Modal`), its centre polished
     every `polish_every` iterations by `polish_nfev` evaluations of
     Levenberg-Marquardt on the projected problem, a fresh population after
-    `restart_after` iterations without progress
-    (:func:`~spiralid.sysid.estimation.memetic.projected_spiral`), `frequency_seeds`
+    ``restarts.stall`` iterations without progress (`restarts`, as
+    :func:`~spiralid.optim.minimize` takes it: a
+    :class:`~spiralid.optim.Restarts`, True for ``Restarts()`` or False;
+    the default is :data:`SPIRAL_RESTARTS`;
+    :func:`~spiralid.sysid.estimation.memetic.projected_spiral`), `frequency_seeds`
     initial points at the frequency response's peaks, and with the safe
     start the stabilised least-squares, Steiglitz-McBride and zero models in
     the first population. With the safe start (the default) the search's
@@ -621,6 +641,7 @@ def _estimate_recommended(
             f"{problem.parametrization.name!r}"
         )
     holdback = _holdback_share(holdback)
+    restarts = _spiral_restarts(restarts)
     if frequency_seeds:
         frequency_seeds = integer(frequency_seeds, "frequency_seeds", 0)
     settings = dict(
@@ -629,7 +650,7 @@ def _estimate_recommended(
         max_nfev=10_000 if max_nfev is None else max_nfev,
         polish_every=polish_every,
         polish_nfev=polish_nfev,
-        restart_after=restart_after,
+        restarts=restarts,
         frequency_seeds=frequency_seeds,
         x0=x0,
         max_iter=max_iter,
@@ -653,6 +674,22 @@ def _estimate_recommended(
     if problem.cancel:
         _cancel(problem, result, problem.cost)
     return result
+
+
+def _spiral_restarts(restarts) -> Restarts | None:
+    """`restarts` of method 'spiral' checked: a Restarts (True: the
+    default ``Restarts()``) or None for False; a collapse radius other than
+    the default is refused, as the memetic search restarts on stalls only."""
+    from spiralid.optim.restarts import parse_restarts
+
+    parsed = parse_restarts(restarts)
+    if parsed is not None and parsed.tol_radius != Restarts.tol_radius:
+        raise ValueError(
+            "`restarts.tol_radius` does not apply to method 'spiral' (it "
+            "restarts after `stall` iterations without progress, with `growth`);"
+            f" got {parsed.tol_radius!r}"
+        )
+    return parsed
 
 
 def _holdback_share(holdback) -> float:
@@ -715,7 +752,7 @@ def _spiral_search(
     max_nfev,
     polish_every,
     polish_nfev,
-    restart_after,
+    restarts,
     frequency_seeds,
     x0,
     max_iter,
@@ -740,7 +777,7 @@ def _spiral_search(
         max_nfev=max_nfev,
         polish_every=polish_every,
         polish_nfev=polish_nfev,
-        restart_after=restart_after,
+        restarts=restarts,
         x0=start,
         max_iter=max_iter,
         callback=callback,
@@ -812,6 +849,8 @@ def _keyword_options(function: Callable, own: tuple[str, ...] = ()) -> tuple[str
     )
 
 
+_MINIMIZE_OPTIONS = _keyword_options(minimize, own=("method", "rng", "vectorized"))
+
 # One entry per method; its key is the name users pass.
 METHODS: dict[str, Method] = {
     **{
@@ -819,8 +858,9 @@ METHODS: dict[str, Method] = {
             partial(_estimate_spiral, rule=name),
             # The rule is the method's own, so a method bound to one rule
             # cannot be re-ruled.
-            options=_keyword_options(minimize, own=("method", "rng", "vectorized")),
+            options=_MINIMIZE_OPTIONS,
             narx=partial(_narx.estimate_search, rule=name),
+            narx_options=_MINIMIZE_OPTIONS,
         )
         for name in RULES
     },
@@ -836,13 +876,51 @@ METHODS: dict[str, Method] = {
         narx=_narx.estimate_spiral,
         margin=True,
         cancel=True,
+        narx_options=_keyword_options(_narx.estimate_spiral),
     ),
     "ls": Method(
-        _estimate_ls, search=False, narx=_narx.estimate_ls, minimises="one-step"
+        _estimate_ls,
+        search=False,
+        options=(),
+        narx=_narx.estimate_ls,
+        minimises="one-step",
+        narx_options=_keyword_options(_narx.estimate_ls),
     ),
     "oe": Method(
-        _estimate_oe, search=False, narx=_narx.estimate_oe, margin=True, cancel=True
+        _estimate_oe,
+        search=False,
+        options=(),
+        narx=_narx.estimate_oe,
+        margin=True,
+        cancel=True,
+        narx_options=_keyword_options(_narx.estimate_oe),
     ),
 }
+
+# What identify() takes beside a search's optimiser options: what the
+# search moves, its box, the polish after it and the safe start. Methods
+# that do not search (ls, oe) take none of them.
+SEARCH_PROBLEM_OPTIONS = ("parametrization", "bounds", "refine", "safe_start")
+
+
+def method_options(method: str, narx: bool = False) -> tuple[str, ...]:
+    """The options `method` takes through ``identify(**options)``: for an
+    ARX structure a search's :data:`SEARCH_PROBLEM_OPTIONS` and its
+    optimiser's, for a NARX structure its NARX estimator's (beside
+    ``holdout`` and ``decay``). The one table the entry points, the command
+    line and the tests read.
+
+    Examples
+    --------
+    >>> method_options("ls")
+    ()
+    >>> method_options("ls", narx=True)
+    ('max_rounds', 'patience')
+    """
+    spec = METHODS[method]
+    if narx:
+        return spec.narx_options
+    return (*SEARCH_PROBLEM_OPTIONS, *spec.options) if spec.search else ()
+
 
 require_names(METHODS, METHOD_NAMES, "spiralid.sysid.METHODS")

@@ -47,7 +47,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from spiralid._checks import box_bounds, generator
+from spiralid._checks import box_bounds, generator, is_default, refuse_options
 
 from ..data import IOData
 from ..models.arx import ARX
@@ -56,7 +56,7 @@ from ..models.narx import NARX, PolynomialNARX
 from ..models.polynomials import integrator_count, with_integrator
 from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
-from .estimators import DEFAULT_METHOD, METHODS, Problem
+from .estimators import DEFAULT_METHOD, METHODS, Problem, method_options
 from .margin import AUTO, max_radius
 from .outputerror import steiglitz_mcbride
 from .parametrizations import (
@@ -69,10 +69,14 @@ from .parametrizations import (
 from .uncertainty import parameter_covariance
 
 __all__ = [
+    "IDENTIFY_DEFAULTS",
     "IdentifiedModel",
+    "check_method_options",
     "default_bounds",
     "feasible_initial_points",
     "identify",
+    "identify_options",
+    "refused_options",
     "steiglitz_mcbride",
 ]
 
@@ -81,43 +85,143 @@ def _check_bounds(bounds, p: int) -> np.ndarray:
     return np.column_stack(box_bounds(bounds, p))
 
 
-def check_method_options(method: str, options: dict) -> None:
-    """The one check of a method's options against what it declares
-    (:data:`METHODS`), for `identify`, the command line and study files
-    alike: a one-line ValueError before any work."""
+# identify's arguments by name with their defaults; an argument equal to
+# its default is never refused, whatever the method or structure.
+IDENTIFY_DEFAULTS = dict(
+    predictor="simulation",
+    initial="rest",
+    rng=None,
+    gain="auto",
+    penalty=1e6,
+    integrator=False,
+    max_time_constant=AUTO,
+    cancel=None,
+    parametrization=None,
+    bounds=None,
+    refine=False,
+    safe_start=None,
+    # A NARX's early stopping and weight decay (identify_narx's).
+    holdout=0.2,
+    decay=1e-3,
+)
+# Names identify's methods no longer take, and what to use instead.
+_RENAMED = {
+    "restart_after": (
+        "`restart_after` of method 'spiral' is now `restarts`: "
+        "restarts=Restarts(stall=k, growth=1) (False for none)"
+    ),
+    "polish_iterations": (
+        "`polish_iterations` of the NARX method 'spiral' is now `polish_nfev`"
+    ),
+}
+
+
+def identify_options(method: str, structure, refine: bool = False) -> tuple[str, ...]:
+    """Every option :func:`identify` takes for `method` and `structure`,
+    its own arguments and ``**options`` alike; the one table `identify`,
+    the command line and the tests check against.
+
+    For an ARX structure: ``predictor``, ``initial``, ``gain``,
+    ``penalty`` and ``integrator`` always; ``rng`` for a search;
+    ``max_time_constant`` for the methods with ``Method.margin`` and a
+    search with ``refine=True``; ``cancel`` for those with
+    ``Method.cancel``; then
+    :func:`~spiralid.sysid.estimation.estimators.method_options`.
+    For a NARX: ``predictor``, ``initial``, ``rng``, ``holdout``, ``decay``
+    and the method's NARX estimator's options; a PolynomialNARX (forward
+    regression, deterministic) takes ``predictor`` and ``initial`` only.
+
+    Examples
+    --------
+    >>> identify_options("ls", ARX(2, 2, 1))
+    ('predictor', 'initial', 'gain', 'penalty', 'integrator')
+    >>> identify_options("oe", NARX(2, 2, 1))
+    ('predictor', 'initial', 'rng', 'holdout', 'decay', 'max_rounds', 'patience')
+    """
+    if isinstance(structure, PolynomialNARX):
+        return ("predictor", "initial")
+    if isinstance(structure, NARX):
+        own = ("predictor", "initial", "rng", "holdout", "decay")
+        return (*own, *method_options(method, narx=True))
+    spec = METHODS[method]
+    out = ["predictor", "initial", "gain", "penalty", "integrator"]
+    if spec.search:
+        out.append("rng")
+    if spec.margin or (spec.search and _is_true(refine)):
+        out.append("max_time_constant")
+    if spec.cancel:
+        out.append("cancel")
+    return (*out, *method_options(method))
+
+
+def _is_true(value) -> bool:
+    return isinstance(value, bool | np.bool_) and bool(value)
+
+
+def _check_method(method) -> str:
+    """`method` as a key of METHODS (any case), or a one-line ValueError."""
+    if isinstance(method, str):
+        # As minimize and scipy.optimize.minimize: names in any case.
+        method = method.lower()
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
-    spec = METHODS[method]
-    if not spec.search and options:
-        searches = tuple(name for name, m in METHODS.items() if m.search)
-        raise ValueError(
-            f"`optimiser_options` apply to the search methods {searches}; method "
-            f"{method!r} got {sorted(options)}"
-        )
-    if spec.options is not None and set(options) - set(spec.options):
-        raise ValueError(
-            f"`optimiser_options` of method {method!r} must be among "
-            f"{spec.options}; got {sorted(set(options) - set(spec.options))}"
-        )
+    return method
+
+
+def refused_options(method: str, options: dict, structure=None) -> list[str]:
+    """The names in `options` that :func:`check_method_options` refuses
+    for `method` and `structure` (default an ARX), in their order."""
+    structure = ARX(1, 1, 0) if structure is None else structure
+    applicable = identify_options(method, structure, options.get("refine", False))
+    defaults = IDENTIFY_DEFAULTS
+    return [
+        name
+        for name, value in options.items()
+        if name not in applicable
+        and not (name in defaults and is_default(value, defaults[name]))
+    ]
+
+
+def check_method_options(method: str, options: dict, structure=None) -> None:
+    """The one check of the options given to `method` for `structure`
+    (default an ARX) against :func:`identify_options`, for `identify`, the
+    command line and study files alike: a one-line ValueError naming the
+    first option that does not apply, the method and the options that do,
+    before any work. An option equal to :data:`IDENTIFY_DEFAULTS`' value is
+    never refused."""
+    method = _check_method(method)
+    structure = ARX(1, 1, 0) if structure is None else structure
+    for name in options:
+        if name in _RENAMED:
+            raise ValueError(_RENAMED[name])
+    kind = ""
+    if isinstance(structure, NARX | PolynomialNARX):
+        if METHODS[method].narx is None:
+            able = tuple(name for name, m in METHODS.items() if m.narx is not None)
+            raise ValueError(
+                f"`method` {method!r} does not train NARX models; use one of {able}"
+            )
+        kind = f" for a {type(structure).__name__}"
+    applicable = identify_options(method, structure, options.get("refine", False))
+    refuse_options(
+        options, applicable, f"method {method!r}{kind}", defaults=IDENTIFY_DEFAULTS
+    )
 
 
 def identify(
     data: IOData,
     arx: ARX,
     method: str = DEFAULT_METHOD,
+    *,
     predictor: str = "simulation",
-    parametrization: str | None = None,
+    initial: str = "rest",
     rng=None,
-    refine: bool = False,
     gain: str | float = "auto",
     penalty: float = 1e6,
-    bounds=None,
-    initial: str = "rest",
-    safe_start: bool | None = None,
     integrator: bool | int = False,
     max_time_constant: float | str | None = AUTO,
     cancel: bool | None = None,
-    **optimiser_options,
+    **options,
 ) -> IdentifiedModel:
     """Estimate an ARX model from input-output data.
 
@@ -129,7 +233,7 @@ def identify(
         Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6). A NARX
         structure is trained by the method's NARX estimator
         (:mod:`spiralid.sysid.estimation.narx`; ``holdout`` passed through
-        `optimiser_options` sets its early-stopping share) and returns a
+        `options` sets its early-stopping share) and returns a
         :class:`~spiralid.sysid.models.narx.NARXModel`.
     method : str, default "spiral"
         A key of :data:`spiralid.sysid.estimation.estimators.METHODS`, in
@@ -146,37 +250,16 @@ def identify(
     predictor : {"simulation", "one-step"}
         The error of the paper's cost, eq. (2): the free-run simulation
         error or the one-step prediction error.
-    parametrization : str, optional
-        What a search moves, a key of
-        :data:`spiralid.sysid.estimation.parametrizations.PARAMETRIZATIONS`:
-        ``"coefficients"`` (the paper's), ``"reflection"`` (stable by
-        construction) or ``"modal"`` (the denominator's modes, numerator
-        projected out; simulation error from rest only). Default: the
-        method's (``"modal"`` for ``"spiral"``, which needs it;
-        ``"coefficients"`` otherwise).
     rng : int, numpy.random.Generator or None
-        Randomness of a search (initial points and the search).
-    refine : bool
-        Polish a search's result locally with the ``"oe"`` machinery applied
-        to the `predictor`'s error (kept only if it lowers the cost).
-        Ignored by ``"ls"`` and ``"oe"``.
+        Randomness of a search (initial points and the search), or of a
+        NARX's initial weights.
     gain, penalty
         The cost's gain ``w`` and stability penalty, see :class:`PaperCost`.
-    bounds : array_like, shape (p, 2), optional
-        Search box in the searched parameters (``[a, b]`` or ``[k, b]``);
-        default :func:`default_bounds`.
     initial : {"rest", "measured"}, default "rest"
         Initial condition of the simulation error (the cost, ``"oe"`` and
         ``refine``), see :class:`PaperCost` and the module docstring:
         ``"rest"`` (paper-faithful) for records that start at rest,
         ``"measured"`` for records that start in motion.
-    safe_start : bool, optional
-        Seed a search's first population with the stabilised least-squares
-        estimate and the zero model, and let ``refine`` start from least
-        squares and Steiglitz-McBride too, so the result is never worse than
-        either (see :mod:`spiralid.sysid.estimation.estimators`). Default: the method's
-        (off for the paper's ``"sda"``, ``"ebsda"`` and for ``"lasda"``,
-        ``"de"``). Ignored by ``"ls"`` and ``"oe"``.
     integrator : bool or int
         The output integrates (a pole at z = 1 known beforehand, as the
         rig's hub velocity integrates its torque): ``arx.na`` counts it, the
@@ -215,18 +298,89 @@ def identify(
         the structure asked for, with zero coefficients where the pair was;
         ``effective_order`` and ``cancellations`` say what was removed.
         Refused by the other methods.
-    **optimiser_options
-        Passed to :func:`spiralid.optim.minimize` (``n_points``, ``max_iter``,
-        ``max_nfev``, ``target``, ``callback``, ``bounds_policy``, ``x0``...);
-        for ``"de"`` only ``n_points``, ``max_iter``, ``max_nfev``, ``x0`` and
-        ``callback``. A budget ``max_nfev`` without ``max_iter`` is the stop
+    **options
+        The method's own options (:func:`identify_options` lists them per
+        method and structure; the Notes give the table): for a search,
+        those under Other Parameters and its optimiser's
+        (:func:`spiralid.optim.minimize`'s ``n_points``, ``max_iter``,
+        ``max_nfev``, ``target``, ``callback``, ``bounds_policy``,
+        ``restarts``, ``x0``...; for ``"de"`` only ``n_points``,
+        ``max_iter``, ``max_nfev``, ``x0`` and ``callback``; for
+        ``"spiral"`` those of
+        :func:`~spiralid.sysid.estimation.estimators._estimate_recommended`).
+        A budget ``max_nfev`` without ``max_iter`` is the stop
         (:func:`~spiralid.sysid.estimation.estimators.search_options`).
+        For a NARX: ``holdout`` and ``decay``
+        (:func:`~spiralid.sysid.estimation.narx.identify_narx`) and its
+        estimator's. Any option that does not apply to the method and
+        structure is refused in one line naming it, the method and the
+        options that do, unless it equals its default
+        (:data:`IDENTIFY_DEFAULTS`, compared by value).
+
+    Other Parameters
+    ----------------
+    parametrization : str, optional
+        What a search moves, a key of
+        :data:`spiralid.sysid.estimation.parametrizations.PARAMETRIZATIONS`:
+        ``"coefficients"`` (the paper's), ``"reflection"`` (stable by
+        construction) or ``"modal"`` (the denominator's modes, numerator
+        projected out; simulation error from rest only). Default: the
+        method's (``"modal"`` for ``"spiral"``, which needs it;
+        ``"coefficients"`` otherwise). Search methods only.
+    bounds : array_like, shape (p, 2), optional
+        Search box in the searched parameters (``[a, b]`` or ``[k, b]``);
+        default :func:`default_bounds`. Search methods only.
+    refine : bool, default False
+        Polish a search's result locally with the ``"oe"`` machinery applied
+        to the `predictor`'s error (kept only if it lowers the cost).
+        Search methods only.
+    safe_start : bool, optional
+        Seed a search's first population with the stabilised least-squares
+        estimate and the zero model, and let ``refine`` start from least
+        squares and Steiglitz-McBride too, so the result is never worse than
+        either (see :mod:`spiralid.sysid.estimation.estimators`). Default: the method's
+        (off for the paper's ``"sda"``, ``"ebsda"`` and for ``"lasda"``,
+        ``"de"``). Search methods only.
 
     Returns
     -------
     IdentifiedModel
         Its ``result`` is the estimator's
         :class:`~spiralid.sysid.estimation.estimators.EstimatorResult`.
+
+    Notes
+    -----
+    Options by method, beside ``predictor``, ``initial``, ``gain``,
+    ``penalty`` and ``integrator``, which every method takes for an ARX
+    structure (with ``"ls"`` and ``"oe"``, `predictor`, `gain` and `penalty`
+    only set the reported cost):
+
+    - ``"ls"``: none.
+    - ``"oe"``: ``max_time_constant``, ``cancel``.
+    - ``"spiral"``: ``rng``, ``max_time_constant``, ``cancel``,
+      ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
+      ``rule``, ``n_points``, ``max_nfev``, ``polish_every``,
+      ``polish_nfev``, ``restarts``, ``frequency_seeds``, ``holdback``,
+      ``x0``, ``max_iter``, ``callback``.
+    - ``"de"``: ``rng``, ``max_time_constant`` (with ``refine=True``),
+      ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
+      ``n_points``, ``max_iter``, ``max_nfev``, ``x0``, ``callback``.
+    - every rule of :data:`spiralid.optim.RULES` (``"sda"``, ``"ebsda"``,
+      ``"lasda"``, ...): ``rng``, ``max_time_constant`` (with
+      ``refine=True``), ``parametrization``, ``bounds``, ``refine``,
+      ``safe_start``, ``n_points``, ``max_iter``, ``max_nfev``,
+      ``max_time``, ``target``, ``x0``, ``callback``, ``bounds_policy``,
+      ``restarts``.
+
+    For a NARX structure every method takes ``predictor``, ``initial``,
+    ``rng``, ``holdout`` and ``decay``, and: ``"ls"`` and ``"oe"``
+    ``max_rounds``, ``patience``; ``"spiral"`` ``rule``, ``n_points``,
+    ``max_nfev``, ``polish_every``, ``polish_nfev``, ``max_iter``; a rule
+    ``n_points``, ``max_iter``, ``max_nfev``, ``max_time``, ``target``,
+    ``x0``, ``callback``, ``bounds_policy``, ``restarts``. A
+    PolynomialNARX (``"ls"`` only) takes ``predictor`` and ``initial``.
+    ``tests/test_option_contract.py`` checks this table against
+    :func:`identify_options` and the command line.
 
     Examples
     --------
@@ -241,66 +395,62 @@ def identify(
     t_start = time.perf_counter()
     if not isinstance(data, IOData):
         raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
-    if isinstance(arx, NARX | PolynomialNARX):
-        return _identify_narx(
-            data,
-            arx,
-            method,
-            predictor=predictor,
-            initial=initial,
-            rng=rng,
-            other=dict(
-                parametrization=parametrization,
-                refine=refine,
-                gain=gain,
-                penalty=penalty,
-                bounds=bounds,
-                safe_start=safe_start,
-                integrator=integrator,
-                max_time_constant=max_time_constant,
-                cancel=cancel,
-            ),
-            **optimiser_options,
-        )
-    if not isinstance(arx, ARX):
+    if not isinstance(arx, ARX | NARX | PolynomialNARX):
         raise ValueError(
             f"`arx` must be an ARX, NARX or PolynomialNARX; got {type(arx).__name__}"
         )
-    integrator = integrator_count(integrator, arx.na)
-    if isinstance(method, str):
-        # As minimize and scipy.optimize.minimize: names in any case.
-        method = method.lower()
-    if integrator:
-        return _identify_integrating(
-            data,
-            arx,
-            integrator,
-            dict(
-                method=method,
-                predictor=predictor,
-                parametrization=parametrization,
-                rng=rng,
-                refine=refine,
-                gain=gain,
-                penalty=penalty,
-                bounds=bounds,
-                initial=initial,
-                safe_start=safe_start,
-                max_time_constant=max_time_constant,
-                cancel=cancel,
-                **optimiser_options,
-            ),
+    method = _check_method(method)
+    given = dict(
+        predictor=predictor,
+        initial=initial,
+        rng=rng,
+        gain=gain,
+        penalty=penalty,
+        integrator=integrator,
+        max_time_constant=max_time_constant,
+        cancel=cancel,
+        **options,
+    )
+    check_method_options(method, given, arx)
+    if not isinstance(arx, ARX):
+        from .narx import identify_narx
+
+        takes = identify_options(method, arx)
+        narx = {k: v for k, v in given.items() if k in takes}
+        return identify_narx(
+            data, arx, method=method, estimate=METHODS[method].narx, **narx
         )
-    check_method_options(method, optimiser_options)
+    count = integrator_count(integrator, arx.na)
+    if count:
+        del given["integrator"]
+        return _identify_integrating(data, arx, count, dict(method=method, **given))
+    problem, options = _problem(method, data, arx, given)
+    return _estimate(method, problem, options, t_start)
+
+
+def _problem(method: str, data: IOData, arx: ARX, given: dict):
+    """identify's checked arguments as a :class:`Problem`, and the options
+    left for the estimator."""
+    spec = METHODS[method]
+    settings = {**IDENTIFY_DEFAULTS, **given}
+    options = {k: v for k, v in given.items() if k not in IDENTIFY_DEFAULTS}
+    refine, safe_start = settings["refine"], settings["safe_start"]
+    if not isinstance(refine, bool | np.bool_):
+        raise ValueError(f"`refine` must be True or False; got {refine!r}")
+    if safe_start is not None and not isinstance(safe_start, bool | np.bool_):
+        raise ValueError(
+            f"`safe_start` must be True, False or None; got {safe_start!r}"
+        )
+    parametrization = settings["parametrization"]
     if parametrization is None:
-        parametrization = METHODS[method].parametrization
+        parametrization = spec.parametrization
         if arx.na == 0 and parametrization == "modal":
             # An FIR model has no modes; the recommended method solves it
             # exactly over the coefficients (see `_estimate_fir`).
             parametrization = DEFAULT_PARAMETRIZATION
-    if not isinstance(refine, bool | np.bool_):
-        raise ValueError(f"`refine` must be True or False; got {refine!r}")
-    radius, cancel = margin_options(method, data, refine, max_time_constant, cancel)
+    radius, cancel = margin_options(
+        method, data, refine, settings["max_time_constant"], settings["cancel"]
+    )
     # The margin inside the search: for the methods that apply it, in a
     # parametrisation that can hold it (a paper search's refine polishes alone).
     kind = (
@@ -308,13 +458,10 @@ def identify(
         if isinstance(parametrization, str)
         else None
     )
-    inside = METHODS[method].margin and getattr(kind, "takes_margin", False)
+    inside = spec.margin and getattr(kind, "takes_margin", False)
     par = make_parametrization(parametrization, data, arx, radius if inside else None)
-    if safe_start is not None and not isinstance(safe_start, bool | np.bool_):
-        raise ValueError(
-            f"`safe_start` must be True, False or None; got {safe_start!r}"
-        )
-    spec = METHODS[method]
+    predictor, initial = settings["predictor"], settings["initial"]
+    gain, penalty, bounds = settings["gain"], settings["penalty"], settings["bounds"]
     cost = PaperCost(
         arx, data, predictor=predictor, gain=gain, penalty=penalty, initial=initial
     )
@@ -327,14 +474,24 @@ def identify(
         gain=gain,
         penalty=penalty,
         parametrization=par,
-        rng=generator(rng),
+        rng=generator(settings["rng"]),
         bounds=None if bounds is None else _check_bounds(bounds, par.n_search),
         refine=bool(refine),
         safe_start=spec.safe_start if safe_start is None else bool(safe_start),
         max_radius=radius,
         cancel=cancel,
     )
-    res = spec.estimate(problem, **optimiser_options)
+    return problem, options
+
+
+def _estimate(
+    method: str, problem: Problem, options: dict, t_start: float
+) -> IdentifiedModel:
+    """Run the method on the problem; the model with its covariance."""
+    spec = METHODS[method]
+    data, arx, cost = problem.data, problem.arx, problem.cost
+    predictor, initial = problem.predictor, problem.initial
+    res = spec.estimate(problem, **options)
     refined = res.get("refine")
     t_refine = 0.0 if refined is None else refined.elapsed
     cancelled = res.get("cancelled") or []
@@ -358,7 +515,7 @@ def identify(
         ts=data.ts,
         method=method,
         predictor=predictor,
-        parametrization=parametrization,
+        parametrization=problem.parametrization.name,
         initial=initial,
         gain=cost.w,
         penalty=cost.penalty,
@@ -383,103 +540,43 @@ def identify(
 
 def margin_options(method: str, data: IOData, refine, max_time_constant, cancel):
     """identify's ``max_time_constant`` and ``cancel`` for `method`: the
-    margin's radius (None: none) and whether to cancel; a value given to a
-    method it does not apply to is a one-line ValueError."""
+    margin's radius (None: none) and whether to cancel. Whether they apply
+    at all is :func:`check_method_options`' rule; here their values."""
     spec = METHODS[method]
     applies = spec.margin or (spec.search and bool(refine))
-    where = tuple(name for name, m in METHODS.items() if m.margin)
     if isinstance(max_time_constant, str) and max_time_constant == AUTO:
         seconds = data.n * data.ts if applies else None
     else:
-        if not applies:
-            why = (
-                "keeps eq. (3)'s penalty as printed"
-                if spec.search
-                else "takes no margin"
-            )
-            raise ValueError(
-                f"`max_time_constant` applies to the methods {where} and to the "
-                f"polish of refine=True; method {method!r} {why} (got "
-                f"{max_time_constant!r})"
-            )
-        if max_time_constant is not None:
-            bad = isinstance(max_time_constant, bool | np.bool_ | str)
-            try:
-                seconds = float(max_time_constant)
-            except (TypeError, ValueError):
-                bad = True
-            if bad or not (np.isfinite(seconds) and seconds > 0):
-                raise ValueError(
-                    "`max_time_constant` must be a number of seconds > 0, "
-                    f"{AUTO!r} or None; got {max_time_constant!r}"
-                )
-            if seconds < data.ts:
-                # Every pole inside exp(-1) = 0.37 and below: no sampled
-                # plant's margin, and r_max^na would underflow.
-                raise ValueError(
-                    "`max_time_constant` must be at least the sample time "
-                    f"ts = {data.ts:g} s; got {max_time_constant!r}"
-                )
-        else:
-            seconds = None
+        seconds = _time_constant(max_time_constant, data.ts)
     if cancel is None:
         cancel = spec.cancel
     elif not isinstance(cancel, bool | np.bool_):
         raise ValueError(f"`cancel` must be True, False or None; got {cancel!r}")
-    elif not spec.cancel:
-        able = tuple(name for name, m in METHODS.items() if m.cancel)
-        raise ValueError(
-            f"`cancel` applies to the methods {able}; method {method!r} got {cancel!r}"
-        )
     return max_radius(data.ts, seconds), bool(cancel)
 
 
-def _identify_narx(data, structure, method, *, other: dict, **options):
-    """`identify` for a NARX structure: the method's ``Method.narx``
-    estimator (:mod:`spiralid.sysid.estimation.narx`)."""
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
-    estimate = METHODS[method].narx
-    if estimate is None:
-        able = tuple(name for name, m in METHODS.items() if m.narx is not None)
+def _time_constant(value, ts: float) -> float | None:
+    """An explicit ``max_time_constant`` in seconds (None: no margin)."""
+    if value is None:
+        return None
+    bad = isinstance(value, bool | np.bool_ | str)
+    try:
+        seconds = float(value)
+    except (TypeError, ValueError):
+        bad = True
+    if bad or not (np.isfinite(seconds) and seconds > 0):
         raise ValueError(
-            f"`method` {method!r} does not train NARX models; use one of {able}"
+            "`max_time_constant` must be a number of seconds > 0, "
+            f"{AUTO!r} or None; got {value!r}"
         )
-    defaults = dict(
-        parametrization=None,
-        refine=False,
-        gain="auto",
-        penalty=1e6,
-        bounds=None,
-        safe_start=None,
-        integrator=False,
-        max_time_constant=AUTO,
-        cancel=None,
-    )
-    given = sorted(k for k, v in other.items() if not _is_default(v, defaults[k]))
-    if given:
+    if seconds < ts:
+        # Every pole inside exp(-1) = 0.37 and below: no sampled plant's
+        # margin, and r_max^na would underflow.
         raise ValueError(
-            f"{given} apply to ARX structures; a NARX takes its integrator, "
-            "scaling and box from its structure and record"
+            "`max_time_constant` must be at least the sample time "
+            f"ts = {ts:g} s; got {value!r}"
         )
-    from .narx import identify_narx
-
-    return identify_narx(data, structure, method=method, estimate=estimate, **options)
-
-
-def _is_default(value, default) -> bool:
-    """`value` is the option's default: the same object, or an equal number
-    or string (``penalty=float("1e6")`` is the default 1e6, ``True`` is not
-    ``1``)."""
-    if value is default:
-        return True
-    if isinstance(default, bool):
-        return isinstance(value, bool | np.bool_) and bool(value) == default
-    if isinstance(value, bool | np.bool_):
-        return False
-    if isinstance(default, int | float) and isinstance(value, int | float | np.number):
-        return bool(value == default)
-    return isinstance(default, str) and isinstance(value, str) and value == default
+    return seconds
 
 
 def _identify_integrating(

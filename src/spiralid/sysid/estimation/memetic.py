@@ -31,7 +31,7 @@ import numpy as np
 from scipy import signal
 
 from spiralid._checks import integer
-from spiralid.optim import OptimiserResult, SpiralSearch, minimize
+from spiralid.optim import OptimiserResult, Restarts, SpiralSearch, minimize
 
 from ..data import IOData
 from ..spectra import PSD, default_nperseg, find_resonances
@@ -94,7 +94,7 @@ def projected_spiral(
     max_nfev: int,
     polish_every: int | None,
     polish_nfev: int,
-    restart_after: int | None,
+    restarts: Restarts | None,
     x0=None,
     max_iter: int | None = None,
     callback=None,
@@ -126,12 +126,15 @@ def projected_spiral(
         once at the end; ``None``: a pure spiral search.
     polish_nfev : int
         Evaluations per polish.
-    restart_after : int or None
-        Start a fresh population of the same size, uniform in the box
-        (:meth:`~spiralid.optim.SpiralSearch.restart`), when the best cost
-        has not fallen by more than 1e-9 of itself for this many
-        iterations; the best point over all populations is returned.
-        ``None``: no restarts.
+    restarts : Restarts or None
+        Start a fresh population of ``restarts.next_size`` points, uniform
+        in the box (:meth:`~spiralid.optim.SpiralSearch.restart`), when the
+        best cost has not fallen by more than 1e-9 of itself for
+        ``restarts.stall`` iterations (a move of the centre by the polish
+        does not count: its ever smaller steps would keep a stalled
+        population alive); the best point over all populations is
+        returned. ``tol_radius`` is not used (the polished centre is not a
+        collapse test). ``None``: no restarts.
     x0 : array_like, shape (k, na), optional
         Initial points (the rest of the population is uniform in the box).
     max_iter : int, optional
@@ -156,8 +159,9 @@ def projected_spiral(
     polish_nfev = integer(polish_nfev, "polish_nfev", 2)
     if polish_every is not None:
         polish_every = integer(polish_every, "polish_every", 1)
-    if restart_after is not None:
-        restart_after = integer(restart_after, "restart_after", 1)
+    if restarts is not None and not isinstance(restarts, Restarts):
+        raise ValueError(f"`restarts` must be a Restarts or None; got {restarts!r}")
+    n_dim = parametrization.bounds.shape[0]
     max_iter = max_nfev if max_iter is None else integer(max_iter, "max_iter", 1)
     n_polish = 0
     stalled, before = 0, np.inf
@@ -178,9 +182,10 @@ def projected_spiral(
         # that must not keep a stalled population alive.
         stalled = 0 if search.fun < before * (1.0 - 1e-9) else stalled + 1
         before = min(before, search.fun)
-        if restart_after and stalled >= restart_after:
-            if search.nfev + 2 * n_points - 1 <= max_nfev:
-                search.restart(n_points)
+        if restarts is not None and stalled >= restarts.stall_for(n_dim):
+            size = restarts.next_size(search.n_points)
+            if search.nfev + 2 * size - 1 <= max_nfev:
+                search.restart(size)
                 stalled = 0
         if callback is None:
             return False

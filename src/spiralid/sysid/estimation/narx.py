@@ -399,16 +399,17 @@ def frols(problem: NARXProblem) -> OptimiserResult:
     )
 
 
-def estimate_ls(problem: NARXProblem, **options) -> OptimiserResult:
+def estimate_ls(
+    problem: NARXProblem, *, max_rounds: int = 50, patience: int = 3
+) -> OptimiserResult:
     """``"ls"``: one-step least squares (LM for the MLP, FROLS for the
     polynomial).
 
     Parameters
     ----------
     problem : NARXProblem
-    **options
-        ``max_rounds`` and ``patience`` of the early stopping
-        (:meth:`NARXProblem.polish`).
+    max_rounds, patience : int
+        Of the early stopping (:meth:`NARXProblem.polish`).
 
     Returns
     -------
@@ -422,7 +423,7 @@ def estimate_ls(problem: NARXProblem, **options) -> OptimiserResult:
         start = problem.structure.initial_params(problem.rng)
     else:
         start = _with_hidden(problem, start)
-    p, rounds = problem.polish(start, "one-step", **options)
+    p, rounds = problem.polish(start, "one-step", max_rounds, patience)
     return _result(
         problem, p, t0, nit=rounds, message="Levenberg-Marquardt, one-step error."
     )
@@ -447,15 +448,16 @@ def _best_polished(problem: NARXProblem, starts: dict, **options):
     return best
 
 
-def estimate_oe(problem: NARXProblem, **options) -> OptimiserResult:
+def estimate_oe(
+    problem: NARXProblem, *, max_rounds: int = 50, patience: int = 3
+) -> OptimiserResult:
     """``"oe"``: the gradient baseline on the predictor's error.
 
     Parameters
     ----------
     problem : NARXProblem
-    **options
-        ``max_rounds`` and ``patience`` of the early stopping
-        (:meth:`NARXProblem.polish`).
+    max_rounds, patience : int
+        Of the early stopping (:meth:`NARXProblem.polish`).
 
     Returns
     -------
@@ -469,7 +471,9 @@ def estimate_oe(problem: NARXProblem, **options) -> OptimiserResult:
         )
     t0 = time.perf_counter()
     starts = _oe_starts(problem)
-    _, name, p, rounds = _best_polished(problem, starts, **options)
+    _, name, p, rounds = _best_polished(
+        problem, starts, max_rounds=max_rounds, patience=patience
+    )
     return _result(
         problem,
         p,
@@ -551,7 +555,7 @@ def estimate_spiral(
     n_points: int = 50,
     max_nfev: int = 10_000,
     polish_every: int = 10,
-    polish_iterations: int = 5,
+    polish_nfev: int = 5,
     max_iter: int | None = None,
 ) -> OptimiserResult:
     """``"spiral"``: Eb-SDA with safe starts and a memetic polish.
@@ -567,8 +571,13 @@ def estimate_spiral(
         Budget of cost evaluations (the polish's count too).
     polish_every : int
         Polish the centre every this many iterations.
-    polish_iterations : int
-        Levenberg-Marquardt evaluations per polish.
+    polish_nfev : int
+        Levenberg-Marquardt evaluations per polish (the ARX ``"spiral"``'s
+        option of the same name and meaning; it was ``polish_iterations``).
+        The defaults differ from the ARX method's (every 5 iterations, 10
+        evaluations) because each step here is a free run of the network
+        with its forward sensitivities, not a projected linear solve; they
+        are the values the NARX method was added with, not tuned since.
     max_iter : int, optional
         Cap on the iterations.
 
@@ -586,7 +595,7 @@ def estimate_spiral(
     n_points = integer(n_points, "n_points", 2)
     max_nfev = integer(max_nfev, "max_nfev", n_points)
     polish_every = integer(polish_every, "polish_every", 1)
-    polish_iterations = integer(polish_iterations, "polish_iterations", 1)
+    polish_nfev = integer(polish_nfev, "polish_nfev", 1)
     starts = _oe_starts(problem)
     seeds = np.array(list(starts.values()))
     box = default_box(problem, seeds)
@@ -615,7 +624,7 @@ def estimate_spiral(
                 search.x,
                 jac=jac,
                 method="lm",
-                max_nfev=polish_iterations,
+                max_nfev=polish_nfev,
             )
             # The centre must stay in the box: a polish that left it is
             # clipped back (and scored there).
