@@ -8,8 +8,8 @@ from scipy import stats
 from scipy.signal import lfilter
 
 from spiralid import ARX, IOData
-from spiralid.report.output import results_dict, summary_text, verdict
-from spiralid.reproduction import Configuration, reproduce
+from spiralid.report.output import results_dict, summary_text
+from spiralid.reproduction import HEADLINE_TEST, Configuration, Reproduction, reproduce
 
 CONFIGS = (Configuration("SDA", "sda"), Configuration("Eb-SDA", "ebsda"))
 
@@ -86,9 +86,9 @@ def test_baselines_and_table2(rep, data):
 
 def test_summary_and_verdict_are_honest(rep):
     text = summary_text(rep)
-    assert "Table-2" in text and verdict(rep) in text
+    assert "Table-2" in text and rep.verdict() in text
     test = rep.ranksum("Eb-SDA", "SDA")
-    assert verdict(rep).startswith("Eb-SDA beat") == (
+    assert rep.verdict().startswith("Eb-SDA beat") == (
         test["p_two_sided"] < 0.05 and test["a12"] > 0.5
     )
 
@@ -96,14 +96,14 @@ def test_summary_and_verdict_are_honest(rep):
 def test_one_headline_test_in_summary_results_and_report(rep):
     """The verdict's test is the two-sided rank-sum test, named and quoted the
     same in summary_text, results.json and report.html; no one-sided p."""
-    from spiralid.report.output import HEADLINE_TEST, _html
+    from spiralid.report.output import _html
 
     results = json.loads(json.dumps(results_dict(rep)))
     head = results["headline_test"]
     p = rep.ranksum("Eb-SDA", "SDA")["p_two_sided"]
     assert head["test"] == HEADLINE_TEST and "two-sided" in HEADLINE_TEST
     assert (head["a"], head["b"], head["p_two_sided"]) == ("Eb-SDA", "SDA", p)
-    assert head["verdict"] == results["verdict"] == verdict(rep)
+    assert head["verdict"] == results["verdict"] == rep.verdict()
     assert f"two-sided Wilcoxon rank-sum p = {p:.3g}" in head["verdict"]
     text = summary_text(rep)
     page = _html(rep, {}, None)
@@ -111,6 +111,21 @@ def test_one_headline_test_in_summary_results_and_report(rep):
         assert head["verdict"] in where
         assert f"Headline test: {HEADLINE_TEST}." in where
         assert "one-sided" not in where
+
+
+def test_the_verdicts_are_computed_by_the_reproduction(rep):
+    # The report only draws them; its old names are the same functions.
+    from spiralid.report import output
+
+    assert output.headline is Reproduction.headline
+    assert output.verdict is Reproduction.verdict
+    assert output.HEADLINE_TEST is HEADLINE_TEST
+    assert [(t["a"], t["b"]) for t in rep.ranksums()] == [("Eb-SDA", "SDA")]
+    ladder = rep.budget_verdict()
+    assert ladder["rows"][-1]["budget"] == ladder["budgets"][-1]
+    assert ladder["sentence"].startswith(f"At {ladder['budgets'][-1]:,} evaluations")
+    assert rep.budget_verdict("Eb-SDA", "DE") == {"rows": [], "sentence": ""}
+    assert rep.headline("Eb-SDA", "DE")["p_two_sided"] is None
 
 
 def test_the_report_lists_each_best_model_s_modes_with_intervals(rep):

@@ -35,6 +35,7 @@ from spiralid.sysid.validation.validate import Validation, validate
 
 __all__ = [
     "CONFIGURATIONS",
+    "HEADLINE_TEST",
     "Configuration",
     "Reproduction",
     "Run",
@@ -42,6 +43,19 @@ __all__ = [
     "default_data_source",
     "reproduce",
 ]
+
+
+# The one test behind the headline verdict, everywhere it is stated (the
+# report, its summary, results.json): the same two-sided test the budget
+# ladder and `spiralid study` make, so the three never disagree in kind.
+HEADLINE_TEST = (
+    "two-sided Wilcoxon rank-sum test (Mann-Whitney U) of the estimation costs "
+    "over the seeds, Eb-SDA against SDA, at the 5 % level; the direction from "
+    "A12 (the probability that an Eb-SDA run costs less than an SDA run)"
+)
+HEADLINE_ALPHA = 0.05
+# The rank-sum pairs the report lists, one per parametrisation.
+_PAIRS = (("Eb-SDA", "SDA"), ("Eb-SDA (reflection)", "SDA (reflection)"))
 
 
 @dataclass(frozen=True)
@@ -253,6 +267,118 @@ class Reproduction:
             )
         return rows
 
+    def ranksums(self) -> list[dict]:
+        """:meth:`ranksum` of Eb-SDA against SDA, per parametrisation present."""
+        return [
+            self.ranksum(a, b) for a, b in _PAIRS if a in self.runs and b in self.runs
+        ]
+
+    def headline(self, a: str = "Eb-SDA", b: str = "SDA") -> dict:
+        """The headline test (:data:`HEADLINE_TEST`) of `a` against `b` and its
+        verdict sentence; ``None`` numbers when the experiment lacks either."""
+        out = {"test": HEADLINE_TEST, "alpha": HEADLINE_ALPHA, "a": a, "b": b}
+        if a not in self.runs or b not in self.runs:
+            sentence = (
+                f"No {a} vs {b} comparison: the experiment ran neither or one of them."
+            )
+            return {**out, "outcome": None, "p_two_sided": None, "verdict": sentence}
+        test = self.ranksum(a, b)
+        p, effect = test["p_two_sided"], test["a12"]
+        ma = self.statistics(a)["cost_median"]
+        mb = self.statistics(b)["cost_median"]
+        numbers = (
+            f"median cost {ma:.4g} against {mb:.4g} over {len(self.seeds)} seeds "
+            f"(two-sided Wilcoxon rank-sum p = {p:.3g}, A12 = {effect:.2f})"
+        )
+        outcome, sentence = _outcome(a, b, p, effect, numbers)
+        return {
+            **out,
+            "outcome": outcome,
+            "median_a": ma,
+            "median_b": mb,
+            "n_seeds": len(self.seeds),
+            "u_statistic": test["u_statistic"],
+            "p_two_sided": p,
+            "a12": effect,
+            "verdict": sentence,
+        }
+
+    def verdict(self, a: str = "Eb-SDA", b: str = "SDA") -> str:
+        """One sentence: did `a` beat `b` on estimation cost over the seeds, by
+        the headline test (:data:`HEADLINE_TEST`)?"""
+        return self.headline(a, b)["verdict"]
+
+    def budget_verdict(self, a: str = "Eb-SDA", b: str = "SDA") -> dict:
+        """The claim at a ladder of budgets, from the runs' own histories
+        (:func:`spiralid.study.anytime.budget_verdicts`, Holm over the
+        budgets), with a sentence: the budget the verdict holds at and where
+        it flips."""
+        from spiralid.study.anytime import budget_verdicts
+
+        if a not in self.runs or b not in self.runs:
+            return {"rows": [], "sentence": ""}
+        cells = {
+            (("reproduce",), label): {
+                "history": [r.model.history for r in self.runs[label]],
+                "nfev": [r.model.result["nfev"] for r in self.runs[label]],
+            }
+            for label in (a, b)
+        }
+        out = budget_verdicts(
+            cells,
+            [("reproduce",)],
+            (a, b),
+            self.options["max_nfev"],
+            self.options["n_points"],
+        )
+        rows = out["rows"]
+        flips = out["crossovers"].get(("reproduce",), [])
+        return {
+            "budgets": out["budgets"],
+            "holm_family": out["family"],
+            "rows": [{k: v for k, v in r.items() if k != "reading"} for r in rows],
+            "crossovers": flips,
+            "sentence": _ladder_sentence(rows, flips, out["family"]),
+        }
+
+
+def _outcome(a: str, b: str, p: float, effect: float, numbers: str) -> tuple:
+    """The headline's outcome and sentence from its p-value and A12."""
+    if p < HEADLINE_ALPHA and effect > 0.5:
+        return f"{a} better", f"{a} beat {b}: {numbers}."
+    if p < HEADLINE_ALPHA:
+        return f"{b} better", f"{a} did not beat {b}; {b} beat {a}: {numbers}."
+    return (
+        "no significant difference",
+        f"{a} did not beat {b}: no significant difference, {numbers}.",
+    )
+
+
+def _ladder_sentence(rows: list[dict], flips: list[int], family: int) -> str:
+    """The budget ladder in words: the verdict at the full budget, then
+    where it flips along the way (or that it never does)."""
+    full = rows[-1]
+    sentence = f"At {full['budget']:,} evaluations: {full['verdict']}"
+    if flips:
+        verdict_at = {r["budget"]: r["verdict"] for r in rows}
+        ladder = [r["budget"] for r in rows]
+        steps = [
+            f"{verdict_at[ladder[ladder.index(f) - 1]]} up to "
+            f"{ladder[ladder.index(f) - 1]:,}, {verdict_at[f]} from {f:,}"
+            for f in flips
+        ]
+        sentence += "; along the way: " + "; ".join(steps)
+    else:
+        sentence += f", the same at every budget from {rows[0]['budget']:,}"
+    # The headline's test at each budget, Holm-adjusted over the ladder: at
+    # the full budget it can say "no significant difference" where the
+    # headline's unadjusted p is below 5 %.
+    sentence += (
+        f" (the headline's two-sided rank-sum test, Holm-adjusted over the "
+        f"{family} budgets)"
+    )
+    return sentence + "."
+
 
 def default_data(seed: int = 0) -> IOData:
     """The default record: the simulated rig's bang-bang experiment.
@@ -362,9 +488,58 @@ def reproduce(
     if data is None:
         data, source = default_data(), default_data_source()
     source = {"kind": "user data"} if source is None else dict(source)
+    seed_list = _checked_seeds(data, seeds, n_points, max_nfev)
+    arx = ARX(8, 8, 0) if arx is None else arx
+    est, val = data.split(fraction)
+    _check_record(est, arx)
+    if initial != "rest":
+        # The modal parametrisation projects the numerator of the
+        # simulation from rest only.
+        configurations = [c for c in configurations if c.parametrization != "modal"]
+    options = {
+        **search_options({"n_points": n_points, "max_nfev": max_nfev}),
+        "predictor": "simulation",
+        "initial": initial,
+        "gain": PaperCost(arx, est, predictor="simulation", initial=initial).w,
+    }
+    # The same tasks and runner as `spiralid study`: one execution path.
+    tasks = reading_tasks(
+        "record",
+        f"simulation-{initial}",
+        BASELINES,
+        [(c.parametrization, c) for c in configurations],
+        seed_list,
+        budget=max_nfev,
+        points=n_points,
+        arx=(arx.na, arx.nb, arx.nk),
+        fraction=fraction,
+    )
+    kinds = sorted({(c.method, c.parametrization) for c in configurations})
+    results = _run_tasks(tasks, data, workers, (est, arx, kinds, initial), progress)
+    rep = Reproduction(
+        data=data,
+        estimation=est,
+        validation=val,
+        arx=arx,
+        seeds=seed_list,
+        options=options,
+        configurations=tuple(configurations),
+        runs={
+            c.label: [results[c.label, s] for s in seed_list] for c in configurations
+        },
+        baselines={label: results[label, None] for label in BASELINES.values()},
+        validations={},
+        source=source,
+    )
+    rep.validations = _validate_best(rep)
+    rep.elapsed = time.perf_counter() - t0
+    return rep
+
+
+def _checked_seeds(data, seeds, n_points, max_nfev) -> list[int]:
+    """The seeds as a list, after :func:`reproduce`'s argument checks."""
     if not isinstance(data, IOData):
         raise ValueError(f"`data` must be an IOData or None; got {type(data)!r}")
-    arx = ARX(8, 8, 0) if arx is None else arx
     seed_list = list(range(seeds)) if isinstance(seeds, int) else list(seeds)
     if not seed_list:
         raise ValueError(f"`seeds` must give at least one seed; got {seeds!r}")
@@ -380,34 +555,24 @@ def reproduce(
             f"`max_nfev` must be an integer >= 2 * n_points = {2 * n_points}; "
             f"got {max_nfev!r}"
         )
-    est, val = data.split(fraction)
+    return seed_list
+
+
+def _check_record(est: IOData, arx: ARX) -> None:
+    """Refuse an estimation record the searches cannot start from."""
     arx.check_length(est, "data")
     # Every search scales its box from the least-squares estimate, and the
     # workers' warm-up runs searches: a record that least squares refuses (a
     # constant input, too little excitation) fails here, in this process,
     # rather than in the initializer of every worker of a pool.
     arx_least_squares(est, arx)
-    if initial != "rest":
-        # The modal parametrisation projects the numerator of the
-        # simulation from rest only.
-        configurations = [c for c in configurations if c.parametrization != "modal"]
-    gain = PaperCost(arx, est, predictor="simulation", initial=initial).w
-    options = search_options({"n_points": n_points, "max_nfev": max_nfev})
-    # The same tasks and runner as `spiralid study`: one execution path.
-    tasks = reading_tasks(
-        "record",
-        f"simulation-{initial}",
-        BASELINES,
-        [(c.parametrization, c) for c in configurations],
-        seed_list,
-        budget=max_nfev,
-        points=n_points,
-        arx=(arx.na, arx.nb, arx.nk),
-        fraction=fraction,
-    )
+
+
+def _run_tasks(tasks, data: IOData, workers, warm_up: tuple, progress) -> dict:
+    """Every task's :class:`Run`, by ``(label, seed)``, from the study's
+    runner (processes unless `workers` is 1, each warmed up by
+    :func:`_warm_up` with `warm_up`)."""
     n_workers = (os.cpu_count() or 1) if workers is None else int(workers)
-    kinds = sorted({(c.method, c.parametrization) for c in configurations})
-    warm_up = (est, arx, kinds, initial)
     results = {}
     for task, row in execute(
         tasks,
@@ -431,32 +596,17 @@ def reproduce(
         )
         if progress is not None:
             progress(len(results), len(tasks))
+    return results
 
-    baselines = {label: results[label, None] for label in BASELINES.values()}
-    runs = {c.label: [results[c.label, s] for s in seed_list] for c in configurations}
-    rep = Reproduction(
-        data=data,
-        estimation=est,
-        validation=val,
-        arx=arx,
-        seeds=seed_list,
-        options={
-            **options,
-            "predictor": "simulation",
-            "initial": initial,
-            "gain": gain,
-        },
-        configurations=tuple(configurations),
-        runs=runs,
-        baselines=baselines,
-        validations={},
-        source=source,
-    )
-    for label in [*runs, *baselines]:
+
+def _validate_best(rep: Reproduction) -> dict[str, tuple[Validation, Validation]]:
+    """Each configuration's best run and each baseline validated on the
+    estimation part and, run on from it, the validation part."""
+    out = {}
+    for label in [*rep.runs, *rep.baselines]:
         model = rep.best(label).model
-        rep.validations[label] = (
-            validate(model, est, label=label),
-            validate(model, val, warmup=est, label=label),
+        out[label] = (
+            validate(model, rep.estimation, label=label),
+            validate(model, rep.validation, warmup=rep.estimation, label=label),
         )
-    rep.elapsed = time.perf_counter() - t0
-    return rep
+    return out
