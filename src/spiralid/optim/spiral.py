@@ -401,12 +401,24 @@ _REMOVED = {
 }
 
 
-def _refuse_removed(removed: dict) -> None:
-    """A one-line error for a removed keyword, Python's own for any other."""
+def _refuse_removed(removed: dict, method) -> None:
+    """A one-line error for a removed keyword; for any other Python's own
+    words, with the method and the options that apply (every rule takes
+    all of minimize's)."""
+    import inspect
+
     for name in removed:
         if name in _REMOVED:
             raise TypeError(_REMOVED[name])
-        raise TypeError(f"minimize() got an unexpected keyword argument {name!r}")
+        takes = [
+            p.name
+            for p in inspect.signature(minimize).parameters.values()
+            if p.kind is inspect.Parameter.KEYWORD_ONLY
+        ]
+        raise TypeError(
+            f"minimize() got an unexpected keyword argument {name!r}; method "
+            f"{method!r} takes {', '.join(takes)}"
+        )
 
 
 def _target(target) -> float | None:
@@ -632,7 +644,7 @@ def minimize(
     ('Target cost reached.', True)
     """
     start = time.perf_counter()
-    _refuse_removed(_removed)
+    _refuse_removed(_removed, method)
     budget = _Budget.check(max_iter, n_points, max_nfev, max_time, target, start)
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")

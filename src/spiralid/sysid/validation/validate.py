@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal
 
-from spiralid._checks import positive
+from spiralid._checks import positive, refuse_options
 
 from ..data import check_pair
 from ..estimation.cost import auto_gain, cost_of_errors
@@ -676,7 +676,9 @@ def validate(
         :class:`~spiralid.sysid.validation.nonlinear.NARXValidation` (fits
         and the Billings-Voon tests); an ARX model (anything with ``theta``,
         ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
-        ``predict(data)``, ``poles``, ``zeros``).
+        ``predict(data)``, ``poles``, ``zeros``). For a NARX model
+        `n_peaks`, `nperseg` and `max_damping` (spectra and modes) do not
+        apply: one of them other than its default is refused in one line.
     data : IOData
         The validation record, usually the last third (the paper's split).
         The model is run from zero initial conditions over it.
@@ -774,8 +776,16 @@ def validate(
         residuals = _fitted_error(model)
     if getattr(model, "kind", None) == "narx":
         # Poles, modes and realisations mean nothing for a nonlinear model:
-        # its own report (fits and the Billings-Voon tests).
+        # its own report (fits and the Billings-Voon tests), and the options
+        # of spectra and modes are refused rather than ignored.
         from .nonlinear import validate_narx
+
+        refuse_options(
+            dict(n_peaks=n_peaks, nperseg=nperseg, max_damping=max_damping),
+            ("lags", "levels", "residuals", "gain", "warmup", "label"),
+            "validate for a NARX model",
+            defaults=dict(n_peaks=3, nperseg=None, max_damping=0.3),
+        )
 
         return validate_narx(
             model,
