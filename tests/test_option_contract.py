@@ -6,7 +6,7 @@ import pytest
 from scipy.signal import lfilter
 
 import spiralid as sid
-from spiralid.optim import minimize_pareto
+from spiralid.optim import Restarts, minimize, minimize_pareto
 
 
 @pytest.fixture(scope="module")
@@ -206,3 +206,179 @@ def test_the_command_refuses_what_python_refuses(method, kind, flag):
             _check_options(args)
     else:
         _check_options(args)
+
+
+# -- the misuse matrix: real calls, one-line errors naming the option ---------
+
+ARX2 = sid.ARX(2, 2, 1)
+NARX2 = sid.NARX(2, 2, 1, hidden=(3,))
+POLY = sid.PolynomialNARX(2, 2, 1, degree=2, n_terms=4)
+_IDENTIFY_MISUSE = [
+    # issue 29's cases
+    (ARX2, dict(method="ls", refine=True), "refine"),
+    (ARX2, dict(method="ls", safe_start=True), "safe_start"),
+    (ARX2, dict(method="oe", bounds=[(0, 1)] * 4), "bounds"),
+    (ARX2, dict(method="ls", parametrization="modal"), "parametrization"),
+    (ARX2, dict(method="oe", parametrization="modal"), "parametrization"),
+    (ARX2, dict(method="oe", refine=True), "refine"),
+    (ARX2, dict(method="oe", safe_start=False), "safe_start"),
+    (ARX2, dict(method="ls", n_points=10), "n_points"),
+    (ARX2, dict(method="ls", max_nfev=100), "max_nfev"),
+    (ARX2, dict(method="ls", max_iter=5), "max_iter"),
+    (ARX2, dict(method="oe", callback=print), "callback"),
+    (ARX2, dict(method="ls", rng=0), "rng"),
+    (ARX2, dict(method="oe", rng=0), "rng"),
+    (ARX2, dict(method="ls", max_time_constant=1.0), "max_time_constant"),
+    (ARX2, dict(method="ls", cancel=True), "cancel"),
+    (ARX2, dict(method="sda", max_time_constant=1.0), "max_time_constant"),
+    (ARX2, dict(method="ebsda", cancel=False), "cancel"),
+    (ARX2, dict(method="de", cancel=True), "cancel"),
+    (ARX2, dict(method="de", target=1.0), "target"),
+    (ARX2, dict(method="de", restarts=True), "restarts"),
+    (ARX2, dict(method="de", bounds_policy="clip"), "bounds_policy"),
+    (ARX2, dict(method="spiral", target=1.0), "target"),
+    (ARX2, dict(method="spiral", max_nfve=100), "max_nfve"),
+    (ARX2, dict(method="spiral", bounds_policy="clip"), "bounds_policy"),
+    (ARX2, dict(method="spiral", restart_after=10), "restart_after"),
+    (ARX2, dict(method="spiral", polish_iterations=3), "polish_iterations"),
+    (ARX2, dict(method="sda", holdback=0.1), "holdback"),
+    (ARX2, dict(method="sda", polish_every=3), "polish_every"),
+    (ARX2, dict(method="ebsda", rule="sda"), "rule"),
+    (ARX2, dict(method="ls", holdout=0.1), "holdout"),
+    (ARX2, dict(method="ls", decay=0.1), "decay"),
+    (ARX2, dict(method="sda", on_iteration=print), "on_iteration"),
+    (
+        ARX2,
+        dict(method="spiral", restarts=Restarts(tol_radius=1e-3)),
+        "restarts.tol_radius",
+    ),
+    # NARX structures
+    (NARX2, dict(method="ls", penalty=1e5), "penalty"),
+    (NARX2, dict(method="ls", gain=2.0), "gain"),
+    (NARX2, dict(method="oe", refine=True), "refine"),
+    (NARX2, dict(method="oe", bounds=[(0, 1)]), "bounds"),
+    (NARX2, dict(method="oe", cancel=True), "cancel"),
+    (NARX2, dict(method="oe", max_time_constant=1.0), "max_time_constant"),
+    (NARX2, dict(method="ls", parametrization="modal"), "parametrization"),
+    (NARX2, dict(method="ls", integrator=True), "integrator"),
+    (NARX2, dict(method="ls", max_rnds=3), "max_rnds"),
+    (NARX2, dict(method="oe", n_points=10), "n_points"),
+    (NARX2, dict(method="spiral", holdback=0.1), "holdback"),
+    (NARX2, dict(method="spiral", restarts=True), "restarts"),
+    (NARX2, dict(method="spiral", polish_iterations=3), "polish_iterations"),
+    (NARX2, dict(method="sda", safe_start=True), "safe_start"),
+    (NARX2, dict(method="de"), "method"),
+    (POLY, dict(method="ls", rng=0), "rng"),
+    (POLY, dict(method="ls", max_rounds=3), "max_rounds"),
+    (POLY, dict(method="ls", holdout=0.1), "holdout"),
+]
+
+
+@pytest.mark.parametrize(("structure", "kwargs", "option"), _IDENTIFY_MISUSE)
+def test_identify_misuse_is_one_line_naming_the_option(
+    record, structure, kwargs, option
+):
+    with pytest.raises(ValueError) as refused:
+        sid.identify(record, structure, **kwargs)
+    message = str(refused.value)
+    assert "\n" not in message and f"`{option}`" in message
+
+
+_PARETO_MISUSE = [
+    (dict(max_iter=5), "max_iter"),
+    (dict(polish_nfev=10), "polish_nfev"),
+    (dict(objectives=("cost", "one-step"), nperseg=64), "nperseg"),
+    (dict(objectives=("cost", "one-step"), fmin=1.0), "fmin"),
+    (dict(objectives=("cost", "one-step"), min_coherence=0.3), "min_coherence"),
+    (dict(refine=True), "refine"),
+    (dict(restarts=True), "restarts"),
+    (dict(x0=[0.0]), "x0"),
+    (dict(extremes_nfev=-1), "extremes_nfev"),
+    (dict(seed_estimates="yes"), "seed_estimates"),
+]
+
+
+@pytest.mark.parametrize(("kwargs", "option"), _PARETO_MISUSE)
+def test_identify_pareto_misuse_is_one_line_naming_the_option(record, kwargs, option):
+    with pytest.raises(ValueError) as refused:
+        sid.identify_pareto(record, ARX2, rng=0, **kwargs)
+    message = str(refused.value)
+    assert "\n" not in message and f"`{option}`" in message
+
+
+def test_identify_pareto_accepts_frequency_defaults_without_the_objective(record):
+    front = sid.identify_pareto(
+        record, ARX2, ("cost", "one-step"), rng=0, max_nfev=200, n_points=10,
+        extremes_nfev=0, min_coherence=0.5, nperseg=None,
+    )  # fmt: skip
+    assert front.names == ("cost", "one-step")
+
+
+@pytest.fixture(scope="module")
+def narx_model(record):
+    est, _ = record.split(2 / 3)
+    return sid.identify(est, NARX2, method="ls", rng=0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "option"),
+    [
+        (dict(n_peaks=-5, nperseg=64, max_damping=0.9), "n_peaks"),
+        (dict(nperseg=64), "nperseg"),
+        (dict(max_damping=0.9), "max_damping"),
+    ],
+)
+def test_validate_refuses_spectral_options_for_a_narx_model(
+    record, narx_model, kwargs, option
+):
+    _, val = record.split(2 / 3)
+    with pytest.raises(ValueError) as refused:
+        sid.validate(narx_model, val, **kwargs)
+    message = str(refused.value)
+    assert "\n" not in message and f"`{option}` does not apply" in message
+
+
+def test_validate_accepts_the_defaults_for_a_narx_model(record, narx_model):
+    _, val = record.split(2 / 3)
+    report = sid.validate(narx_model, val, n_peaks=3, max_damping=float("0.3"))
+    assert np.isfinite(report.fit_percent)
+
+
+@pytest.mark.parametrize(
+    ("call", "option"),
+    [
+        (lambda: minimize(np.sum, [(0, 1)] * 2, callbak=print), "callbak"),
+        (lambda: minimize(np.sum, [(0, 1)] * 2, restarts=3), "restarts"),
+        (
+            lambda: minimize_pareto(_two_objectives, [(0, 1)] * 2, method="periodic"),
+            "method",
+        ),
+        (
+            lambda: minimize_pareto(_two_objectives, [(0, 1)] * 2, vectorized="yes"),
+            "vectorized",
+        ),
+    ],
+)
+def test_optimiser_misuse_is_one_line_naming_the_option(call, option):
+    with pytest.raises((TypeError, ValueError)) as refused:
+        call()
+    message = str(refused.value)
+    assert "\n" not in message and option in message
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        dict(method="ls", refine=False),
+        dict(method="ls", safe_start=None),
+        dict(method="ls", parametrization=None),
+        dict(method="ls", max_time_constant="auto"),
+        dict(method="ls", cancel=None),
+        dict(method="ls", rng=None),
+        dict(method="ls", penalty=float("1e6")),
+        dict(method="oe", holdout=0.2),
+    ],
+)
+def test_a_default_passed_by_value_is_accepted(record, kwargs):
+    model = sid.identify(record, ARX2, **kwargs)
+    assert model.method == kwargs["method"]
