@@ -137,17 +137,7 @@ def estimation_response(rep: Reproduction) -> Figure:
     """Figures 6b-c: estimation part, measured against the models, and errors."""
     est = rep.estimation
     outs = {k: m.simulate(est.u) for k, m in _models(rep).items()}
-    fig = plots.plot_time_response(
-        est.t,
-        est.y,
-        outs,
-        title="Modelling (estimation part), free run",
-        ylabel=est.output_name,
-        unit=est.output_unit,
-    )
-    _as_reference(fig)
-    _legend_outside(fig)
-    return fig
+    return _time_response(est, est.t, outs, "Modelling (estimation part), free run")
 
 
 def validation_response(rep: Reproduction) -> Figure:
@@ -158,13 +148,19 @@ def validation_response(rep: Reproduction) -> Figure:
     n = rep.estimation.n
     val = rep.validation
     outs = {k: m.simulate(rep.data.u)[n:] for k, m in _models(rep).items()}
+    return _time_response(val, val.t + n * val.ts, outs, "Validation part, free run")
+
+
+def _time_response(part, t, outs: dict, title: str) -> Figure:
+    """A record part's measured output against the models' `outs` at times
+    `t`, with their errors; output error dashed, the legend under."""
     fig = plots.plot_time_response(
-        val.t + n * val.ts,
-        val.y,
+        t,
+        part.y,
         outs,
-        title="Validation part, free run",
-        ylabel=val.output_name,
-        unit=val.output_unit,
+        title=title,
+        ylabel=part.output_name,
+        unit=part.output_unit,
     )
     _as_reference(fig)
     _legend_outside(fig)
