@@ -73,7 +73,9 @@ def _fixed(theta):
             nfev=0, nit=0, history=None, elapsed=0.0,
         )  # fmt: skip
 
-    return estimators.Method(estimate)
+    # It stands in for a search, so it takes a spiral method's options
+    # (reproduce passes the same budget to every configuration).
+    return estimators.Method(estimate, options=estimators.METHODS["sda"].options)
 
 
 def test_results_json_and_the_report_say_the_same(data, monkeypatch):
