@@ -144,7 +144,11 @@ def _docstring_table() -> dict[str, set[str]]:
     """identify's Notes: the options each ARX method takes, as written."""
     doc = " ".join(sid.identify.__doc__.split())
     notes = doc[doc.index("Options by method") : doc.index("For a NARX structure")]
-    common = {"predictor", "initial", "gain", "penalty", "integrator"}
+    # The common ones, read from the sentence that names them.
+    head = notes[: notes.index("which every method takes")]
+    common = set(re.findall(r"``(\w+)``", head))
+    assert common == {"rng", "predictor", "initial", "gain", "penalty", "integrator"}
+    notes = notes[len(head) :]
     table = {}
     for bullet in notes.split(" - ")[1:]:
         heads, body = re.split(r'(?:"``|\)): ', bullet, maxsplit=1)
@@ -226,8 +230,8 @@ _IDENTIFY_MISUSE = [
     (ARX2, dict(method="ls", max_nfev=100), "max_nfev"),
     (ARX2, dict(method="ls", max_iter=5), "max_iter"),
     (ARX2, dict(method="oe", callback=print), "callback"),
-    (ARX2, dict(method="ls", rng=0), "rng"),
-    (ARX2, dict(method="oe", rng=0), "rng"),
+    (ARX2, dict(method="ls", holdback=0.3), "holdback"),
+    (ARX2, dict(method="oe", rule="sda"), "rule"),
     (ARX2, dict(method="ls", max_time_constant=1.0), "max_time_constant"),
     (ARX2, dict(method="ls", cancel=True), "cancel"),
     (ARX2, dict(method="sda", max_time_constant=1.0), "max_time_constant"),
@@ -268,7 +272,7 @@ _IDENTIFY_MISUSE = [
     (NARX2, dict(method="spiral", polish_iterations=3), "polish_iterations"),
     (NARX2, dict(method="sda", safe_start=True), "safe_start"),
     (NARX2, dict(method="de"), "method"),
-    (POLY, dict(method="ls", rng=0), "rng"),
+    (POLY, dict(method="ls", holdout=0.3), "holdout"),
     (POLY, dict(method="ls", max_rounds=3), "max_rounds"),
     (POLY, dict(method="ls", holdout=0.1), "holdout"),
 ]
@@ -282,6 +286,19 @@ def test_identify_misuse_is_one_line_naming_the_option(
         sid.identify(record, structure, **kwargs)
     message = str(refused.value)
     assert "\n" not in message and f"`{option}`" in message
+
+
+@pytest.mark.parametrize("method", ["ls", "oe", "spiral"])
+def test_rng_is_accepted_by_every_method_so_one_call_loops_over_them(record, method):
+    # A documented acceptance (identify's `rng`): ls and oe have nothing to
+    # seed, and give the same model with any seed.
+    options = {"max_nfev": 300} if method == "spiral" else {}
+    first = sid.identify(record, ARX2, method=method, rng=0, **options)
+    again = sid.identify(record, ARX2, method=method, rng=0, **options)
+    np.testing.assert_array_equal(first.theta, again.theta)
+    if method != "spiral":
+        other = sid.identify(record, ARX2, method=method, rng=1)
+        np.testing.assert_array_equal(first.theta, other.theta)
 
 
 _PARETO_MISUSE = [

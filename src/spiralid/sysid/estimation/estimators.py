@@ -603,12 +603,12 @@ def _estimate_recommended(
     ``polish_every=None``, which asks for no gradient step at all), unless
     the held-back choice below says otherwise.
 
-    With `holdback` ``h`` (default 0.2) all this runs on the first ``1 -
-    h`` of the estimation record; each distinct minimum (the polished search
-    best, output error from least squares and from Steiglitz-McBride) is
-    scored by its simulation error on the held-back end and refitted on the
-    whole record, and the lowest whole-record cost is kept unless another
-    minimum validates clearly better on the held-back end
+    With `holdback` ``h`` (default 0.2) each distinct minimum of the whole
+    estimation record (the polished search best, output error from least
+    squares and from Steiglitz-McBride) is refitted locally on its first
+    ``1 - h`` and scored by that refit's simulation error on the held-back
+    end, and the lowest whole-record cost is kept unless another minimum
+    validates clearly better on the held-back end
     (:mod:`~spiralid.sysid.estimation.heldback`; ``result.selection`` and
     the message say which and why). ``holdback=None`` (or 0) chooses by the
     whole-record cost alone. The pole-zero cancellation (``cancel``) may

@@ -121,32 +121,34 @@ def identify_options(method: str, structure, refine: bool = False) -> tuple[str,
     its own arguments and ``**options`` alike; the one table `identify`,
     the command line and the tests check against.
 
+    ``rng`` for every method and structure: one call can then loop over
+    methods, and a deterministic method (``"ls"``, ``"oe"``, forward
+    regression) has nothing to seed (a documented acceptance, not an
+    option ignored by mistake).
     For an ARX structure: ``predictor``, ``initial``, ``gain``,
-    ``penalty`` and ``integrator`` always; ``rng`` for a search;
+    ``penalty`` and ``integrator`` always;
     ``max_time_constant`` for the methods with ``Method.margin`` and a
     search with ``refine=True``; ``cancel`` for those with
     ``Method.cancel``; then
     :func:`~spiralid.sysid.estimation.estimators.method_options`.
-    For a NARX: ``predictor``, ``initial``, ``rng``, ``holdout``, ``decay``
-    and the method's NARX estimator's options; a PolynomialNARX (forward
-    regression, deterministic) takes ``predictor`` and ``initial`` only.
+    For a NARX: ``predictor``, ``initial``, ``holdout``, ``decay`` and the
+    method's NARX estimator's options; a PolynomialNARX (forward
+    regression) takes ``predictor`` and ``initial`` only.
 
     Examples
     --------
     >>> identify_options("ls", ARX(2, 2, 1))
-    ('predictor', 'initial', 'gain', 'penalty', 'integrator')
+    ('rng', 'predictor', 'initial', 'gain', 'penalty', 'integrator')
     >>> identify_options("oe", NARX(2, 2, 1))
-    ('predictor', 'initial', 'rng', 'holdout', 'decay', 'max_rounds', 'patience')
+    ('rng', 'predictor', 'initial', 'holdout', 'decay', 'max_rounds', 'patience')
     """
     if isinstance(structure, PolynomialNARX):
-        return ("predictor", "initial")
+        return ("rng", "predictor", "initial")
     if isinstance(structure, NARX):
-        own = ("predictor", "initial", "rng", "holdout", "decay")
+        own = ("rng", "predictor", "initial", "holdout", "decay")
         return (*own, *method_options(method, narx=True))
     spec = METHODS[method]
-    out = ["predictor", "initial", "gain", "penalty", "integrator"]
-    if spec.search:
-        out.append("rng")
+    out = ["rng", "predictor", "initial", "gain", "penalty", "integrator"]
     if spec.margin or (spec.search and _is_true(refine)):
         out.append("max_time_constant")
     if spec.cancel:
@@ -252,7 +254,9 @@ def identify(
         error or the one-step prediction error.
     rng : int, numpy.random.Generator or None
         Randomness of a search (initial points and the search), or of a
-        NARX's initial weights.
+        NARX's initial weights. Every method accepts it, so one call can
+        loop over methods; ``"ls"``, ``"oe"`` and forward regression have
+        nothing to seed.
     gain, penalty
         The cost's gain ``w`` and stability penalty, see :class:`PaperCost`.
     initial : {"rest", "measured"}, default "rest"
@@ -350,35 +354,36 @@ def identify(
 
     Notes
     -----
-    Options by method, beside ``predictor``, ``initial``, ``gain``,
-    ``penalty`` and ``integrator``, which every method takes for an ARX
-    structure (with ``"ls"`` and ``"oe"``, `predictor`, `gain` and `penalty`
+    Options by method, beside ``rng``, ``predictor``, ``initial``,
+    ``gain``, ``penalty`` and ``integrator``, which every method takes for
+    an ARX structure (with ``"ls"`` and ``"oe"``, `predictor`, `gain` and `penalty`
     only set the reported cost):
 
     - ``"ls"``: none.
     - ``"oe"``: ``max_time_constant``, ``cancel``.
-    - ``"spiral"``: ``rng``, ``max_time_constant``, ``cancel``,
+    - ``"spiral"``: ``max_time_constant``, ``cancel``,
       ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
       ``rule``, ``n_points``, ``max_nfev``, ``polish_every``,
       ``polish_nfev``, ``restarts``, ``frequency_seeds``, ``holdback``,
       ``x0``, ``max_iter``, ``callback``.
-    - ``"de"``: ``rng``, ``max_time_constant`` (with ``refine=True``),
+    - ``"de"``: ``max_time_constant`` (with ``refine=True``),
       ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
       ``n_points``, ``max_iter``, ``max_nfev``, ``x0``, ``callback``.
     - every rule of :data:`spiralid.optim.RULES` (``"sda"``, ``"ebsda"``,
-      ``"lasda"``, ...): ``rng``, ``max_time_constant`` (with
+      ``"lasda"``, ...): ``max_time_constant`` (with
       ``refine=True``), ``parametrization``, ``bounds``, ``refine``,
       ``safe_start``, ``n_points``, ``max_iter``, ``max_nfev``,
       ``max_time``, ``target``, ``x0``, ``callback``, ``bounds_policy``,
       ``restarts``.
 
-    For a NARX structure every method takes ``predictor``, ``initial``,
-    ``rng``, ``holdout`` and ``decay``, and: ``"ls"`` and ``"oe"``
+    For a NARX structure every method takes ``rng``, ``predictor``,
+    ``initial``, ``holdout`` and ``decay``, and: ``"ls"`` and ``"oe"``
     ``max_rounds``, ``patience``; ``"spiral"`` ``rule``, ``n_points``,
     ``max_nfev``, ``polish_every``, ``polish_nfev``, ``max_iter``; a rule
     ``n_points``, ``max_iter``, ``max_nfev``, ``max_time``, ``target``,
     ``x0``, ``callback``, ``bounds_policy``, ``restarts``. A
-    PolynomialNARX (``"ls"`` only) takes ``predictor`` and ``initial``.
+    PolynomialNARX (``"ls"`` only) takes ``rng``, ``predictor`` and
+    ``initial``.
     ``tests/test_option_contract.py`` checks this table against
     :func:`identify_options` and the command line.
 
