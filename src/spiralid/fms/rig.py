@@ -92,8 +92,14 @@ class Recording:
     ts: float
     state: np.ndarray | None = None
 
-    def iodata(self, name: str = "end_acceleration"):
-        """The torque and one output channel as a :class:`spiralid.IOData`.
+    def iodata(self, name: str | list[str] = "end_acceleration"):
+        """The torque and one output channel, or several, as a
+        :class:`spiralid.IOData`.
+
+        `name` is one of the recorded outputs (``"hub_angle"``,
+        ``"hub_velocity"``, ``"end_acceleration"``, ``"tip_deflection"``), or
+        a list of them: a record of several outputs that share the torque
+        (``y`` of shape (N, p), each output with its own name and unit).
 
         ``spiralid.sysid.data`` is imported here, inside the method: it is the
         one sanctioned dependency of ``fms`` on the rest of the package, kept
@@ -103,22 +109,33 @@ class Recording:
         --------
         >>> from spiralid.fms import FlexibleManipulator, bang_bang
         >>> u = bang_bang(0.3, 0.05, 0.1, 1.0, 500.0)
-        >>> d = FlexibleManipulator().simulate(u).iodata("end_acceleration")
+        >>> rec = FlexibleManipulator().simulate(u)
+        >>> d = rec.iodata("end_acceleration")
         >>> d.n, d.ts, d.output_name, d.output_unit
         (500, 0.002, 'end_acceleration', 'm/s^2')
+        >>> rec.iodata(["hub_angle", "tip_deflection"]).output_units
+        ('rad', 'm')
         """
         from spiralid.sysid.data import IOData
 
-        if not isinstance(name, str) or name not in _OUTPUTS:
-            raise ValueError(f"`name` must be one of {_OUTPUTS}; got {name!r}")
+        names = list(name) if isinstance(name, list | tuple) else [name]
+        for one in names:
+            if not isinstance(one, str) or one not in _OUTPUTS:
+                raise ValueError(f"`name` must be one of {_OUTPUTS}; got {one!r}")
+        if not names or len(set(names)) != len(names):
+            raise ValueError(f"`name` must list each output once; got {name!r}")
+        several = len(names) > 1
+        y = [getattr(self, one) for one in names]
         return IOData(
             self.u,
-            getattr(self, name),
+            np.column_stack(y) if several else y[0],
             ts=self.ts,
             input_name="torque",
-            output_name=name,
+            output_name=tuple(names) if several else names[0],
             input_unit="N m",
-            output_unit=_UNITS[name],
+            output_unit=tuple(_UNITS[one] for one in names)
+            if several
+            else _UNITS[names[0]],
         )
 
 

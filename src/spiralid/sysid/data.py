@@ -60,6 +60,15 @@ def check_signal(x, name: str, min_size: int = 1) -> np.ndarray:
     return arr
 
 
+def single_output_record(data, what: str):
+    """`data` checked as an :class:`IOData` of one output, for `what` (a
+    function that models one output): a one-line ValueError otherwise."""
+    if not isinstance(data, IOData):
+        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    data.require_single_output(what)
+    return data
+
+
 def check_pair(a, b, name_a: str, name_b: str) -> tuple[np.ndarray, np.ndarray]:
     """Two signals through :func:`check_signal`, refused unless equally long."""
     a = check_signal(a, name_a)
@@ -72,12 +81,42 @@ def check_pair(a, b, name_a: str, name_b: str) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
+def check_outputs(y, name: str = "y") -> np.ndarray:
+    """A finite float output: a 1-D signal (one output, as
+    :func:`check_signal`), or an (N, p) array of p >= 2 outputs, each
+    column checked as a signal named ``y[:, k]``."""
+    arr = np.asarray(y) if not isinstance(y, np.ndarray) else y
+    if arr.ndim == 2 and arr.shape[1] >= 2:
+        cols = [check_signal(arr[:, k], f"{name}[:, {k}]") for k in range(arr.shape[1])]
+        return np.column_stack(cols)
+    return check_signal(y, name)
+
+
 def _frozen_signal(x, name: str) -> np.ndarray:
     # A private read-only copy: IOData is immutable, and freezing the
     # caller's own array instead would make it read-only behind their back.
-    arr = np.array(check_signal(x, name), dtype=float, order="C", copy=True)
+    check = check_outputs if name == "y" else check_signal
+    arr = np.array(check(x, name), dtype=float, order="C", copy=True)
     arr.flags.writeable = False
     return arr
+
+
+def _per_output(value, p: int, name: str, kind):
+    """`value` for each of p outputs: one value for all, or a sequence of
+    p values; converted by `kind` (str or float)."""
+    if isinstance(value, str | int | float | np.number) and not isinstance(value, bool):
+        return (kind(value),) * p
+    try:
+        values = tuple(kind(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`{name}` must be one value or one per output ({p}); got {value!r}"
+        ) from None
+    if len(values) != p:
+        raise ValueError(
+            f"`{name}` must have one entry per output ({p}); got {len(values)}"
+        )
+    return values
 
 
 # Sums of squares of N samples overflow beyond about 1e154 / sqrt(N), and
@@ -118,22 +157,40 @@ def _check_ts(ts) -> float:
 
 @dataclass(frozen=True, eq=False)
 class IOData:
-    """A single-input single-output record sampled every `ts` seconds.
+    """A single-input record of one or several outputs, sampled every `ts`
+    seconds.
 
     Parameters
     ----------
-    u, y : array_like, shape (N,) or (N, 1)
-        Input and output samples; must be finite and of equal length.
+    u : array_like, shape (N,) or (N, 1)
+        Input samples; finite.
+    y : array_like, shape (N,), (N, 1) or (N, p)
+        Output samples, as long as `u` and finite: one output (stored as
+        shape (N,), the simple case every single-output function takes), or
+        ``p >= 2`` outputs that share the input, one per column (a
+        flexible structure's sensors).
     ts : float
         Sample time in seconds (> 0).
     input_name, output_name : str
-        Labels used in tables and plots.
+        Labels used in tables and plots; with several outputs
+        `output_name` is one name per output (default ``y1, y2, ...``).
     input_unit, output_unit : str
         Units of `u` and `y` (e.g. ``"N m"``, ``"m/s^2"``), shown in every
-        figure and table; empty when unknown.
+        figure and table; empty when unknown. With several outputs
+        `output_unit` is one unit for all or one per output.
     u_offset, y_offset : float
         Offsets already removed from the signals (set by :meth:`detrend`);
-        add them back to recover the raw signals.
+        add them back to recover the raw signals. With several outputs
+        `y_offset` is one per output.
+
+    Notes
+    -----
+    With several outputs, ``output_name``, ``output_unit`` and ``y_offset``
+    are tuples with one entry per output; :attr:`output_names`,
+    :attr:`output_units` and :attr:`y_offsets` are tuples in every case,
+    :meth:`output` picks one output as a single-output record, and a
+    function that models one output refuses several in one line
+    (:meth:`require_single_output`).
 
     Examples
     --------
@@ -149,18 +206,18 @@ class IOData:
     y: np.ndarray
     ts: float
     input_name: str = "u"
-    output_name: str = "y"
+    output_name: str | tuple[str, ...] = "y"
     u_offset: float = field(default=0.0)
-    y_offset: float = field(default=0.0)
+    y_offset: float | tuple[float, ...] = field(default=0.0)
     input_unit: str = ""
-    output_unit: str = ""
+    output_unit: str | tuple[str, ...] = ""
 
     def __post_init__(self) -> None:
         u = _frozen_signal(self.u, "u")
         y = _frozen_signal(self.y, "y")
-        if u.size != y.size:
+        if u.size != y.shape[0]:
             raise ValueError(
-                f"`u` and `y` must have the same length; got {u.size} and {y.size}"
+                f"`u` and `y` must have the same length; got {u.size} and {y.shape[0]}"
             )
         _check_magnitude(u, "u")
         _check_magnitude(y, "y")
@@ -168,11 +225,27 @@ class IOData:
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "ts", _check_ts(self.ts))
         object.__setattr__(self, "input_name", str(self.input_name))
-        object.__setattr__(self, "output_name", str(self.output_name))
         object.__setattr__(self, "u_offset", float(self.u_offset))
-        object.__setattr__(self, "y_offset", float(self.y_offset))
         object.__setattr__(self, "input_unit", str(self.input_unit))
-        object.__setattr__(self, "output_unit", str(self.output_unit))
+        if y.ndim == 1:
+            object.__setattr__(self, "output_name", str(self.output_name))
+            object.__setattr__(self, "y_offset", float(self.y_offset))
+            object.__setattr__(self, "output_unit", str(self.output_unit))
+            return
+        p = y.shape[1]
+        names = self.output_name
+        if isinstance(names, str):
+            names = tuple(f"{names}{k + 1}" for k in range(p))
+        names = _per_output(names, p, "output_name", str)
+        if len(set(names)) != p:
+            raise ValueError(f"`output_name` must name each output once; got {names}")
+        object.__setattr__(self, "output_name", names)
+        object.__setattr__(
+            self, "y_offset", _per_output(self.y_offset, p, "y_offset", float)
+        )
+        object.__setattr__(
+            self, "output_unit", _per_output(self.output_unit, p, "output_unit", str)
+        )
 
     @property
     def n(self) -> int:
@@ -181,6 +254,76 @@ class IOData:
 
     def __len__(self) -> int:
         return self.n
+
+    @property
+    def n_outputs(self) -> int:
+        """Number of outputs ``p`` (1 for a single-output record)."""
+        return 1 if self.y.ndim == 1 else int(self.y.shape[1])
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        """One name per output."""
+        return (self.output_name,) if self.y.ndim == 1 else self.output_name
+
+    @property
+    def output_units(self) -> tuple[str, ...]:
+        """One unit per output."""
+        return (self.output_unit,) if self.y.ndim == 1 else self.output_unit
+
+    @property
+    def y_offsets(self) -> tuple[float, ...]:
+        """One removed offset per output."""
+        return (self.y_offset,) if self.y.ndim == 1 else self.y_offset
+
+    @property
+    def outputs(self) -> np.ndarray:
+        """The outputs as an (N, p) array, whatever ``p`` (a read-only view)."""
+        return self.y.reshape(self.n, self.n_outputs)
+
+    def output(self, which: int | str) -> IOData:
+        """One output, by 0-based index or name, as a single-output record
+        with its own name, unit and offset (the record itself when it has
+        one output and `which` names it)."""
+        names = self.output_names
+        if isinstance(which, str):
+            if which not in names:
+                raise ValueError(
+                    f"`which` must be one of the outputs {names}; got {which!r}"
+                )
+            k = names.index(which)
+        elif isinstance(which, int | np.integer) and not isinstance(which, bool):
+            if not 0 <= which < len(names):
+                raise ValueError(
+                    f"`which` must be an output index in [0, {len(names) - 1}]; "
+                    f"got {which!r}"
+                )
+            k = int(which)
+        else:
+            raise ValueError(
+                f"`which` must be an output's index or name; got {which!r}"
+            )
+        if self.y.ndim == 1:
+            return self
+        return IOData(
+            self.u,
+            self.y[:, k],
+            ts=self.ts,
+            input_name=self.input_name,
+            output_name=names[k],
+            u_offset=self.u_offset,
+            y_offset=self.y_offsets[k],
+            input_unit=self.input_unit,
+            output_unit=self.output_units[k],
+        )
+
+    def require_single_output(self, what: str) -> None:
+        """A one-line ValueError when the record has several outputs:
+        `what` (e.g. ``"identify with an ARX structure"``) models one."""
+        if self.y.ndim != 1:
+            raise ValueError(
+                f"`data` has {self.n_outputs} outputs {self.output_names}; {what} "
+                "takes one: pass data.output(name)"
+            )
 
     @property
     def t(self) -> np.ndarray:
@@ -194,8 +337,12 @@ class IOData:
 
     @property
     def output_label(self) -> str:
-        """``"name (unit)"``, or the name alone when the unit is unknown."""
-        return _label(self.output_name, self.output_unit)
+        """``"name (unit)"``, or the name alone when the unit is unknown
+        (joined by commas for several outputs)."""
+        return ", ".join(
+            _label(n, unit)
+            for n, unit in zip(self.output_names, self.output_units, strict=True)
+        )
 
     def __repr__(self) -> str:
         return (
@@ -284,12 +431,20 @@ class IOData:
         ref = self if like is None else like
         if not isinstance(ref, IOData):
             raise ValueError(f"`like` must be an IOData; got {type(like).__name__}")
-        mu, my = float(ref.u.mean()), float(ref.y.mean())
+        if ref.n_outputs != self.n_outputs:
+            raise ValueError(
+                f"`like` must have the record's {self.n_outputs} output(s); got "
+                f"{ref.n_outputs}"
+            )
+        mu = float(ref.u.mean())
+        if self.y.ndim == 1:
+            my = float(ref.y.mean())
+            offset = self.y_offset + my
+        else:
+            my = ref.y.mean(axis=0)
+            offset = tuple(float(a + b) for a, b in zip(self.y_offset, my, strict=True))
         return self._replace(
-            self.u - mu,
-            self.y - my,
-            u_offset=self.u_offset + mu,
-            y_offset=self.y_offset + my,
+            self.u - mu, self.y - my, u_offset=self.u_offset + mu, y_offset=offset
         )
 
     # -- loading ---------------------------------------------------------------
@@ -299,13 +454,13 @@ class IOData:
         cls,
         path: str | os.PathLike,
         input: str | int = "u",
-        output: str | int = "y",
+        output: str | int | list = "y",
         ts: float | None = None,
         delimiter: str = ",",
         *,
         default_ts: float | None = None,
     ) -> IOData:
-        """Read two columns of a delimited text file (opened once).
+        """Read the input and output columns of a delimited text file (opened once).
 
         Parameters
         ----------
@@ -313,9 +468,11 @@ class IOData:
             The file. A first line that is not all numbers is read as a header.
         input, output : str or int
             Column names (needs a header) or 0-based column indices. A header
-        may carry units as ``name [unit]`` or ``name (unit)``; the column is
-        then named by either the whole header or ``name``, and the unit goes
-        to ``input_unit`` / ``output_unit``.
+            may carry units as ``name [unit]`` or ``name (unit)``; the column
+            is then named by either the whole header or ``name``, and the
+            unit goes to ``input_unit`` / ``output_unit``. `output` may be a
+            list of columns: a record of several outputs, ``y`` of shape
+            (N, p).
         ts : float, optional
             Sample time in seconds; default the step of an evenly spaced
             ``time_s`` column, else `default_ts`.
@@ -373,16 +530,20 @@ class IOData:
             return j, *(_split_unit(header[j]) if header else (f"column {j}", ""))
 
         iu, name_u, unit_u = column(input, "input")
-        iy, name_y, unit_y = column(output, "output")
-
+        keys = _output_keys(output)
+        found = [column(key, "output") for key in keys]
+        ys = [_csv_column(rows, j, name, where) for j, name, _ in found]
+        names = tuple(name for _, name, _ in found)
+        units = tuple(unit for _, _, unit in found)
+        several = len(keys) > 1
         return cls(
             _csv_column(rows, iu, name_u, where),
-            _csv_column(rows, iy, name_y, where),
+            np.column_stack(ys) if several else ys[0],
             ts,
             name_u,
-            name_y,
+            names if several else names[0],
             input_unit=unit_u,
-            output_unit=unit_y,
+            output_unit=units if several else units[0],
         )
 
     @classmethod
@@ -390,7 +551,7 @@ class IOData:
         cls,
         path: str | os.PathLike,
         input: str = "u",
-        output: str = "y",
+        output: str | list = "y",
         ts: float | None = None,
         *,
         default_ts: float | None = None,
@@ -403,7 +564,8 @@ class IOData:
             The archive, as :func:`numpy.savez` writes it.
         input, output : str
             The names of the input and output arrays; a (1, N) or (N, 1)
-            array is read as a vector.
+            array is read as a vector. `output` may be a list of names: a
+            record of several outputs, ``y`` of shape (N, p).
         ts : float, optional
             Sample time in seconds; default the scalar array named ``ts``,
             else `default_ts`.
@@ -418,7 +580,7 @@ class IOData:
         cls,
         path: str | os.PathLike,
         input: str = "u",
-        output: str = "y",
+        output: str | list = "y",
         ts: float | None = None,
         *,
         default_ts: float | None = None,
@@ -435,7 +597,8 @@ class IOData:
         """The one reader of the formats that hold named arrays (.npz, .mat):
         `mapping` is the file's arrays by name."""
         names = sorted(mapping)
-        for key, arg in ((input, "input"), (output, "output")):
+        keys = _output_keys(output)
+        for key, arg in ((input, "input"), *((k, "output") for k in keys)):
             if key not in mapping:
                 raise ValueError(
                     f"`{arg}` must be one of the variables {names}; got {key!r}"
@@ -466,9 +629,27 @@ class IOData:
             # MATLAB stores vectors as (1, N) or (N, 1).
             return a.ravel() if a.ndim == 2 and 1 in a.shape else a
 
+        ys = [arr(key, "output") for key in keys]
+        several = len(keys) > 1
         return cls(
-            arr(input, "input"), arr(output, "output"), ts, str(input), str(output)
+            arr(input, "input"),
+            np.column_stack(ys) if several else ys[0],
+            ts,
+            str(input),
+            tuple(str(k) for k in keys) if several else str(keys[0]),
         )
+
+
+def _output_keys(output) -> list:
+    """The readers' `output`: one column or variable, or a list of them for
+    a record of several outputs."""
+    if isinstance(output, list | tuple):
+        if not output:
+            raise ValueError("`output` must name at least one column; got []")
+        if len(set(output)) != len(output):
+            raise ValueError(f"`output` must name each column once; got {output!r}")
+        return list(output)
+    return [output]
 
 
 def _npz_arrays(path) -> dict:

@@ -54,7 +54,7 @@ from scipy.signal import lfilter, lfiltic
 
 from spiralid._checks import nonneg, positive
 
-from ..data import IOData
+from ..data import IOData, single_output_record
 from ..models.arx import ARX, INITIAL_CONDITIONS
 from ..models.polynomials import is_stable_polynomial
 
@@ -151,8 +151,7 @@ class PaperCost:
     ) -> None:
         if not isinstance(arx, ARX):
             raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
-        if not isinstance(data, IOData):
-            raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+        single_output_record(data, "PaperCost")
         if predictor not in _PREDICTORS:
             raise ValueError(
                 f"`predictor` must be one of {_PREDICTORS}; got {predictor!r}"

@@ -34,7 +34,7 @@ import numpy as np
 
 from spiralid._checks import positive
 
-from ..data import IOData
+from ..data import IOData, single_output_record
 from ..models.arx import ARX
 from ..spectra import cross_spectra, segment_length
 
@@ -129,8 +129,7 @@ def h1_estimate(
     >>> round(float(est.magnitude_db[0]), 1), bool(est.coherence.min() > 0.99)
     (13.9, True)
     """
-    if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    single_output_record(data, "the H1 estimate")
     nperseg = segment_length(nperseg, data.n, 8)
     fs = 1.0 / data.ts
     nyquist = fs / 2.0

@@ -49,7 +49,7 @@ import numpy as np
 
 from spiralid._checks import box_bounds, generator, is_default, refuse_options
 
-from ..data import IOData
+from ..data import IOData, single_output_record
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from ..models.narx import NARX, PolynomialNARX
@@ -398,8 +398,7 @@ def identify(
     (array([-1.5,  0.7,  1. ,  0.5]), True, 0)
     """
     t_start = time.perf_counter()
-    if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    single_output_record(data, "identify")
     if not isinstance(arx, ARX | NARX | PolynomialNARX):
         raise ValueError(
             f"`arx` must be an ARX, NARX or PolynomialNARX; got {type(arx).__name__}"

@@ -29,7 +29,7 @@ from scipy import signal
 from spiralid._checks import integer
 from spiralid.optim.result import OptimiserResult
 
-from ..data import IOData
+from ..data import IOData, single_output_record
 from ..models.arx import ARX, arx_least_squares
 from ..models.polynomials import step_down, step_up
 from .levenberg import levenberg_marquardt
@@ -236,8 +236,7 @@ def steiglitz_mcbride(
     >>> bool(np.linalg.norm(sm - true) < np.linalg.norm(ls - true))
     True
     """
-    if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    single_output_record(data, "steiglitz_mcbride")
     if not isinstance(arx, ARX):
         raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
     n_iter = integer(n_iter, "n_iter", 0)

@@ -32,7 +32,7 @@ from scipy import signal
 
 from spiralid._checks import integer
 
-from ..data import IOData, check_signal
+from ..data import IOData, check_signal, single_output_record
 from .polynomials import is_stable_polynomial
 
 __all__ = ["ARX", "INITIAL_CONDITIONS", "arx_least_squares"]
@@ -147,8 +147,7 @@ class ARX:
         -------
         ndarray, shape (N, n_params)
         """
-        if not isinstance(data, IOData):
-            raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+        single_output_record(data, "the ARX regressors")
         u, y = data.u, data.y
         n = u.size
         phi = np.zeros((n, self.n_params))
@@ -337,8 +336,7 @@ def arx_least_squares(data: IOData, arx: ARX) -> np.ndarray:
     >>> arx_least_squares(IOData(u, y, ts=1.0), ARX(2, 2, 1)).round(9)
     array([-1.5,  0.7,  1. ,  0.5])
     """
-    if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    single_output_record(data, "arx_least_squares")
     if not isinstance(arx, ARX):
         raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
     arx.check_length(data)

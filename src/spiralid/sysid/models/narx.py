@@ -40,7 +40,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from ..data import IOData, check_signal
+from ..data import IOData, check_signal, single_output_record
 from . import _fields
 
 __all__ = [
@@ -931,8 +931,7 @@ class NARXModel:
         ----------
         data : IOData
         """
-        if not isinstance(data, IOData):
-            raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+        single_output_record(data, "a NARX model")
         phi, _ = self.structure.regressors(data.u, data.y, self.scaling)
         z = self.structure.evaluate(self.params, phi)
         s = self.scaling

@@ -643,6 +643,9 @@ def _signals_of(data, name: str = "data"):
                 f"`{name}` must be an IOData (with .u, .y, .ts); "
                 f"got {type(data).__name__}"
             )
+    if np.ndim(data.y) == 2 and np.shape(data.y)[1] > 1:
+        # Before .ravel() would interleave the outputs into one signal.
+        data.require_single_output(f"validate (`{name}`)")
     u = np.asarray(data.u, dtype=float).ravel()
     y = np.asarray(data.y, dtype=float).ravel()
     if u.size != y.size:
