@@ -140,7 +140,7 @@ def quality_table() -> None:
                     max_nfev=budget,
                     rng=seed,
                     vectorized=True,
-                    bounds_policy=policy,
+                    options={"bounds_policy": policy},
                 )
                 assert res.nfev == budget
                 costs.append(res.fun)

@@ -178,7 +178,7 @@ def _modal_only(est, seed, budget):
         rng=seed,
         vectorized=True,
         max_nfev=budget,
-        bounds_policy="clip",
+        options={"bounds_policy": "clip"},
     )
     return np.r_[par.to_denominator(res.x[:8]), res.x[8:]]
 

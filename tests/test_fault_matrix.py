@@ -649,7 +649,9 @@ def test_max_time_ends_a_search_after_the_iteration_that_passes_it():
         return float(x @ x)
 
     box = [(-5, 5)] * 3
-    capped = minimize(sphere, box, "ebsda", rng=0, n_points=10, max_time=1e-12)
+    capped = minimize(
+        sphere, box, "ebsda", rng=0, n_points=10, options={"max_time": 1e-12}
+    )
     free = minimize(sphere, box, "ebsda", rng=0, n_points=10, max_iter=1)
     assert capped.nit == 1 and capped.nfev == free.nfev == 10 + 9
     assert capped.status == 3 and capped.success
@@ -657,14 +659,16 @@ def test_max_time_ends_a_search_after_the_iteration_that_passes_it():
     np.testing.assert_array_equal(capped.x, free.x)
     # A generous limit changes nothing.
     long = minimize(sphere, box, "ebsda", rng=0, n_points=10, max_iter=20,
-                    max_time=1e9)  # fmt: skip
+                    options={"max_time": 1e9})  # fmt: skip
     assert long.nit == 20 and long.status == 2
 
     def two(x):
         return np.column_stack([x[:, 0] ** 2, (x[:, 0] - 2) ** 2])
 
     kw = {"n_points": 20, "rng": 0, "vectorized": True}
-    front = minimize_pareto(two, [(-5, 5)], max_nfev=2000, max_time=1e-12, **kw)
+    front = minimize_pareto(
+        two, [(-5, 5)], max_nfev=2000, options={"max_time": 1e-12}, **kw
+    )
     assert front.nit == 1 and front.status == 3 and "time limit" in front.message
     first = minimize_pareto(two, [(-5, 5)], max_nfev=2000, **kw)
     assert front.nfev < first.nfev and first.status == 1
@@ -675,9 +679,9 @@ def test_max_time_must_be_a_positive_finite_number(bad):
     from spiralid.optim import minimize, minimize_pareto
 
     with pytest.raises(ValueError, match=r"`max_time` must be a finite number > 0"):
-        minimize(lambda x: float(x @ x), [(-1, 1)], max_time=bad)
+        minimize(lambda x: float(x @ x), [(-1, 1)], options={"max_time": bad})
     with pytest.raises(ValueError, match=r"`max_time` must be a finite number > 0"):
-        minimize_pareto(lambda x: [x[0], -x[0]], [(-1, 1)], max_time=bad)
+        minimize_pareto(lambda x: [x[0], -x[0]], [(-1, 1)], options={"max_time": bad})
 
 
 # -- third fault round: data files, reproduce, study stores -------------------

@@ -112,7 +112,7 @@ def test_invariant_to_a_rotation_of_the_problem(seed):
             n_points=2,
             max_iter=10**6,
             max_nfev=40_000,
-            target=1e-10,
+            options={"target": 1e-10},
             rng=seed,
         )
         assert res.message == "Target cost reached."
@@ -189,7 +189,7 @@ def test_bounds_policy_keeps_every_evaluated_point_in_the_box(policy):
         "learned-metric",
         max_nfev=600,
         rng=0,
-        bounds_policy=policy,
+        options={"bounds_policy": policy},
         restarts=True,
     )
     pts = np.array(seen)

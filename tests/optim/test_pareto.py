@@ -90,7 +90,7 @@ def test_ebsda_approaches_the_zdt1_front():
     front = np.column_stack([a, 1.0 - np.sqrt(a)])
     res = minimize_pareto(
         _zdt1, [(0.0, 1.0)] * 30, "ebsda", n_points=100, max_nfev=25_000,
-        rng=1, vectorized=True, ref_point=[1.1, 1.1],
+        rng=1, vectorized=True, options={"ref_point": [1.1, 1.1]},
     )  # fmt: skip
     assert _igd_plus(res.fun, front) < 0.2
     assert res.nfev <= 25_000 and res.status == 1
@@ -98,7 +98,7 @@ def test_ebsda_approaches_the_zdt1_front():
     assert res.history[-1] > 2 * res.history[0]
     again = minimize_pareto(
         _zdt1, [(0.0, 1.0)] * 30, "ebsda", n_points=100, max_nfev=25_000,
-        rng=1, vectorized=True, ref_point=[1.1, 1.1],
+        rng=1, vectorized=True, options={"ref_point": [1.1, 1.1]},
     )  # fmt: skip
     np.testing.assert_array_equal(res.x, again.x)
 
@@ -309,14 +309,16 @@ def test_arguments_and_the_objective_count_are_checked_before_spending():
         return [x[0], 1 - x[0], 0.0, 0.0]
 
     with pytest.raises(ValueError, match="`ref_point` must be a finite vector"):
-        minimize_pareto(four, [(0, 1)] * 2, n_points=10, ref_point=[1.0] * 4)
+        minimize_pareto(
+            four, [(0, 1)] * 2, n_points=10, options={"ref_point": [1.0] * 4}
+        )
     assert calls == []
     with pytest.raises(ValueError, match="2 or 3 objectives; got 4"):
         minimize_pareto(four, [(0, 1)] * 2, n_points=10, max_nfev=40, rng=0)
     assert len(calls) == 1  # one point, not the whole population
     with pytest.raises(ValueError, match="finite vector of length 2; got"):
-        minimize_pareto(_zdt1, [(0, 1)] * 2, n_points=10, ref_point=[1, 1, 1],
-                        vectorized=True)  # fmt: skip
+        minimize_pareto(_zdt1, [(0, 1)] * 2, n_points=10, vectorized=True,
+                        options={"ref_point": [1, 1, 1]})  # fmt: skip
 
 
 def test_nfev_counts_every_evaluation_with_three_objectives():

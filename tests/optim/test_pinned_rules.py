@@ -268,7 +268,7 @@ def test_existing_rules_unchanged_per_seed(method, name, policy, seed, x, fun):
         max_iter=150,
         rng=seed,
         vectorized=True,
-        bounds_policy=policy,
+        options={"bounds_policy": policy},
     )
     assert_close_to_pin(res, x, fun)
     assert res.nfev == 20 + 150 * 19

@@ -38,7 +38,9 @@ def test_every_rule_reports_each_stop(rule):
     assert by_nfev.status == 1 and by_nfev.nfev <= 100
     by_iter = minimize(sphere, BOX, rule, max_iter=5, **kw)
     assert by_iter.status == 2 and by_iter.nit == 5
-    by_target = minimize(sphere, BOX, rule, max_iter=1000, target=1e6, **kw)
+    by_target = minimize(
+        sphere, BOX, rule, max_iter=1000, options={"target": 1e6}, **kw
+    )
     assert by_target.status == 0 and by_target.nit == 0
     by_callback = minimize(sphere, BOX, rule, callback=lambda r: r.nit >= 3, **kw)
     assert by_callback.status == 0 and by_callback.nit == 3

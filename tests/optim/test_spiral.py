@@ -289,11 +289,19 @@ def test_max_nfev_budget():
 
 
 def test_target_stops_early():
-    res = minimize(sphere, [(-5, 5)] * 2, "sda", rng=0, vectorized=True, target=1e-3)
+    res = minimize(
+        sphere, [(-5, 5)] * 2, "sda", rng=0, vectorized=True, options={"target": 1e-3}
+    )
     assert res.success and res.fun <= 1e-3 and res.history[-2] > 1e-3
     assert res.nit < 500 and res.message == "Target cost reached."
     missed = minimize(
-        sphere, [(-5, 5)] * 2, "sda", rng=0, vectorized=True, max_iter=2, target=-1.0
+        sphere,
+        [(-5, 5)] * 2,
+        "sda",
+        rng=0,
+        vectorized=True,
+        max_iter=2,
+        options={"target": -1.0},
     )
     assert not missed.success and "target cost was not reached" in missed.message
 
@@ -343,6 +351,14 @@ def test_the_removed_hook_and_alias_name_their_replacement():
         minimize(sphere, [(-5, 5)] * 2, on_iteration=print)
     with pytest.raises(TypeError, match="unexpected keyword argument 'callbak'"):
         minimize(sphere, [(-5, 5)] * 2, callbak=print)
+    for name in ("max_time", "target", "bounds_policy"):
+        with pytest.raises(TypeError) as moved:
+            minimize(sphere, [(-5, 5)] * 2, **{name: None})
+        message = str(moved.value)
+        assert "\n" not in message
+        assert message.startswith(
+            f"`{name}` of minimize() is now a key of its `options`"
+        )
     with pytest.raises(AttributeError, match="returns `OptimiserResult`"):
         spiralid.optim.SpiralResult  # noqa: B018
     assert "SpiralResult" not in spiralid.optim.__all__
@@ -357,7 +373,7 @@ def test_callback_sees_the_iteration_that_reaches_the_target():
         "sda",
         rng=0,
         vectorized=True,
-        target=1e-3,
+        options={"target": 1e-3},
         callback=lambda r: seen.append(r.fun) or True,
     )
     # The callback asked to stop after the first iteration, target unmet.
@@ -370,7 +386,7 @@ def test_callback_sees_the_iteration_that_reaches_the_target():
         "sda",
         rng=0,
         vectorized=True,
-        target=1e-3,
+        options={"target": 1e-3},
         callback=lambda r: seen.append(r.fun),
     )
     assert res.message == "Target cost reached."
@@ -381,7 +397,12 @@ def test_callback_sees_the_iteration_that_reaches_the_target():
     h = minimize(sphere, [(-5, 5)] * 2, "sda", max_iter=1, **kw).history
     assert h[1] < h[0]
     both = minimize(
-        sphere, [(-5, 5)] * 2, "sda", target=h[1], callback=lambda r: True, **kw
+        sphere,
+        [(-5, 5)] * 2,
+        "sda",
+        options={"target": h[1]},
+        callback=lambda r: True,
+        **kw,
     )
     assert both.nit == 1 and both.success and both.message == "Target cost reached."
 
@@ -463,7 +484,7 @@ def _one_step_from(x0, policy):
         rng=0,
         vectorized=True,
         x0=x0,
-        bounds_policy=policy,
+        options={"bounds_policy": policy},
     )
     return rec.batches[1][0]
 
@@ -491,7 +512,7 @@ def test_reflect_unfolds_an_overshoot_of_several_widths():
         max_iter=1,
         vectorized=True,
         x0=[[0.9, 0.0], [-0.95, -0.95]],
-        bounds_policy="reflect",
+        options={"bounds_policy": "reflect"},
     )
     np.testing.assert_allclose(rec.batches[1][0], [-0.15, 0.75], atol=1e-13)
 
@@ -507,7 +528,7 @@ def test_reflect_and_clip_keep_every_point_inside():
             max_iter=30,
             rng=0,
             vectorized=True,
-            bounds_policy=policy,
+            options={"bounds_policy": policy},
         )
         pts = np.concatenate(rec.batches)
         assert pts.min() >= -1 and pts.max() <= 2
@@ -556,13 +577,22 @@ B2 = [(-1, 1)] * 2
         (dict(max_nfev=5, n_points=6), r"^`max_nfev` must be an integer >= 6; got 5"),
         (dict(method="pso"), r"^`method` must be 'sda', .*got 'pso'"),
         (dict(method=ConstantSpiral), r"^`method` must be"),
-        (dict(bounds_policy="wrap"), r"^`bounds_policy` must be one of .*got 'wrap'"),
+        (
+            dict(options={"bounds_policy": "wrap"}),
+            r"^`bounds_policy` must be one of .*got 'wrap'",
+        ),
         # An array would make `in` ambiguous (NumPy's own ValueError).
         (
-            dict(bounds_policy=np.array(["clip", "none"])),
+            dict(options={"bounds_policy": np.array(["clip", "none"])}),
             r"^`bounds_policy` must be one of",
         ),
-        (dict(target=np.nan), r"^`target` must be a real number or None"),
+        (dict(options={"target": np.nan}), r"^`target` must be a real number or None"),
+        (
+            dict(options={"tagret": 1.0}),
+            r"^`tagret` does not apply to the options of minimize\(\); the options "
+            "that do: max_time, target, bounds_policy$",
+        ),
+        (dict(options=[("target", 1.0)]), r"^`options` must be a mapping of max_time"),
         (dict(callback=3), r"^`callback` must be callable or None; got 3"),
         (dict(fun=3), r"^`fun` must be callable; got 3"),
         (dict(x0=[0.0, 0.0, 0.0]), r"^`x0` must have shape \(2,\) or \(k, 2\).*\(3,\)"),

@@ -12,6 +12,7 @@ from spiralid.optim.evolution import differential_evolution
 from spiralid.optim.front import knee_point
 from spiralid.optim.learned import LearnedMetricSearch, LearnedMetricSpiral
 from spiralid.optim.pareto import (
+    PARETO_OPTIONS,
     hypervolume,
     minimize_pareto,
     non_dominated,
@@ -32,9 +33,11 @@ from spiralid.optim.rules import (
     exponential_rule,
     rank_condition,
 )
-from spiralid.optim.spiral import RULES, SpiralSearch, minimize
+from spiralid.optim.spiral import MINIMIZE_OPTIONS, RULES, SpiralSearch, minimize
 
 __all__ = [
+    "MINIMIZE_OPTIONS",
+    "PARETO_OPTIONS",
     "RULES",
     "STATUS",
     "AdaptiveEncoding",

@@ -163,9 +163,11 @@ class LearnedMetricSearch(SearchBase):
 
     Parameters
     ----------
-    fun, bounds, method, n_points, rng, vectorized, x0, bounds_policy
+    fun, bounds, method, n_points, rng, vectorized, x0
         As in :func:`~spiralid.optim.minimize`; ``method`` is a
         :class:`LearnedMetricSpiral`.
+    bounds_policy : {"none", "clip", "reflect"}
+        As the key of :func:`~spiralid.optim.minimize`'s ``options``.
     max_iter : int, optional
         The run's iteration budget, over which ``success_steps=False``
         schedules its contraction (required then).

@@ -46,7 +46,15 @@ from spiralid.optim._decomposition import (
     SpiralMoves,
     Subproblems,
 )
-from spiralid.optim._loop import STATUS_CODE, STOPS, check_max_time, check_objective
+from spiralid.optim._loop import (
+    STATUS_CODE,
+    STOPS,
+    check_max_time,
+    check_objective,
+    moved_into_options,
+    refuse_keywords,
+    settings,
+)
 from spiralid.optim.front import (
     hypervolume,
     non_dominated,
@@ -60,6 +68,7 @@ from spiralid.optim.spiral import RULES, _parse_method
 
 __all__ = [
     "PARETO_METHODS",
+    "PARETO_OPTIONS",
     "hypervolume",
     "minimize_pareto",
     "non_dominated",
@@ -205,6 +214,13 @@ def _first_population(fun, x: np.ndarray, vectorized: bool) -> np.ndarray:
     return np.vstack([f, _evaluate(fun, x[1:], vectorized, k)])
 
 
+# minimize_pareto()'s rarely used settings and their defaults: keys of its
+# `options` mapping, as minimize() keeps its own (MINIMIZE_OPTIONS).
+PARETO_OPTIONS = {"max_time": None, "neighbours": 10, "ref_point": None}
+# Keywords minimize_pareto() no longer takes, and what replaced each.
+_MOVED = moved_into_options("minimize_pareto", PARETO_OPTIONS)
+
+
 def minimize_pareto(
     fun: Callable,
     bounds,
@@ -212,14 +228,13 @@ def minimize_pareto(
     *,
     n_points: int = 100,
     max_nfev: int = 10_000,
-    max_time: float | None = None,
-    neighbours: int = 10,
     archive: bool = True,
-    ref_point=None,
     rng=None,
     vectorized: bool = False,
     callback: Callable | None = None,
     x0=None,
+    options: dict | None = None,
+    **unknown,
 ) -> OptimiserResult:
     """Approximate the Pareto front of a vector objective by a spiral search.
 
@@ -253,22 +268,11 @@ def minimize_pareto(
         5,000 evaluations.
     max_nfev : int
         Budget of objective evaluations (at least two populations).
-    max_time : float, optional
-        Wall-time limit in seconds (a finite number > 0; default None, no
-        limit), checked after each iteration as in
-        :func:`spiralid.optim.minimize`: the search ends after the
-        iteration during which it passed.
-    neighbours : int
-        Subproblems whose incumbents a point may take as its centre and
-        replace.
     archive : bool
         Keep every evaluated non-dominated point and return that archive
         thinned to at most `n_points` evenly spread points (SPEA2's
         truncation, :func:`~spiralid.optim.front.thin_front`; default);
         False returns the non-dominated incumbents of the subproblems.
-    ref_point : array_like, shape (k,), optional
-        Reference point of the hypervolume ``history``; default the initial
-        population's worst value of each objective plus a tenth of its range.
     rng : None, int or numpy.random.Generator
     vectorized : bool
         Whether `fun` takes a batch of points.
@@ -281,6 +285,27 @@ def minimize_pareto(
         of the first ``q`` uniform draws of the initial population (clipped
         into the box; at most the population size). The draws are made
         anyway, so a seed changes nothing else.
+    options : dict, optional
+        The rarely used settings (:data:`PARETO_OPTIONS`, with their
+        defaults), as :func:`~spiralid.optim.minimize` keeps its own; any
+        other key is refused in one line naming it:
+
+        ``max_time`` : float or None
+            Wall-time limit in seconds (a finite number > 0; default None,
+            no limit), checked after each iteration as in
+            :func:`spiralid.optim.minimize`: the search ends after the
+            iteration during which it passed.
+        ``neighbours`` : int
+            Subproblems whose incumbents a point may take as its centre and
+            replace (default 10).
+        ``ref_point`` : array_like, shape (k,), or None
+            Reference point of the hypervolume ``history``; default the
+            initial population's worst value of each objective plus a
+            tenth of its range.
+
+        They were keywords of their own; passing one so is a one-line
+        TypeError saying to use ``options``, and any other unknown keyword
+        one naming the method and the options that apply.
 
     Returns
     -------
@@ -307,19 +332,21 @@ def minimize_pareto(
     (1, True)
     """
     t_start = time.perf_counter()
+    refuse_keywords(minimize_pareto, unknown, method, PARETO_OPTIONS, _MOVED)
+    opts = settings(options, PARETO_OPTIONS, "the options of minimize_pareto()")
     lo, hi = box_bounds(bounds)
     rule = _parse_rule(method)
     m = integer(n_points, "n_points", 4)
     max_nfev = integer(max_nfev, "max_nfev", 2 * m)
-    max_time = check_max_time(max_time)
-    neighbours = integer(neighbours, "neighbours", 2)
+    max_time = check_max_time(opts["max_time"])
+    neighbours = integer(opts["neighbours"], "neighbours", 2)
     if not isinstance(archive, bool):
         raise ValueError(f"`archive` must be True or False; got {archive!r}")
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
     vectorized = check_objective(fun, vectorized)
-    ref = _check_ref_point(ref_point)
+    ref = _check_ref_point(opts["ref_point"])
 
     x = _initial_points(gen, lo, hi, m, x0)
     f = _first_population(fun, x, vectorized)

@@ -36,8 +36,11 @@ from spiralid.optim._loop import (
     apply_bounds,
     check_max_time,
     finite_or_inf,
+    moved_into_options,
     point_in_box,
+    refuse_keywords,
     seed_points,
+    settings,
     stop_report,
 )
 from spiralid.optim._search import SearchBase
@@ -55,7 +58,7 @@ from spiralid.optim.rules import (
     StepRateRule,
 )
 
-__all__ = ["RULES", "SpiralSearch", "minimize"]
+__all__ = ["MINIMIZE_OPTIONS", "RULES", "SpiralSearch", "minimize"]
 
 _METHODS = {
     "sda": ConstantSpiral,
@@ -119,8 +122,10 @@ class SpiralSearch(SearchBase):
 
     Parameters
     ----------
-    fun, bounds, method, n_points, rng, vectorized, x0, bounds_policy
+    fun, bounds, method, n_points, rng, vectorized, x0
         As in :func:`minimize`.
+    bounds_policy : {"none", "clip", "reflect"}
+        As the key of :func:`minimize`'s ``options``.
     max_iter : int, optional
         Iteration budget ``k_max`` that a
         :class:`~spiralid.optim.StepRateRule` schedules its step rate over
@@ -392,33 +397,18 @@ def _fixed_rotation(rule: StepRateRule, n: int) -> np.ndarray:
     return R
 
 
+# minimize()'s rarely used settings and their defaults: keys of its
+# `options` mapping, as scipy.optimize.minimize takes its solvers' settings.
+MINIMIZE_OPTIONS = {"max_time": None, "target": None, "bounds_policy": "none"}
+
 # Keywords minimize() no longer takes, and what replaced each.
 _REMOVED = {
     "on_iteration": (
         "`on_iteration` was removed: use `callback`, whose "
         "`intermediate_result.search` is the search the hook received"
     ),
+    **moved_into_options("minimize", MINIMIZE_OPTIONS),
 }
-
-
-def _refuse_removed(removed: dict, method) -> None:
-    """A one-line error for a removed keyword; for any other Python's own
-    words, with the method and the options that apply (every rule takes
-    all of minimize's)."""
-    import inspect
-
-    for name in removed:
-        if name in _REMOVED:
-            raise TypeError(_REMOVED[name])
-        takes = [
-            p.name
-            for p in inspect.signature(minimize).parameters.values()
-            if p.kind is inspect.Parameter.KEYWORD_ONLY
-        ]
-        raise TypeError(
-            f"minimize() got an unexpected keyword argument {name!r}; method "
-            f"{method!r} takes {', '.join(takes)}"
-        )
 
 
 def _target(target) -> float | None:
@@ -530,14 +520,12 @@ def minimize(
     n_points: int = 50,
     max_iter: int = 500,
     max_nfev: int | None = None,
-    max_time: float | None = None,
-    target: float | None = None,
     rng=None,
     vectorized: bool = False,
     x0=None,
     callback: Callable | None = None,
-    bounds_policy: str = "none",
     restarts: bool | Restarts = False,
+    options: dict | None = None,
     **_removed,
 ) -> OptimiserResult:
     """Minimise ``fun`` with a spiral dynamic algorithm (SDA, Eb-SDA, LASDA).
@@ -575,14 +563,6 @@ def minimize(
         Budget of objective evaluations (``>= n_points``). The search stops
         before an iteration that would exceed it, so ``nfev <= max_nfev``.
         See Returns for how evaluations are counted.
-    max_time : float, optional
-        Wall-time limit in seconds (a finite number > 0; default None, no
-        limit). Checked after each iteration: the search ends after the
-        iteration during which the limit passed, so it overruns by up to
-        one iteration. Where a time limit stops it, the result is not
-        reproducible from the seed alone.
-    target : float, optional
-        Stop as soon as the best cost is at or below ``target``.
     rng : None, int or numpy.random.Generator
         Seed or generator; the same seed gives the same result bit for bit.
     vectorized : bool
@@ -600,9 +580,6 @@ def minimize(
         its centre (:meth:`SpiralSearch.move_centre`, e.g. a local polish of
         it, as the memetic identification search does) or restart it; the
         evaluations it reports there count toward `max_nfev`.
-    bounds_policy : {"none", "clip", "reflect"}
-        What to do with points that leave the box. The paper has no bound
-        handling, so ``"none"`` (the default) lets them go.
     restarts : bool or Restarts
         IPOP-style restarts (:class:`~spiralid.optim.Restarts`): when a run
         has collapsed, start again from fresh uniform points with a larger
@@ -611,6 +588,27 @@ def minimize(
         configurations). A restart happens only if its population can still
         make 10 iterations within the budget. The learned-metric rule
         alternates fresh polls with population periods (see its module).
+    options : dict, optional
+        The rarely used settings (:data:`MINIMIZE_OPTIONS`, with their
+        defaults), as ``scipy.optimize.minimize`` takes its solvers'; any
+        other key is refused in one line naming it:
+
+        ``max_time`` : float or None
+            Wall-time limit in seconds (a finite number > 0; default None,
+            no limit). Checked after each iteration: the search ends after
+            the iteration during which the limit passed, so it overruns by
+            up to one iteration. Where a time limit stops it, the result is
+            not reproducible from the seed alone.
+        ``target`` : float or None
+            Stop as soon as the best cost is at or below ``target``
+            (default None, no target).
+        ``bounds_policy`` : {"none", "clip", "reflect"}
+            What to do with points that leave the box. The paper has no
+            bound handling, so ``"none"`` (the default) lets them go.
+
+        They were keywords of their own; passing one so is a one-line
+        TypeError saying to use ``options``.
+
     Returns
     -------
     OptimiserResult
@@ -639,13 +637,17 @@ def minimize(
     >>> res = minimize(sphere, [(-5, 5)] * 2, "sda", rng=0)
     >>> res.success, res.nit, res.nfev, bool(res.fun < 1e-12)
     (True, 500, 24550, True)
-    >>> res = minimize(sphere, [(-5, 5)] * 2, "ebsda", rng=0, target=1e-6)
+    >>> res = minimize(sphere, [(-5, 5)] * 2, "ebsda", rng=0,
+    ...                options={"target": 1e-6})
     >>> res.message, bool(res.fun <= 1e-6)
     ('Target cost reached.', True)
     """
     start = time.perf_counter()
-    _refuse_removed(_removed, method)
-    budget = _Budget.check(max_iter, n_points, max_nfev, max_time, target, start)
+    refuse_keywords(minimize, _removed, method, MINIMIZE_OPTIONS, _REMOVED)
+    opts = settings(options, MINIMIZE_OPTIONS, "the options of minimize()")
+    budget = _Budget.check(
+        max_iter, n_points, max_nfev, opts["max_time"], opts["target"], start
+    )
     if callback is not None and not callable(callback):
         raise ValueError(f"`callback` must be callable or None; got {callback!r}")
     restarts = parse_restarts(restarts)
@@ -664,7 +666,7 @@ def minimize(
         rng=rng,
         vectorized=vectorized,
         x0=x0,
-        bounds_policy=bounds_policy,
+        bounds_policy=opts["bounds_policy"],
         max_iter=max(budget.iterations_left(m, 0, m), 1),
     )
     status = "target" if budget.reached(search) else None

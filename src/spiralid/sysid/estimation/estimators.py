@@ -93,7 +93,13 @@ import numpy as np
 
 from spiralid._checks import integer
 from spiralid.choices import DEFAULT_METHOD, METHOD_NAMES, require_names
-from spiralid.optim import RULES, Restarts, differential_evolution, minimize
+from spiralid.optim import (
+    MINIMIZE_OPTIONS,
+    RULES,
+    Restarts,
+    differential_evolution,
+    minimize,
+)
 from spiralid.optim.result import STATUS, OptimiserResult
 
 from ..data import IOData
@@ -506,6 +512,7 @@ def _refine(problem: Problem, result: EstimatorResult) -> None:
 
 def _estimate_spiral(problem: Problem, *, rule: str, **options) -> EstimatorResult:
     def run(fun, box, **opts):
+        opts["options"] = {k: opts.pop(k) for k in MINIMIZE_OPTIONS if k in opts}
         return minimize(fun, box, method=rule, rng=problem.rng, vectorized=True, **opts)
 
     return _search(problem, run, options)
@@ -849,7 +856,10 @@ def _keyword_options(function: Callable, own: tuple[str, ...] = ()) -> tuple[str
     )
 
 
-_MINIMIZE_OPTIONS = _keyword_options(minimize, own=("method", "rng", "vectorized"))
+# minimize's keywords and the keys of its `options`, all passed flat here.
+_MINIMIZE_OPTIONS = _keyword_options(
+    minimize, own=("method", "rng", "vectorized", "options")
+) + tuple(MINIMIZE_OPTIONS)
 
 # One entry per method; its key is the name users pass.
 METHODS: dict[str, Method] = {

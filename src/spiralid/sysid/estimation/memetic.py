@@ -207,7 +207,7 @@ def projected_spiral(
         vectorized=True,
         x0=x0,
         callback=after_step,
-        bounds_policy="clip",
+        options={"bounds_policy": "clip"},
     )
     z, nfev = res.x, res.nfev
     if polish_every and res.status != 0 and nfev + polish_nfev <= max_nfev:

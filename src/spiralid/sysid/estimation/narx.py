@@ -56,7 +56,7 @@ import numpy as np
 from scipy import optimize
 
 from spiralid._checks import generator, integer
-from spiralid.optim import SpiralSearch, minimize
+from spiralid.optim import MINIMIZE_OPTIONS, SpiralSearch, minimize
 from spiralid.optim.result import OptimiserResult
 
 from ..data import IOData
@@ -513,8 +513,8 @@ def estimate_search(problem: NARXProblem, *, rule: str, **options) -> OptimiserR
     rule : str
         A key of :data:`spiralid.optim.RULES`.
     **options
-        :func:`spiralid.optim.minimize`'s options; ``max_nfev`` defaults to
-        10,000.
+        :func:`spiralid.optim.minimize`'s keyword options and the keys of
+        its ``options`` mapping, all flat; ``max_nfev`` defaults to 10,000.
 
     Returns
     -------
@@ -529,6 +529,8 @@ def estimate_search(problem: NARXProblem, *, rule: str, **options) -> OptimiserR
     opts = dict(options)
     opts.setdefault("max_nfev", 10_000)
     opts.setdefault("max_iter", opts["max_nfev"])
+    # identify() takes minimize's `options` keys flat, as its own.
+    opts["options"] = {k: opts.pop(k) for k in MINIMIZE_OPTIONS if k in opts}
     box = default_box(problem)
     raw = minimize(
         problem.objective,

@@ -67,7 +67,7 @@ from spiralid._checks import generator, integer, refuse_options
 from spiralid.choices import OBJECTIVES
 from spiralid.optim._decomposition import Archive
 from spiralid.optim.front import knee_point
-from spiralid.optim.pareto import minimize_pareto, non_dominated
+from spiralid.optim.pareto import PARETO_OPTIONS, minimize_pareto, non_dominated
 
 from ..data import IOData
 from ..models.arx import ARX
@@ -317,11 +317,14 @@ def _search_structure(
     # Every incumbent is a candidate model: an unbounded archive of them
     # (minimize_pareto's own, thinned one is not needed).
     archive = Archive(np.empty((0, box.shape[0])), np.empty((0, len(searched))))
+    search = dict(search)
+    options = {k: search.pop(k) for k in PARETO_OPTIONS if k in search}
     res = minimize_pareto(
         lambda x: evaluate(x)[1],
         box,
         method,
         **search,
+        options=options,
         rng=gen,
         vectorized=True,
         x0=x0,
@@ -414,8 +417,9 @@ def _front_model(
 def pareto_options(objectives) -> dict:
     """The options :func:`identify_pareto` takes through ``**options`` for
     these objectives, with their defaults: the search's
-    (:func:`~spiralid.optim.pareto.minimize_pareto`'s keyword options less
-    those it sets itself), the models' and, with the ``"frequency"``
+    (:func:`~spiralid.optim.pareto.minimize_pareto`'s keyword options and
+    the keys of its ``options``, flat, less those it sets itself), the
+    models' and, with the ``"frequency"``
     objective, its H1 estimate's.
 
     Examples
@@ -436,13 +440,16 @@ def _search_defaults() -> dict:
     from .estimators import _keyword_options
 
     # What each structure's search sets itself (its seeds, its own archive,
-    # the progress callback, the shared generator).
-    own = ("rng", "vectorized", "callback", "x0", "archive", "ref_point")
+    # the progress callback, the shared generator, the hypervolume's
+    # reference point); `options`' other keys are taken flat, as identify
+    # takes minimize's.
+    own = ("rng", "vectorized", "callback", "x0", "archive", "options", "ref_point")
     signature = inspect.signature(minimize_pareto).parameters
     defaults = {
         name: signature[name].default
         for name in _keyword_options(minimize_pareto, own=own)
     }
+    defaults.update((k, v) for k, v in PARETO_OPTIONS.items() if k not in own)
     # Per order, half minimize_pareto's 100 points and 10,000 evaluations:
     # the same 100 iterations per search, and every order is a search of its
     # own (with its seeds' output-error fits and its polishes besides).
