@@ -195,8 +195,8 @@ CASES = [
     ),
     ("simulate --signal chirp --width 0.1", "--signal chirp has no pulses"),
     (
-        "pareto ok.csv --ts 0.01 --objectives cost,one-step --min-coherence 0.5",
-        "--min-coherence applies to the frequency objective",
+        "pareto ok.csv --ts 0.01 --objectives cost,one-step --min-coherence 0.3",
+        "--min-coherence does not apply to --objectives cost,one-step; the options",
     ),
     (
         "pareto ok.csv --ts 0.01 --objectives cost,one-step --max-frequency 3",
@@ -607,7 +607,7 @@ def test_pareto_checks_every_option_before_the_search(files, capsys, monkeypatch
         ["--by-fit", "1"],
         ["--orders", "2:3", "--by-fit", "1", "--max-frequency", "3"],
         ["--objectives", "cost,one-step", "--max-frequency", "3"],
-        ["--objectives", "cost,one-step", "--min-coherence", "0.5"],
+        ["--objectives", "cost,one-step", "--min-coherence", "0.3"],
     ):
         status = cli.main(["pareto", "ok.csv", "--ts", "0.01", *extra, "--out", "p"])
         err = capsys.readouterr().err

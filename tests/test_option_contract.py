@@ -399,3 +399,238 @@ def test_optimiser_misuse_is_one_line_naming_the_option(call, option):
 def test_a_default_passed_by_value_is_accepted(record, kwargs):
     model = sid.identify(record, ARX2, **kwargs)
     assert model.method == kwargs["method"]
+
+
+# -- no public function takes more than 12 parameters -------------------------
+
+import dataclasses  # noqa: E402
+import importlib  # noqa: E402
+import inspect  # noqa: E402
+import pkgutil  # noqa: E402
+
+MAX_PARAMETERS = 12
+
+
+def _public_callables():
+    """Every function, and every public method and non-record constructor of
+    a class, named in the `__all__` of spiralid and its public modules.
+    Dataclasses are records: their constructor's parameters are their
+    fields, not a call's settings."""
+    modules = [sid] + [
+        importlib.import_module(info.name)
+        for info in pkgutil.walk_packages(sid.__path__, "spiralid.")
+        if not any(part.startswith("_") for part in info.name.split("."))
+    ]
+    for module in modules:
+        for name in getattr(module, "__all__", ()):
+            obj = getattr(module, name)
+            if inspect.isclass(obj):
+                members = [
+                    (f"{obj.__qualname__}.{attr}", getattr(obj, attr))
+                    for attr, value in vars(obj).items()
+                    if not attr.startswith("_")
+                    and inspect.isfunction(getattr(value, "__func__", value))
+                ]
+                if not dataclasses.is_dataclass(obj):
+                    members.append((obj.__qualname__, obj.__init__))
+                yield from members
+            elif inspect.isfunction(obj):
+                yield f"{obj.__module__}.{obj.__qualname__}", obj
+
+
+def _parameters(function) -> int:
+    """Parameters a caller can name: *args, **kwargs, self and cls are not
+    counted (a **kwargs that takes a method's options is one mapping)."""
+    return sum(
+        1
+        for p in inspect.signature(function).parameters.values()
+        if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+        and p.name not in ("self", "cls")
+    )
+
+
+def test_no_public_function_takes_more_than_12_parameters():
+    counted = dict(_public_callables())
+    assert "spiralid.optim.spiral.minimize" in counted
+    over = {
+        name: _parameters(function)
+        for name, function in counted.items()
+        if _parameters(function) > MAX_PARAMETERS
+    }
+    assert not over, over
+
+
+@pytest.mark.parametrize(
+    ("call", "moved"),
+    [
+        (lambda: minimize(np.sum, [(0, 1)], target=1.0), "target"),
+        (lambda: minimize(np.sum, [(0, 1)], max_time=1.0), "max_time"),
+        (lambda: minimize(np.sum, [(0, 1)], bounds_policy="clip"), "bounds_policy"),
+        (
+            lambda: minimize_pareto(_two_objectives, [(0, 1)], neighbours=5),
+            "neighbours",
+        ),
+        (
+            lambda: minimize_pareto(_two_objectives, [(0, 1)], ref_point=[2, 2]),
+            "ref_point",
+        ),
+        (
+            lambda: minimize_pareto(_two_objectives, [(0, 1)], max_time=1.0),
+            "max_time",
+        ),
+    ],
+)
+def test_a_keyword_moved_into_options_says_so_in_one_line(call, moved):
+    with pytest.raises(TypeError) as refused:
+        call()
+    message = str(refused.value)
+    assert "\n" not in message
+    assert message.startswith(f"`{moved}` of ") and "is now a key of its `options`" in (
+        message
+    )
+
+
+def test_minimize_pareto_names_the_method_and_its_options_for_an_unknown_keyword():
+    with pytest.raises(TypeError) as refused:
+        minimize_pareto(_two_objectives, [(0, 1)], "sda", max_iter=5)
+    message = str(refused.value)
+    assert message == (
+        "minimize_pareto() got an unexpected keyword argument 'max_iter'; method "
+        "'sda' takes n_points, max_nfev, archive, rng, vectorized, callback, x0, "
+        "options={max_time, neighbours, ref_point}"
+    )
+
+
+def test_an_options_key_that_does_not_apply_is_named_with_those_that_do():
+    with pytest.raises(ValueError) as refused:
+        minimize_pareto(_two_objectives, [(0, 1)], options={"neighbors": 5})
+    assert str(refused.value) == (
+        "`neighbors` does not apply to the options of minimize_pareto(); the "
+        "options that do: max_time, neighbours, ref_point"
+    )
+    same = minimize_pareto(
+        _two_objectives, [(0, 1)], n_points=10, max_nfev=40, rng=0,
+        vectorized=True, options={"neighbours": 10, "max_time": None},
+    )  # fmt: skip
+    again = minimize_pareto(
+        _two_objectives, [(0, 1)], n_points=10, max_nfev=40, rng=0, vectorized=True
+    )
+    np.testing.assert_array_equal(same.x, again.x)
+
+
+# -- identify_pareto's contract, enumerated -----------------------------------
+
+import spiralid.sysid.estimation.pareto as pareto_module  # noqa: E402
+from spiralid.cli.pareto import _OPTION_FLAGS as _PARETO_FLAGS  # noqa: E402
+from spiralid.cli.pareto import _check_options as _check_pareto  # noqa: E402
+from spiralid.optim.pareto import PARETO_METHODS  # noqa: E402
+from spiralid.sysid.estimation.pareto import (  # noqa: E402
+    pareto_options,
+    refused_pareto_options,
+)
+
+OBJECTIVE_SETS = [
+    ("cost", "frequency"),
+    ("cost", "one-step"),
+    ("frequency", "one-step"),
+    ("cost", "frequency", "one-step"),
+]
+# A valid value other than the default for every option: an option that
+# applies must reach the search, past its own value's checks.
+PARETO_NON_DEFAULT = {
+    "n_points": 12,
+    "max_nfev": 300,
+    "max_time": 100.0,
+    "neighbours": 5,
+    "parametrization": "coefficients",
+    "seed_estimates": False,
+    "extremes_nfev": 7,
+    "nperseg": 64,
+    "fmin": 1.0,
+    "fmax": 10.0,
+    "min_coherence": 0.3,
+}
+EVERY_PARETO_OPTION = sorted(
+    {name for names in OBJECTIVE_SETS for name in pareto_options(names)}
+    | {"max_iter", "polish_nfev", "ref_point", "archive", "nperseq"}
+)
+
+
+@pytest.fixture
+def stop_before_searching(monkeypatch):
+    monkeypatch.setattr(pareto_module, "_search_structure", _reach)
+
+
+@pytest.mark.parametrize(
+    ("method", "objectives", "option"),
+    [
+        (method, objectives, option)
+        for method in PARETO_METHODS
+        for objectives in OBJECTIVE_SETS
+        for option in EVERY_PARETO_OPTION
+    ],
+)
+def test_every_pareto_option_is_taken_or_refused_by_the_table(
+    record, stop_before_searching, method, objectives, option
+):
+    value = PARETO_NON_DEFAULT.get(option, 7)
+    call = dict(method=method, rng=0, **{option: value})
+    if option in pareto_options(objectives):
+        with pytest.raises(_Reached):
+            sid.identify_pareto(record, ARX2, objectives, **call)
+        return
+    with pytest.raises(ValueError) as refused:
+        sid.identify_pareto(record, ARX2, objectives, **call)
+    message = str(refused.value)
+    assert "\n" not in message
+    assert message.startswith(
+        f"`{option}` does not apply to identify_pareto with method '{method}' "
+        f"and objectives {objectives}; the options that do: "
+    ) or message.startswith(f"`{option}` of identify_pareto is now")
+
+
+@pytest.mark.parametrize("objectives", OBJECTIVE_SETS)
+def test_identify_pareto_accepts_every_option_at_its_default(
+    record, stop_before_searching, objectives
+):
+    # Every option's default, the frequency objective's among them.
+    defaults = pareto_options(("cost", "frequency", "one-step"))
+    assert refused_pareto_options(objectives, defaults) == []
+    with pytest.raises(_Reached):
+        sid.identify_pareto(record, ARX2, objectives, rng=0, **defaults)
+
+
+def _pareto_args(objectives, flag):
+    value = {
+        "--points": "7",
+        "--budget": "700",
+        "--parametrization": "coefficients",
+        "--polish": "7",
+        "--min-coherence": "0.3",
+    }.get(flag)
+    argv = ["pareto", "rig.csv", "--objectives", ",".join(objectives)]
+    argv += [flag] if value is None else [flag, value]
+    return build_parser().parse_args(argv)
+
+
+@pytest.mark.parametrize(
+    ("objectives", "flag"),
+    [(objectives, flag) for objectives in OBJECTIVE_SETS for flag in _PARETO_FLAGS],
+)
+def test_the_pareto_command_refuses_what_python_refuses(objectives, flag):
+    args = _pareto_args(objectives, flag)
+    name = _PARETO_FLAGS[flag]
+    value = (
+        not args.no_seeds
+        if name == "seed_estimates"
+        else getattr(args, flag[2:].replace("-", "_"))
+    )
+    if refused_pareto_options(objectives, {name: value}):
+        with pytest.raises(UsageError) as refused:
+            _check_pareto(args)
+        assert str(refused.value).startswith(
+            f"{flag} does not apply to --objectives {','.join(objectives)}; "
+            "the options that do: "
+        )
+    else:
+        _check_pareto(args)

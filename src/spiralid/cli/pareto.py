@@ -23,7 +23,6 @@ from .options import (
     _open_folder,
     _positive_int,
     _progress,
-    _refuse_unused,
 )
 
 
@@ -153,13 +152,63 @@ def _refuse_conflicts(args) -> None:
         raise UsageError("give --max-frequency or --by-fit, not both")
     if args.by_fit is not None and (args.orders is None or len(args.orders) < 2):
         raise UsageError("--by-fit chooses among orders: give --orders")
-    if "frequency" not in args.objectives:
-        if args.max_frequency is not None:
-            raise UsageError("--max-frequency needs the frequency objective")
-        _refuse_unused(
-            _given(args, "--min-coherence"),
-            "to the frequency objective; --objectives "
-            f"{','.join(args.objectives)} has none",
+    if "frequency" not in args.objectives and args.max_frequency is not None:
+        raise UsageError("--max-frequency needs the frequency objective")
+    _check_options(args)
+
+
+# The flags that set identify_pareto's options, and the option each sets.
+_OPTION_FLAGS = {
+    "--points": "n_points",
+    "--budget": "max_nfev",
+    "--parametrization": "parametrization",
+    "--no-seeds": "seed_estimates",
+    "--polish": "extremes_nfev",
+    "--min-coherence": "min_coherence",
+}
+
+
+def _option_values(args) -> dict:
+    """identify_pareto's options as the command's flags set them, by name."""
+    values = {
+        name: getattr(args, flag[2:].replace("-", "_"))
+        for flag, name in _OPTION_FLAGS.items()
+    }
+    values["seed_estimates"] = not args.no_seeds
+    return values
+
+
+def _passed(args) -> dict:
+    """What `run` passes to identify_pareto: the options that apply to the
+    objectives (pareto_options), as the flags set them."""
+    from spiralid.sysid.estimation.pareto import pareto_options
+
+    takes = pareto_options(args.objectives)
+    return {name: v for name, v in _option_values(args).items() if name in takes}
+
+
+def _check_options(args) -> None:
+    """Refuse every typed flag whose option identify_pareto would refuse
+    from Python for these objectives (refused_pareto_options, from the same
+    table, pareto_options), naming the flags that do apply."""
+    from spiralid.sysid.estimation.pareto import (
+        pareto_options,
+        refused_pareto_options,
+    )
+
+    values = _option_values(args)
+    typed = {
+        _OPTION_FLAGS[f]: values[_OPTION_FLAGS[f]] for f in _given(args, *_OPTION_FLAGS)
+    }
+    refused = refused_pareto_options(args.objectives, typed)
+    if refused:
+        flags = [f for f, name in _OPTION_FLAGS.items() if name in refused]
+        takes = pareto_options(args.objectives)
+        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
+        verb = "does" if len(flags) == 1 else "do"
+        raise UsageError(
+            f"{', '.join(flags)} {verb} not apply to --objectives "
+            f"{','.join(args.objectives)}; the options that do: {', '.join(able)}"
         )
 
 
@@ -184,14 +233,9 @@ def _search(args, est, structure, progress):
         args.objectives,
         method=args.method,
         rng=args.seed,
-        max_nfev=args.budget,
-        n_points=args.points,
         nk=args.nk,
-        parametrization=args.parametrization,
-        seed_estimates=not args.no_seeds,
-        extremes_nfev=args.polish,
-        min_coherence=args.min_coherence,
         progress=progress,
+        **_passed(args),
     )
 
 

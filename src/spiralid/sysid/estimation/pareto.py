@@ -63,7 +63,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from spiralid._checks import generator, integer, refuse_options
+from spiralid._checks import generator, integer, is_default, refuse_options
 from spiralid.choices import OBJECTIVES
 from spiralid.optim._decomposition import Archive
 from spiralid.optim.front import knee_point
@@ -83,7 +83,13 @@ from .frequency import (
 from .outputerror import steiglitz_mcbride
 from .parametrizations import Modal, make_parametrization
 
-__all__ = ["OBJECTIVES", "ParetoIdentification", "identify_pareto", "pareto_options"]
+__all__ = [
+    "OBJECTIVES",
+    "ParetoIdentification",
+    "identify_pareto",
+    "pareto_options",
+    "refused_pareto_options",
+]
 
 _SEEDS = ("ls", "steiglitz-mcbride", "oe")
 
@@ -472,21 +478,46 @@ _RENAMED = {
 }
 
 
+# Every option of identify_pareto with its default, whatever the objectives:
+# one left at its default is never refused.
+_EVERY_DEFAULT = {**_SEARCH_DEFAULTS, **_MODEL_DEFAULTS, **_FREQUENCY_DEFAULTS}
+
+
+def refused_pareto_options(objectives, options: dict) -> list[str]:
+    """The names in `options` that :func:`identify_pareto` refuses for
+    `objectives`, in their order: those :func:`pareto_options` does not
+    list, unless equal to their default. The command line refuses its flags
+    by this check.
+
+    Examples
+    --------
+    >>> refused_pareto_options(("cost", "one-step"), {"min_coherence": 0.3})
+    ['min_coherence']
+    >>> refused_pareto_options(("cost", "one-step"), {"min_coherence": 0.5})
+    []
+    """
+    applicable = pareto_options(objectives)
+    return [
+        name
+        for name, value in options.items()
+        if name not in applicable
+        and not (name in _EVERY_DEFAULT and is_default(value, _EVERY_DEFAULT[name]))
+    ]
+
+
 def _pareto_settings(method, names, options: dict) -> dict:
     """`options` checked against :func:`pareto_options` (one line naming an
     option that does not apply), completed with the defaults."""
     for name in options:
         if name in _RENAMED:
             raise ValueError(_RENAMED[name])
-    applicable = pareto_options(names)
-    everything = {**_SEARCH_DEFAULTS, **_MODEL_DEFAULTS, **_FREQUENCY_DEFAULTS}
     refuse_options(
         options,
-        applicable,
+        pareto_options(names),
         f"identify_pareto with method {method!r} and objectives {names}",
-        defaults=everything,
+        defaults=_EVERY_DEFAULT,
     )
-    settings = {**everything, **options}
+    settings = {**_EVERY_DEFAULT, **options}
     seeded = settings["seed_estimates"]
     if not isinstance(seeded, bool | np.bool_):
         raise ValueError(f"`seed_estimates` must be True or False; got {seeded!r}")
