@@ -234,7 +234,7 @@ def minimize_pareto(
     callback: Callable | None = None,
     x0=None,
     options: dict | None = None,
-    **unknown,
+    **_unknown,
 ) -> OptimiserResult:
     """Approximate the Pareto front of a vector objective by a spiral search.
 
@@ -332,7 +332,7 @@ def minimize_pareto(
     (1, True)
     """
     t_start = time.perf_counter()
-    refuse_keywords(minimize_pareto, unknown, method, PARETO_OPTIONS, _MOVED)
+    refuse_keywords(minimize_pareto, _unknown, method, PARETO_OPTIONS, _MOVED)
     opts = settings(options, PARETO_OPTIONS, "the options of minimize_pareto()")
     lo, hi = box_bounds(bounds)
     rule = _parse_rule(method)
