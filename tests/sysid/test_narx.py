@@ -172,3 +172,88 @@ def test_free_run_from_measured_samples_continues_the_record(integrator):
     tail = model.simulate(u[50:], y0=y[50:])
     np.testing.assert_array_equal(tail[: st.max_lag], y[50 : 50 + st.max_lag])
     np.testing.assert_allclose(tail, y[50:], rtol=1e-10, atol=1e-10)
+
+
+@pytest.mark.parametrize("method", ["ls", "oe", "spiral"])
+def test_training_never_ends_above_its_linear_start(method):
+    """Guaranteed by the final check: the returned model's cost on the
+    whole estimation record is at most its linear start's."""
+    est, _ = _hammerstein(n=600, noise=0.05).split(2 / 3)
+    opts = {"max_nfev": 400} if method == "spiral" else {}
+    model = identify(est, NARX(2, 2, 1, hidden=(3,)), method=method, rng=0, **opts)
+    res = model.result
+    assert model.linear_params is not None
+    if method == "ls":
+        return  # its guarantee is on the one-step error it minimises
+    assert res["fun"] <= res["linear_cost"] + 1e-9
+
+
+def test_linear_start_is_the_default_methods_arx_with_its_integrators():
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal(500)
+    y = np.cumsum(np.cumsum(lfilter([0.0, 0.02], [1.0, -0.5], u)))
+    est = IOData(u, y, ts=0.01)
+    model = identify(est, NARX(2, 2, 1, hidden=(2,), integrator=2), "oe", rng=3)
+    arx = identify(est, ARX(3, 2, 1), integrator=2, rng=3)
+    np.testing.assert_allclose(
+        model.linear_start.simulate(u), arx.simulate(u), rtol=1e-8, atol=1e-8
+    )
+    assert "integrator=2" in model.linear_model
+
+
+def test_a_network_that_adds_nothing_is_reported_as_such():
+    rng = np.random.default_rng(6)
+    u = rng.standard_normal(600)
+    data = IOData(u, lfilter([0.0, 0.5], [1.0, -0.7], u), ts=0.01)
+    est, val = data.split(2 / 3)
+    model = identify(est, NARX(1, 1, 1, hidden=(2,)), method="oe", rng=0)
+    text = validate(model, val, warmup=est).summary()
+    assert "network added nothing" in text or "points of fit" in text
+    est, val = _hammerstein(n=900).split(2 / 3)
+    model = identify(est, NARX(2, 2, 1), method="oe", rng=0)
+    v = validate(model, val, warmup=est)
+    assert v.fit_percent > v.linear_fit_percent + 1.0
+    assert "points of fit" in v.summary()
+
+
+def test_frols_uses_every_sample_and_the_default_method():
+    est = _hammerstein(n=600, noise=0.01)
+    st = PolynomialNARX(2, 2, 1, degree=2, n_terms=6)
+    model = identify(est, st)  # the default method
+    cut = IOData(est.u, np.r_[est.y[:500], 2.0 * est.y[500:]], ts=est.ts)
+    other = identify(cut, st, method="ls")
+    assert not np.array_equal(model.params, other.params)
+
+
+def test_method_names_are_case_insensitive_for_narx():
+    est = _hammerstein(n=400)
+    a = identify(est, NARX(2, 2, 1, hidden=(2,)), method="OE", rng=0)
+    b = identify(est, NARX(2, 2, 1, hidden=(2,)), method="oe", rng=0)
+    np.testing.assert_array_equal(a.params, b.params)
+    identify(est, PolynomialNARX(2, 2, 1, n_terms=4), method="LS")
+
+
+def test_a_test_without_degrees_of_freedom_is_not_applicable():
+    from spiralid.sysid import billings_voon
+
+    rng = np.random.default_rng(0)
+    u = np.sign(rng.standard_normal(800))  # binary: u^2 constant
+    bv = billings_voon(u, rng.standard_normal(800))
+    assert set(bv.not_applicable) == {"u2e", "u2e2"}
+    assert "u2e" not in bv.passed and "n/a" in bv.verdicts()
+    assert (
+        "not applicable" in bv.summary()
+        and "pass" not in bv.summary().split("phi_u2'e")[1].split("\n")[0]
+    )
+
+
+def test_narx_figures_carry_labels():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    est, val = _hammerstein(n=500).split(2 / 3)
+    model = identify(est, NARX(2, 2, 1, hidden=(2,)), method="oe", rng=0)
+    figs = validate(model, val, warmup=est).plot()
+    ax = figs["response"].axes[0]
+    assert ax.get_ylabel() and ax.get_xlabel() == "time (s)" and ax.get_title()
+    assert figs["billings_voon"].axes[-1].get_xlabel() == "lag (samples)"

@@ -83,10 +83,13 @@ def _narx_structure(args):
 
     if args.na < 1:
         raise UsageError(f"--model {args.model} needs --na >= 1; got {args.na}")
-    if args.integrator > 1:
+    # A NARX's linear start takes up to two known integrators (a hub angle
+    # driven by a torque has two); forward regression has one at most.
+    most = 2 if args.model == "narx" else 1
+    if args.integrator > most:
         raise UsageError(
-            f"--model {args.model} takes one integrator; got --integrator "
-            f"{args.integrator}"
+            f"--model {args.model} takes at most {most} integrator(s); got "
+            f"--integrator {args.integrator}"
         )
     if args.model == "narx":
         return NARX(
@@ -95,7 +98,7 @@ def _narx_structure(args):
             args.nk,
             hidden=(args.hidden,),
             activation=args.activation,
-            integrator=bool(args.integrator),
+            integrator=int(args.integrator),
         )
     return PolynomialNARX(
         args.na,

@@ -128,8 +128,8 @@ class NARXProblem:
     def costs(self, params) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Training, held-back and whole-record costs (percent RMS), one per
         row of `params`."""
-        e = self.data.y - self.output(np.atleast_2d(params))
         with np.errstate(over="ignore", invalid="ignore"):
+            e = self.data.y - self.output(np.atleast_2d(params))
             tr = 100.0 * np.sqrt(np.mean(e[..., self.train] ** 2, axis=-1))
             tr /= self.rms_train
             if self.hold is not None:
@@ -199,7 +199,8 @@ class NARXProblem:
                 cache.clear()
                 z, sens = st.free_run_jacobian(p, self.ulag[self.t0 :], self.hist)
                 if st.integrator:
-                    z, sens = np.cumsum(z), np.cumsum(sens, axis=0)
+                    with np.errstate(all="ignore"):
+                        z, sens = np.cumsum(z), np.cumsum(sens, axis=0)
                     z = z + self.ystart / scale
                     full = np.r_[self.data.y[: self.t0] / scale, z]
                 else:
@@ -224,12 +225,25 @@ class NARXProblem:
 
         return fun, jac
 
+    def whole(self) -> NARXProblem:
+        """The same problem with nothing held back: training covers the
+        whole record (the refit after early stopping)."""
+        other = NARXProblem.__new__(NARXProblem)
+        other.__dict__.update(self.__dict__)
+        n = self.data.n
+        other.split, other.hold = n, None
+        other.train = slice(self.train.start, n)
+        other.rms_train = self.rms_all
+        other.nfev = 0
+        return other
+
     def polish(
         self, p0, predictor: str, max_rounds: int = 50, patience: int = 3
     ) -> tuple[np.ndarray, int]:
         """Levenberg-Marquardt in rounds with early stopping on the held-back
         cost; returns the parameters with the lowest held-back cost (the
-        training cost when nothing is held back) and the rounds run.
+        training cost when nothing is held back) and the round that reached
+        them (0: the start).
 
         Parameters
         ----------
@@ -246,27 +260,28 @@ class NARXProblem:
         p = np.asarray(p0, dtype=float).copy()
         pick = 1 if self.hold is not None else 0
         best_p, best = p.copy(), self._score(p, predictor, pick)
-        waited = rounds = 0
+        waited = best_round = 0
         m = fun(p).size
         if m <= p.size:
             return best_p, 0
-        for rounds in range(1, max_rounds + 1):  # noqa: B007
+        for rounds in range(1, max_rounds + 1):
             try:
-                res = optimize.least_squares(
-                    fun, p, jac=jac, method="lm", max_nfev=_ROUND
-                )
+                with np.errstate(all="ignore"):
+                    res = optimize.least_squares(
+                        fun, p, jac=jac, method="lm", max_nfev=_ROUND
+                    )
             except (ValueError, np.linalg.LinAlgError):
                 break
             moved = not np.array_equal(res.x, p)
             p = res.x
             score = self._score(p, predictor, pick)
             if score < best * (1.0 - 1e-9):
-                best_p, best, waited = p.copy(), score, 0
+                best_p, best, waited, best_round = p.copy(), score, 0, rounds
             else:
                 waited += 1
             if waited >= patience or not moved or res.status > 0:
                 break
-        return best_p, rounds
+        return best_p, best_round
 
     def _score(self, p, predictor: str, pick: int) -> float:
         if predictor == self.predictor:
@@ -277,29 +292,46 @@ class NARXProblem:
         return float(other.costs(p)[pick][0])
 
 
-def _arx_start(problem: NARXProblem, method: str) -> np.ndarray | None:
-    """The ARX model of the structure's lags in the bypass (``"ls"`` or
-    ``"oe"``), or None for a structure without one."""
+def _linear_start(problem: NARXProblem, method: str = "default"):
+    """The linear model of the structure's lags in the bypass, and what it
+    is; ``(None, "")`` for a structure without a bypass.
+
+    ``"default"``: for a free run from rest, the default method's ARX
+    (``identify(data, ARX(ny + 1, nu, nk), integrator=k)`` for ``k``
+    integrators, ``ARX(ny, nu, nk)`` without), so a NARX contains the
+    linear model a user would get; otherwise (a one-step predictor, a run
+    from measured samples, which ``"spiral"`` does not fit) and for
+    ``"ls"``: least squares of the one-step error.
+    """
     st = problem.structure
     if not isinstance(st, NARX) or not st.linear:
-        return None
+        return None, ""
     data = problem.data
-    arx = ARX(st.ny, st.nu, st.nk)
-    if method == "ls":
-        if st.integrator:
+    k = st.integrator
+    free_run = problem.predictor == "simulation" and problem.initial == "rest"
+    if method == "ls" or not free_run:
+        arx = ARX(st.ny, st.nu, st.nk)
+        if k:
             # One step ahead, the increment's error is the output's.
             data = IOData(data.u, np.diff(data.y, prepend=0.0), ts=data.ts)
         theta = arx_least_squares(data, arx)
-    else:
-        from .identify import identify
+        a, b = theta[: st.ny], theta[st.ny :]
+        what = f"ARX({st.ny}, {st.nu}, {st.nk}) of the increments" if k else str(arx)
+        return st.from_arx(a, b, problem.scaling), f"{what} by least squares"
+    from .identify import DEFAULT_METHOD, identify
 
-        if st.integrator:
-            # The free run of the output: B / A' on the input's running sum
-            # is the increments' model B / A' on the input (the ARX
-            # integrator's reading, see identify).
-            data = IOData(np.cumsum(data.u), data.y, ts=data.ts)
-        theta = identify(data, arx, method="oe", initial="rest").theta
-    return st.from_arx(theta[: st.ny], theta[st.ny :], problem.scaling)
+    arx = ARX(st.ny + (1 if k else 0), st.nu, st.nk)
+    theta = identify(data, arx, integrator=k, rng=problem.rng).theta
+    a = theta[: arx.na]
+    if k:
+        # A = C (1 - z^-1): the increments' denominator C is A's running sum
+        # (its last term, A(1), is zero); C keeps any second integrator.
+        a = np.cumsum(np.r_[1.0, a])[1:-1]
+    what = f"{arx}, integrator={k}" if k else str(arx)
+    return (
+        st.from_arx(a, theta[arx.na :], problem.scaling),
+        f"{what}, by {DEFAULT_METHOD}",
+    )
 
 
 def _with_hidden(problem: NARXProblem, p: np.ndarray) -> np.ndarray:
@@ -310,6 +342,64 @@ def _with_hidden(problem: NARXProblem, p: np.ndarray) -> np.ndarray:
     q = p.copy()
     q[: st.h * st.n_regressors] = init[: st.h * st.n_regressors]
     return q
+
+
+def _fit(problem: NARXProblem, starts: dict, predictor: str, options: dict):
+    """Train from `starts` with early stopping, then refit on every sample.
+
+    Each start is polished in rounds on the training part while the
+    held-back part is scored; the start and round count with the lowest
+    held-back cost win. That start is then polished again on the whole
+    record for exactly that many rounds, so the end of the record is not
+    thrown away. Returns ``(params, start name, rounds)``; with nothing
+    held back the rounds run until `max_rounds` or convergence.
+    """
+    max_rounds = options.get("max_rounds", 50)
+    patience = options.get("patience", 3)
+    best = None
+    for name, p0 in starts.items():
+        p, rounds = problem.polish(p0, predictor, max_rounds, patience)
+        pick = 1 if problem.hold is not None else 0
+        score = problem._score(p, predictor, pick)
+        if best is None or score < best[0]:
+            best = (score, name, p, rounds)
+    _, name, p, rounds = best
+    if problem.hold is None:
+        return p, name, rounds
+    whole = problem.whole()
+    p, _ = whole.polish(starts[name], predictor, rounds, patience=rounds + 1)
+    problem.nfev += whole.nfev
+    return p, name, rounds
+
+
+def _contain(problem: NARXProblem, p, linear, predictor: str):
+    """`p`, or the linear start when `p` costs more than it on the whole
+    estimation record: training never ends above its linear start."""
+    if linear is None:
+        return p, False
+    whole = problem.whole()
+    cost = whole._score(p, predictor, 0)
+    if cost <= whole._score(linear, predictor, 0):
+        return p, False
+    return np.asarray(linear, dtype=float).copy(), True
+
+
+def _train(problem, starts: dict, linear, predictor: str, options: dict, t0, **extra):
+    """:func:`_fit` then :func:`_contain`, as an OptimiserResult."""
+    p, name, rounds = _fit(problem, starts, predictor, options)
+    p, kept = _contain(problem, p, linear, predictor)
+    if kept:
+        name, rounds = "linear", 0
+    return _result(
+        problem,
+        p,
+        t0,
+        nit=rounds,
+        start=name,
+        linear_params=linear,
+        kept_linear=kept,
+        **extra,
+    )
 
 
 def _result(problem, p, t0, **extra) -> OptimiserResult:
@@ -325,6 +415,9 @@ def _result(problem, p, t0, **extra) -> OptimiserResult:
         status=0,
     )
     out.update(extra)
+    linear = out.get("linear_params")
+    if linear is not None:
+        out["linear_cost"] = float(problem.whole().costs(np.atleast_2d(linear))[2][0])
     out.setdefault("nit", 0)
     out.setdefault("message", "")
     out.setdefault("n_restarts", 0)
@@ -353,7 +446,9 @@ def frols(problem: NARXProblem) -> OptimiserResult:
     t0 = time.perf_counter()
     st = problem.structure
     cands = st.candidates()
-    rows = slice(st.max_lag, problem.split)
+    # Every sample: forward regression stops by its own rule, no early
+    # stopping needs a held-back part.
+    rows = slice(st.max_lag, problem.data.n)
     P = st.term_matrix(problem.phi[rows], cands)
     y = problem.target[rows]
     yy = float(y @ y) or 1.0
@@ -418,40 +513,34 @@ def estimate_ls(
     if isinstance(problem.structure, PolynomialNARX):
         return frols(problem)
     t0 = time.perf_counter()
-    start = _arx_start(problem, "ls")
-    if start is None:
-        start = problem.structure.initial_params(problem.rng)
-    else:
-        start = _with_hidden(problem, start)
-    p, rounds = problem.polish(start, "one-step", max_rounds, patience)
-    return _result(
-        problem, p, t0, nit=rounds, message="Levenberg-Marquardt, one-step error."
+    linear, what = _linear_start(problem, "ls")
+    start = _starting_network(problem, linear)
+    options = {"max_rounds": max_rounds, "patience": patience}
+    return _train(
+        problem,
+        {"linear": start},
+        linear,
+        "one-step",
+        options,
+        t0,
+        linear_model=what,
+        message="Levenberg-Marquardt, one-step error.",
     )
 
 
-def _oe_starts(problem: NARXProblem) -> dict[str, np.ndarray]:
-    """The polished one-step model and the output-error ARX in the bypass."""
-    starts = {"one-step": estimate_ls(problem).x}
-    oe = _arx_start(problem, "oe")
-    if oe is not None:
-        starts["arx-oe"] = _with_hidden(problem, oe)
-    return starts
-
-
-def _best_polished(problem: NARXProblem, starts: dict, **options):
-    best = None
-    for name, p0 in starts.items():
-        p, rounds = problem.polish(p0, problem.predictor, **options)
-        score = float(problem.costs(np.atleast_2d(p))[1][0])
-        if best is None or score < best[0]:
-            best = (score, name, p, rounds)
-    return best
+def _starting_network(problem: NARXProblem, linear) -> np.ndarray:
+    """The linear start with Glorot hidden weights (the map unchanged), or
+    a network's initial weights when there is no bypass."""
+    if linear is None:
+        return problem.structure.initial_params(problem.rng)
+    return _with_hidden(problem, linear)
 
 
 def estimate_oe(
     problem: NARXProblem, *, max_rounds: int = 50, patience: int = 3
 ) -> OptimiserResult:
-    """``"oe"``: the gradient baseline on the predictor's error.
+    """``"oe"``: the gradient baseline on the predictor's error, from the
+    linear start (:func:`_linear_start`).
 
     Parameters
     ----------
@@ -462,7 +551,9 @@ def estimate_oe(
     Returns
     -------
     OptimiserResult
-        ``start`` names the start that won.
+        ``start`` names the start that won, ``linear_params`` and
+        ``linear_cost`` the linear start and its cost, ``kept_linear``
+        whether training ended at it.
     """
     if isinstance(problem.structure, PolynomialNARX):
         raise ValueError(
@@ -470,17 +561,18 @@ def estimate_oe(
             "method 'ls' (forward-regression orthogonal least squares)"
         )
     t0 = time.perf_counter()
-    starts = _oe_starts(problem)
-    _, name, p, rounds = _best_polished(
-        problem, starts, max_rounds=max_rounds, patience=patience
-    )
-    return _result(
+    linear, what = _linear_start(problem)
+    start = _starting_network(problem, linear)
+    options = {"max_rounds": max_rounds, "patience": patience}
+    return _train(
         problem,
-        p,
+        {"linear": start},
+        linear,
+        problem.predictor,
+        options,
         t0,
-        nit=rounds,
-        start=name,
-        message=f"Levenberg-Marquardt with early stopping from the {name} start.",
+        linear_model=what,
+        message="Levenberg-Marquardt with early stopping from the linear start.",
     )
 
 
@@ -589,16 +681,16 @@ def estimate_spiral(
         ``start`` names the point whose final polish won.
     """
     if isinstance(problem.structure, PolynomialNARX):
-        raise ValueError(
-            "a PolynomialNARX is estimated by method 'ls' (FROLS); searches "
-            "train an MLP NARX"
-        )
+        # The default method takes every structure: a polynomial's terms
+        # are chosen by forward regression, which a search would not improve.
+        return frols(problem)
     t0 = time.perf_counter()
     n_points = integer(n_points, "n_points", 2)
     max_nfev = integer(max_nfev, "max_nfev", n_points)
     polish_every = integer(polish_every, "polish_every", 1)
     polish_nfev = integer(polish_nfev, "polish_nfev", 1)
-    starts = _oe_starts(problem)
+    linear, what = _linear_start(problem)
+    starts = {"linear": _starting_network(problem, linear)}
     seeds = np.array(list(starts.values()))
     box = default_box(problem, seeds)
     seeds = np.clip(seeds, box[:, 0], box[:, 1])
@@ -635,19 +727,25 @@ def estimate_spiral(
             n_polish += bool(search.move_centre(x, f))
         history.append(search.fun)
     # The final polish with early stopping, from the search's centre and
-    # from the safe starts' polishes: the lowest held-back cost wins.
+    # from the linear start: the lowest held-back cost wins, then the
+    # winner is refitted on the whole record.
     finals = {"search": search.x, **starts}
-    _, name, p, _rounds = _best_polished(problem, finals)
-    return _result(
+    res = _train(
         problem,
-        p,
+        finals,
+        linear,
+        problem.predictor,
+        {},
         t0,
-        nit=nit,
+        linear_model=what,
         n_polish=n_polish,
-        start=name,
         history=np.asarray(history, dtype=float),
-        message=f"Eb-SDA with memetic polish; final polish from the {name} point.",
     )
+    res.nit, res.final_rounds = nit, res.nit
+    res.message = (
+        f"Eb-SDA with memetic polish; final polish from the {res.start} point."
+    )
+    return res
 
 
 def identify_narx(
@@ -738,5 +836,7 @@ def identify_narx(
         result=res,
         history=history,
         timings={"total": time.perf_counter() - t_start},
+        linear_params=res.get("linear_params"),
+        linear_model=res.get("linear_model", ""),
         **data.provenance(),
     )

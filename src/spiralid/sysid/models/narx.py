@@ -55,6 +55,15 @@ __all__ = [
 ACTIVATIONS = {"tanh": 0, "logistic": 1, "linear": 2}
 
 
+def _integrators(value) -> int:
+    """`integrator` as a count 0, 1 or 2 (False and True are 0 and 1)."""
+    if isinstance(value, bool | np.bool_):
+        return int(value)
+    if isinstance(value, int | np.integer) and 0 <= value <= 2:
+        return int(value)
+    raise ValueError(f"`integrator` must be False, True, 0, 1 or 2; got {value!r}")
+
+
 def _order(value, name: str, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer):
         raise ValueError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
@@ -322,7 +331,7 @@ class _Lags:
     @property
     def max_lag(self) -> int:
         """Samples of measured history the first full regressor needs."""
-        return max(self.ny + int(self.integrator), self.nk + self.nu - 1)
+        return max(self.ny + int(self.integrator > 0), self.nk + self.nu - 1)
 
     def check_length(self, data: IOData, name: str = "data") -> None:
         """Raise ``ValueError`` if `data` is too short for this structure.
@@ -431,8 +440,15 @@ class NARX(_Lags):
         The hidden units' activation.
     linear : bool
         Add the linear bypass ``l^T phi`` (default True).
-    integrator : bool
-        Predict the output's increment (see the module docstring).
+    integrator : bool or int
+        Known integrators of the linear start, 0, 1 or 2 (``True`` is 1).
+        With one or two the map predicts the output's increment from past
+        increments (see the module docstring), so a velocity-dependent
+        friction is in its reach; the count says which linear model the
+        bypass starts from: the default method's ARX with ``integrator=k``
+        (two for a hub angle driven by a torque, a rigid body's double
+        integrator), whose second integrator the bypass then holds as a
+        pole at ``z = 1`` of the increments' model.
 
     Notes
     -----
@@ -451,7 +467,7 @@ class NARX(_Lags):
     hidden: tuple[int, ...] = (10,)
     activation: str = "tanh"
     linear: bool = True
-    integrator: bool = False
+    integrator: bool | int = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "ny", _order(self.ny, "ny", 1))
@@ -474,12 +490,10 @@ class NARX(_Lags):
                 f"`activation` must be one of {tuple(ACTIVATIONS)}; "
                 f"got {self.activation!r}"
             )
-        for name in ("linear", "integrator"):
-            if not isinstance(getattr(self, name), bool | np.bool_):
-                raise ValueError(
-                    f"`{name}` must be True or False; got {getattr(self, name)!r}"
-                )
-            object.__setattr__(self, name, bool(getattr(self, name)))
+        if not isinstance(self.linear, bool | np.bool_):
+            raise ValueError(f"`linear` must be True or False; got {self.linear!r}")
+        object.__setattr__(self, "linear", bool(self.linear))
+        object.__setattr__(self, "integrator", _integrators(self.integrator))
         if not self.hidden and not self.linear:
             raise ValueError("`hidden=()` needs `linear=True` (nothing would remain)")
 
@@ -659,7 +673,8 @@ class NARX(_Lags):
 
     def __str__(self) -> str:
         extra = "" if self.linear else ", linear=False"
-        extra += ", integrator=True" if self.integrator else ""
+        if self.integrator:
+            extra += f", integrator={self.integrator if self.integrator > 1 else True}"
         return (
             f"NARX({self.ny}, {self.nu}, {self.nk}, hidden={self.hidden}, "
             f"activation={self.activation!r}{extra})"
@@ -726,6 +741,7 @@ class PolynomialNARX(_Lags):
         if deg > 3:
             raise ValueError(f"`degree` must be an integer in [1, 3]; got {deg!r}")
         object.__setattr__(self, "degree", deg)
+        object.__setattr__(self, "integrator", _integrators(self.integrator))
         if self.n_terms is not None:
             object.__setattr__(self, "n_terms", _order(self.n_terms, "n_terms", 1))
         tol = self.tolerance
@@ -875,6 +891,13 @@ class NARXModel:
         Offsets removed before estimation (the record's, as for ARX).
     gain, penalty : float
         The cost's gain and stability penalty.
+    linear_params : ndarray or None
+        The linear start: the parameters of this structure that equal the
+        linear (ARX) model training started from, network outputs zero
+        (None for a structure without the bypass, or a polynomial NARX).
+    linear_model : str
+        What the linear start is, e.g. ``"ARX(9, 8, 0), integrator=2, by
+        spiral"``.
     """
 
     params: np.ndarray
@@ -896,8 +919,26 @@ class NARXModel:
     y_offset: float = 0.0
     gain: float = float("nan")
     penalty: float = 0.0
+    linear_params: np.ndarray | None = None
+    linear_model: str = ""
 
     kind = "narx"
+
+    @property
+    def linear_start(self) -> NARXModel | None:
+        """The linear model training started from, as a NARXModel of the
+        same structure (network outputs zero), or None without one."""
+        if self.linear_params is None:
+            return None
+        return NARXModel(
+            params=np.asarray(self.linear_params, dtype=float),
+            structure=self.structure,
+            scaling=self.scaling,
+            ts=self.ts,
+            method=self.method,
+            predictor=self.predictor,
+            initial=self.initial,
+        )
 
     def simulate(self, u, y0=None) -> np.ndarray:
         """Free run over the input `u` from rest, or with ``y0`` (the measured
@@ -1002,6 +1043,12 @@ class NARXModel:
             "output_unit": self.output_unit,
             "u_offset": float(self.u_offset),
             "y_offset": float(self.y_offset),
+            "linear_start": None
+            if self.linear_params is None
+            else {
+                "model": self.linear_model,
+                "params": [float(v) for v in self.linear_params],
+            },
             "result": None
             if res is None
             else {
@@ -1100,6 +1147,7 @@ class NARXModel:
                 y_offset=_fields.number(
                     d, "y_offset", "a finite number", _fields.finite, 0.0
                 ),
+                **_linear_start(d.get("linear_start"), st),
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None
@@ -1109,6 +1157,22 @@ class NARXModel:
             f"NARXModel({self.structure}, method={self.method!r}, "
             f"predictor={self.predictor!r}, cost={self.cost:.6g})"
         )
+
+
+def _linear_start(field, structure) -> dict:
+    """NARXModel's linear-start fields from a model file's
+    ``"linear_start"`` (absent or null in files written before it)."""
+    if field is None:
+        return {}
+    if not isinstance(field, dict):
+        raise ValueError(f"field 'linear_start' must be an object; got {field!r:.80}")
+    params = np.asarray(field.get("params"), dtype=float)
+    if params.shape != (structure.n_params,) or not np.all(np.isfinite(params)):
+        raise ValueError(
+            f"field 'linear_start.params' must hold {structure.n_params} finite "
+            f"numbers for {structure}"
+        )
+    return {"linear_params": params, "linear_model": str(field.get("model", ""))}
 
 
 def _narx_methods() -> tuple[str, ...]:

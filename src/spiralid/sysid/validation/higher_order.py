@@ -77,23 +77,44 @@ class BillingsVoon:
     level: float = 0.95
 
     @property
+    def not_applicable(self) -> tuple[str, ...]:
+        """Tests with no degrees of freedom: nothing to test (a binary
+        input's ``u^2`` is constant, so the two ``u^2'`` tests), reported as
+        not applicable, never as passed."""
+        return tuple(k for k, t in self.tests.items() if t.dof == 0)
+
+    @property
     def passed(self) -> dict[str, bool]:
-        """``{name: verdict at level}``."""
-        return {k: t.passed[self.level] for k, t in self.tests.items()}
+        """``{name: verdict at level}`` of the applicable tests."""
+        skip = self.not_applicable
+        return {k: t.passed[self.level] for k, t in self.tests.items() if k not in skip}
 
     @property
     def n_passed(self) -> int:
-        """How many of the five tests pass at :attr:`level`."""
+        """How many of the five tests pass at :attr:`level` (a test that
+        does not apply does not count)."""
         return int(sum(self.passed.values()))
 
     def verdicts(self) -> str:
-        """Compact verdicts such as ``"ee+ ue+ e(eu)- u2e+ u2e2+"``."""
-        return " ".join(f"{k}{'+' if v else '-'}" for k, v in self.passed.items())
+        """Compact verdicts such as ``"ee+ ue+ e(eu)- u2e+ u2e2+"`` (``u2e
+        n/a`` for a test that does not apply)."""
+        passed = self.passed
+        return " ".join(
+            f"{k}{'+' if passed[k] else '-'}" if k in passed else f"{k} n/a"
+            for k in self.tests
+        )
 
     def summary(self) -> str:
         """A few lines: each test's statistic, p-value and verdict."""
         lines = [f"Billings-Voon tests at {self.level:.0%} (joint chi-square):"]
         for name, t in self.tests.items():
+            if name in self.not_applicable:
+                lines.append(
+                    f"  {BILLINGS_VOON[name]:<34} not applicable: no degrees "
+                    "of freedom (a constant u^2, as a binary input gives; use "
+                    "a multilevel input)"
+                )
+                continue
             lines.append(
                 f"  {BILLINGS_VOON[name]:<34} chi2={t.statistic:9.2f} "
                 f"(dof {t.dof:3d}) p={t.p_value:.3g} "
@@ -108,6 +129,7 @@ class BillingsVoon:
         return {
             "level": float(self.level),
             "passed": {k: bool(v) for k, v in self.passed.items()},
+            "not_applicable": list(self.not_applicable),
             "tests": {k: t.to_dict() for k, t in self.tests.items()},
         }
 
@@ -122,10 +144,18 @@ class BillingsVoon:
             ax.plot(t.lags, t.values, "o", color="C0", ms=3)
             ax.axhline(band, color="C3", ls="--", lw=1)
             ax.axhline(-band, color="C3", ls="--", lw=1)
-            verdict = "pass" if t.passed[self.level] else "FAIL"
+            if name in self.not_applicable:
+                verdict = "not applicable (no degrees of freedom)"
+            else:
+                verdict = "pass" if t.passed[self.level] else "FAIL"
             ax.set_title(f"{BILLINGS_VOON[name]}: {verdict}", fontsize=9)
             ax.set_ylim(-1.05, 1.05)
-        axes[-1].set_xlabel("lag")
+            ax.set_ylabel("correlation", fontsize=8)
+        axes[-1].set_xlabel("lag (samples)")
+        fig.suptitle(
+            f"Billings-Voon correlation tests ({self.level:.0%} bands dashed)",
+            fontsize=10,
+        )
         fig.tight_layout()
         return fig
 

@@ -9,6 +9,7 @@ it, so its :class:`NARXValidation` carries what does.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,6 +51,14 @@ class NARXValidation:
     diverged : bool
         The free run grew without bound on this record: its fit is reported
         (far below zero) but means only that.
+    linear_fit_percent : float
+        Free-run fit of the model's linear start on the same record (nan
+        without one): what the network adds is ``fit_percent`` minus it.
+    kept_linear : bool
+        Training ended at the linear start (the network adds nothing).
+    output_label : str
+        The output's name and unit for the figures, e.g. ``"hub_angle
+        [rad]"``.
     """
 
     label: str
@@ -68,6 +77,27 @@ class NARXValidation:
     y_sim: np.ndarray
     y_pred: np.ndarray
     diverged: bool = False
+    linear_fit_percent: float = float("nan")
+    kept_linear: bool = False
+    output_label: str = "output"
+
+    def network_line(self) -> str:
+        """What the network added over its linear start, in one line."""
+        if not np.isfinite(self.linear_fit_percent):
+            return "  no linear start (no bypass, or a polynomial NARX)"
+        lin = f"{self.linear_fit_percent:.1f} %"
+        if self.kept_linear or np.isclose(
+            self.fit_percent, self.linear_fit_percent, atol=0.005, rtol=0.0
+        ):
+            return (
+                f"  the network added nothing: the model is its linear start "
+                f"(fit {lin})"
+            )
+        gain = self.fit_percent - self.linear_fit_percent
+        return (
+            f"  network over its linear start: {gain:+.1f} points of fit "
+            f"(linear start {lin})"
+        )
 
     def summary(self) -> str:
         """Human-readable report."""
@@ -77,6 +107,7 @@ class NARXValidation:
             f"NARX validation ({self.label}), N = {self.n_samples}",
             f"  fit (free run)   {free:>10}",
             f"  fit (one step)   {one_step:>10}",
+            self.network_line(),
             f"  cost (eq. 2)     {self.cost:8.4g}",
             "  error range      "
             f"[{self.error_range[0]:.4g}, {self.error_range[1]:.4g}]",
@@ -103,6 +134,8 @@ class NARXValidation:
             "residuals": self.residuals,
             "billings_voon": self.correlation.to_dict(),
             "diverged": bool(self.diverged),
+            "linear_fit_percent": float(self.linear_fit_percent),
+            "kept_linear": bool(self.kept_linear),
         }
         if signals:
             for k in ("t", "u", "y", "y_sim", "y_pred"):
@@ -117,6 +150,11 @@ class NARXValidation:
         ax.plot(self.t, self.y, label="measured", lw=1)
         ax.plot(self.t, self.y_sim, label=f"free run ({self.fit_percent:.1f} %)", lw=1)
         ax.set_xlabel("time (s)")
+        ax.set_ylabel(self.output_label)
+        ax.set_title(
+            f"NARX free run against the record ({self.label}, N = {self.n_samples})",
+            fontsize=10,
+        )
         ax.legend(fontsize=8)
         fig.tight_layout()
         return {"response": fig, "billings_voon": self.correlation.plot()}
@@ -182,6 +220,15 @@ def validate_narx(
     y_sim, diverged = _bounded_run(y_sim, y)
     w = _gain(gain, model, y)
     e_sim, e_pred = y - y_sim, y - y_pred
+    linear_fit = math.nan
+    lin_model = getattr(model, "linear_start", None)
+    if lin_model is not None:
+        with np.errstate(all="ignore"):
+            y_lin = np.asarray(lin_model.simulate(whole.u), dtype=float)[start:]
+        linear_fit = fit_percent(y, _bounded_run(y_lin, y)[0])
+    result = getattr(model, "result", None) or {}
+    unit = getattr(model, "output_unit", "")
+    name = getattr(model, "output_name", "y")
     e_cost = e_sim if model.predictor == "simulation" else e_pred
     e_test = e_pred if residuals == "one-step" else e_sim
     return NARXValidation(
@@ -201,4 +248,7 @@ def validate_narx(
         y_sim=y_sim,
         y_pred=y_pred,
         diverged=diverged,
+        linear_fit_percent=linear_fit,
+        kept_linear=bool(result.get("kept_linear", False)),
+        output_label=f"{name} [{unit}]" if unit else name,
     )
