@@ -175,7 +175,7 @@ CASES = [
     ),
     (
         "identify ok.csv --ts 0.01 --model polynomial --method ls --budget 10 --seed 5",
-        "--seed, --budget do not apply to --method ls --model polynomial",
+        "--budget does not apply to --method ls --model polynomial; the options",
     ),
     (
         "identify ok.csv --ts 0.01 --model narx --method ls --budget 5",

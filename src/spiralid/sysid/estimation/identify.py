@@ -398,6 +398,23 @@ def identify(
     (array([-1.5,  0.7,  1. ,  0.5]), True, 0)
     """
     t_start = time.perf_counter()
+    if isinstance(data, IOData) and data.n_outputs > 1 and isinstance(arx, ARX):
+        return _identify_shared(
+            data,
+            arx,
+            method,
+            dict(
+                predictor=predictor,
+                initial=initial,
+                rng=rng,
+                gain=gain,
+                penalty=penalty,
+                integrator=integrator,
+                max_time_constant=max_time_constant,
+                cancel=cancel,
+                **options,
+            ),
+        )
     single_output_record(data, "identify")
     if not isinstance(arx, ARX | NARX | PolynomialNARX):
         raise ValueError(
@@ -581,6 +598,42 @@ def _time_constant(value, ts: float) -> float | None:
             f"ts = {ts:g} s; got {value!r}"
         )
     return seconds
+
+
+# What the shared-denominator estimate of several outputs takes (issue 30):
+# its own options beside the common ones.
+SHARED_OPTIONS = ("rng", "predictor", "initial", "max_time_constant")
+SHARED_OWN = ("n_points", "max_nfev", "weights")
+
+
+def _identify_shared(data: IOData, arx: ARX, method, given: dict):
+    """`identify` on a record of several outputs: one denominator for all
+    (:func:`~spiralid.sysid.estimation.shared.identify_shared`); for now by
+    the default method only."""
+    from .shared import identify_shared
+
+    method = _check_method(method)
+    if method != DEFAULT_METHOD:
+        raise ValueError(
+            f"`method` {method!r} takes one output; a record of several outputs "
+            f"{data.output_names} is identified by {DEFAULT_METHOD!r} (one shared "
+            "denominator), or pass data.output(name)"
+        )
+    if given["predictor"] != "simulation" or given["initial"] != "rest":
+        raise ValueError(
+            "a record of several outputs is fitted to its simulation error from "
+            f"rest; got predictor={given['predictor']!r}, initial={given['initial']!r}"
+        )
+    refuse_options(
+        given,
+        SHARED_OPTIONS + SHARED_OWN,
+        f"a record of {data.n_outputs} outputs (one shared denominator)",
+        IDENTIFY_DEFAULTS,
+    )
+    own = {k: given[k] for k in SHARED_OWN if k in given}
+    return identify_shared(
+        data, arx, rng=given["rng"], max_time_constant=given["max_time_constant"], **own
+    )
 
 
 def _identify_integrating(

@@ -69,7 +69,7 @@ from spiralid.optim._decomposition import Archive
 from spiralid.optim.front import knee_point
 from spiralid.optim.pareto import PARETO_OPTIONS, minimize_pareto, non_dominated
 
-from ..data import IOData
+from ..data import IOData, single_output_record
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from .cost import PaperCost
@@ -613,8 +613,7 @@ def identify_pareto(
     True
     """
     t_start = time.perf_counter()
-    if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    single_output_record(data, "identify_pareto")
     structures = _structures(orders, nk)
     names = _names(objectives, len(structures) > 1)
     if isinstance(method, str):

@@ -198,6 +198,26 @@ class ProjectedCost:
 
     # -- residual and Jacobian of one candidate (for Gauss-Newton) -------------
 
+    def sse(self, a) -> float:
+        """``||y - V b(A)||^2`` of one stable denominator (what the
+        Gauss-Newton polish lowers)."""
+        a = np.ascontiguousarray(np.asarray(a, dtype=float)[:, None])
+        b = np.empty((self.arx.nb, 1))
+        out = np.empty(1)
+        _kernel()(self._u, self._y, a, self.arx.nk, b, out)
+        return float(out[0])
+
+    def normal_equations(self, a) -> tuple[float, np.ndarray, np.ndarray]:
+        """``(sse, J'r, J'J)`` of the projected residual at one denominator
+        (:meth:`residual`'s ``J``), reduced in compiled loops."""
+        _kernel()
+        a = np.ascontiguousarray(a, dtype=float)
+        return _kernels.normal_equations(self._u, self._y, a, self.arx.nb, self.arx.nk)
+
+    def fun_of_sse(self, sse: float) -> float:
+        """The cost, eq. (2), of a projected squared error."""
+        return self.w / self.K * np.sqrt(sse)
+
     def residual(self, a) -> tuple[np.ndarray, np.ndarray]:
         """``(r, J)``: the projected residual ``y - V b(A)`` of one stable
         denominator and its exact Jacobian ``d r / d a`` (Golub-Pereyra).
@@ -234,6 +254,9 @@ def gauss_newton_polish(
     Parameters
     ----------
     cost : ProjectedCost
+        Or any cost with ``sse(a)``, ``normal_equations(a)`` and
+        ``fun_of_sse(sse)`` (the shared denominator's,
+        :class:`~spiralid.sysid.estimation.shared.SharedProjectedCost`).
     parametrization
         Has ``bounds`` (na, 2), ``to_denominator(x)`` and ``jacobian(x)``
         (``d a / d x``), e.g. :class:`~spiralid.sysid.ModalParametrization`.
@@ -253,24 +276,16 @@ def gauss_newton_polish(
     box = parametrization.bounds
     lo, hi = box[:, 0], box[:, 1]
     x = np.clip(np.asarray(x0, dtype=float), lo, hi)
-    arx = cost.arx
-    _kernel()
-    scale = cost.w / cost.K
 
     def sse_at(pt):
-        a = np.ascontiguousarray(parametrization.to_denominator(pt)[:, None])
-        b = np.empty((arx.nb, 1))
-        out = np.empty(1)
-        _kernels.projected_sse(cost._u, cost._y, a, arx.nk, b, out)
-        return float(out[0])
+        return cost.sse(parametrization.to_denominator(pt))
 
     lam = 1e-3
     nfev, nit, status = 0, 0, 1
     message = "Evaluation budget used."
     sse = None
     while nfev < max_nfev:
-        a = np.ascontiguousarray(parametrization.to_denominator(x))
-        s0, g_a, h_a = _kernels.normal_equations(cost._u, cost._y, a, arx.nb, arx.nk)
+        s0, g_a, h_a = cost.normal_equations(parametrization.to_denominator(x))
         nfev += 1
         sse = s0 if sse is None else sse
         m = parametrization.jacobian(x)
@@ -310,7 +325,7 @@ def gauss_newton_polish(
             break
     return OptimiserResult(
         x=x,
-        fun=scale * np.sqrt(sse)
+        fun=cost.fun_of_sse(sse)
         if sse is not None
         else cost(parametrization.to_denominator(x)),
         nfev=nfev,

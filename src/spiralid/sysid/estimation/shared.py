@@ -1,0 +1,282 @@
+"""Several outputs, one denominator: the shared-denominator estimate.
+
+Every sensor of a flexible structure sees the same modes through its own
+numerator (:class:`~spiralid.sysid.models.shared.SharedDenominatorModel`).
+The simulation error of output ``i`` is linear in its numerator ``b_i``, so
+for a candidate denominator each numerator is projected out exactly as for
+one output (:class:`~spiralid.sysid.estimation.varpro.ProjectedCost`), and
+the outputs' squared errors add up with a weight each:
+
+    J(A) = sum_i lambda_i ||y_i - V(A) b_i(A)||^2.
+
+The spiral search (:func:`~spiralid.sysid.estimation.memetic.projected_spiral`,
+Eb-SDA over the modal coordinates of ``A`` with Gauss-Newton polish and
+restarts, as the single-output ``"spiral"``) searches ``A`` alone; each
+output adds a projection, not a search dimension.
+
+Weights. A first fit weighs each output by its mean square, so that every
+sensor counts in its own units' scale (the cost is then the RMS over the
+outputs of their percent errors, eq. (2)). Each output's residual variance
+``sigma_i^2`` there is its noise level, and the estimate is polished again
+with ``lambda_i = 1 / sigma_i^2``, re-estimated from each polish until the
+weights settle (within 10 %, at most 5 rounds): the maximum-likelihood
+weighting for independent Gaussian sensor noise, so a noisy sensor does not
+pull the modes off a clean one's. ``weights=`` gives them explicitly.
+
+Intervals. At the optimum, ``s^2 (J_a' J_a)^-1`` with ``J_a`` the weighted
+variable-projection Jacobian (Golub-Pereyra) is the covariance of ``a``
+(the numerators' uncertainty is already projected out), and ``s^2`` the
+weighted residual variance per degree of freedom.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from spiralid._checks import generator, integer
+
+from ..data import IOData
+from ..models.arx import ARX
+from ..models.polynomials import is_stable_polynomial
+from ..models.shared import SharedDenominatorModel
+from .margin import AUTO, max_radius
+from .modal import ModalParametrization
+from .varpro import ProjectedCost, gauss_newton_polish
+
+__all__ = ["SharedProjectedCost", "identify_shared"]
+
+# The final polishes' budget, in evaluations per searched coordinate (the
+# single-output polish runs LM to its tolerances; this is its like).
+_POLISH_NFEV = 40
+# At most this many rounds of noise weights, each a polish (module docstring).
+_REWEIGHTS = 5
+
+
+class SharedProjectedCost:
+    """``J(A)`` over denominators, every output's numerator projected out.
+
+    Parameters
+    ----------
+    arx : ARX
+        Each output's structure.
+    data : IOData
+        A record of ``p >= 1`` outputs.
+    weights : array_like, shape (p,), optional
+        ``lambda_i``; default ``1 / mean(y_i^2)`` (each output in its own
+        scale).
+
+    The value reported is a percent RMS error:
+    ``100 sqrt(J / sum_i lambda_i ||y_i||^2)``, which with the default
+    weights is the RMS over the outputs of their percent errors.
+    """
+
+    def __init__(self, arx: ARX, data: IOData, weights=None) -> None:
+        self.arx = arx
+        self.parts = [ProjectedCost(arx, data.output(i)) for i in range(data.n_outputs)]
+        energy = np.array([float(np.sum(part.data.y**2)) for part in self.parts])
+        if weights is None:
+            weights = data.n / np.maximum(energy, np.finfo(float).tiny)
+        weights = np.asarray(weights, dtype=float).ravel()
+        if weights.shape != (len(self.parts),) or not np.all(
+            np.isfinite(weights) & (weights > 0)
+        ):
+            raise ValueError(
+                f"`weights` must be {len(self.parts)} finite numbers > 0 (one per "
+                f"output); got {weights!r}"
+            )
+        self.weights = weights
+        self._norm = float(weights @ energy)
+
+    def fun_of_sse(self, sse: float) -> float:
+        return 100.0 * float(np.sqrt(max(sse, 0.0) / self._norm))
+
+    def sse(self, a) -> float:
+        return float(
+            sum(
+                w * part.sse(a)
+                for w, part in zip(self.weights, self.parts, strict=True)
+            )
+        )
+
+    def normal_equations(self, a):
+        total_s, total_g, total_h = 0.0, 0.0, 0.0
+        for w, part in zip(self.weights, self.parts, strict=True):
+            s, g, h = part.normal_equations(a)
+            total_s, total_g, total_h = (
+                total_s + w * s,
+                total_g + w * g,
+                total_h + w * h,
+            )
+        return total_s, total_g, total_h
+
+    def evaluate(self, a) -> tuple[np.ndarray, np.ndarray]:
+        """Costs and numerators ``[b_1, .., b_p]`` of a population."""
+        aa = np.atleast_2d(np.asarray(a, dtype=float))
+        sse = np.zeros(aa.shape[0])
+        numerators = []
+        for w, part in zip(self.weights, self.parts, strict=True):
+            f, b = part.evaluate(aa)
+            # The part's cost back to its squared error (w K / ... scaling).
+            sse += w * (f * part.K / part.w) ** 2
+            numerators.append(b)
+        f = np.array([self.fun_of_sse(s) for s in sse])
+        return f, np.concatenate(numerators, axis=1)
+
+    def __call__(self, a):
+        aa = np.asarray(a, dtype=float)
+        f, _ = self.evaluate(aa)
+        return float(f[0]) if aa.ndim == 1 else f
+
+    def per_output(self, a) -> np.ndarray:
+        """Each output's own paper cost, eq. (2), at denominator `a`."""
+        return np.array([float(part(a)) for part in self.parts])
+
+    def numerators(self, a) -> np.ndarray:
+        """``b_i(A)``, shape (p, nb)."""
+        return np.array([part.numerator(a) for part in self.parts])
+
+
+def _starts(data: IOData, arx: ARX, par: ModalParametrization) -> np.ndarray:
+    """Each output's least-squares denominator (stabilised), in modal
+    coordinates: a sensor's own estimate of the shared modes."""
+    from ..models.arx import arx_least_squares
+    from ..models.polynomials import step_up
+    from .margin import project_denominator
+    from .parametrizations import KMAX, stabilise
+
+    rows = []
+    for i in range(data.n_outputs):
+        theta = stabilise(arx_least_squares(data.output(i), arx), arx)
+        a = step_up(theta[: arx.na])
+        if par.max_radius is not None:
+            a = project_denominator(a, par.max_radius, KMAX)
+        rows.append(par.from_denominator(a))
+    box = par.bounds
+    return np.clip(np.array(rows), box[:, 0], box[:, 1])
+
+
+def identify_shared(
+    data: IOData,
+    arx: ARX,
+    *,
+    rng=None,
+    n_points: int = 50,
+    max_nfev: int = 10_000,
+    weights=None,
+    max_time_constant: float | str | None = AUTO,
+) -> SharedDenominatorModel:
+    """One denominator for every output of `data`, by the spiral search.
+
+    Parameters
+    ----------
+    data : IOData
+        A record of ``p >= 2`` outputs (``y`` of shape (N, p)) from rest.
+    arx : ARX
+        Each output's structure: ``na`` shared poles, ``nb`` numerator
+        coefficients per output after ``nk`` delays.
+    rng : int, Generator or None
+        Seeds the search.
+    n_points, max_nfev : int
+        The search's population and budget of joint-cost evaluations, as
+        the single-output ``"spiral"`` (Eb-SDA over the modes, polish every
+        5 iterations, restarts after 20 stalled ones).
+    weights : array_like, shape (p,), optional
+        ``lambda_i`` of the joint cost; default estimated: a first fit in
+        each output's scale, then ``1 / sigma_i^2`` from its residuals
+        (module docstring).
+    max_time_constant : float, "auto" or None
+        The stability margin, as :func:`~spiralid.sysid.identify`'s:
+        ``"auto"`` keeps every pole's time constant within the record.
+
+    Returns
+    -------
+    SharedDenominatorModel
+    """
+    from spiralid.optim.restarts import Restarts
+
+    from .memetic import projected_spiral
+
+    t0 = time.perf_counter()
+    if not isinstance(data, IOData):
+        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+    if not isinstance(arx, ARX) or arx.na < 1:
+        raise ValueError(f"`arx` must be an ARX with na >= 1; got {arx!r}")
+    n_points = integer(n_points, "n_points", 2)
+    max_nfev = integer(max_nfev, "max_nfev", n_points)
+    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
+        seconds = data.n * data.ts
+    elif max_time_constant is None:
+        seconds = None
+    else:
+        seconds = float(max_time_constant)
+    par = ModalParametrization(arx.na, data.ts, max_radius=max_radius(data.ts, seconds))
+    first = SharedProjectedCost(arx, data, None if weights is None else weights)
+    raw = projected_spiral(
+        first,
+        par,
+        "ebsda",
+        n_points=n_points,
+        max_nfev=max_nfev,
+        polish_every=5,
+        polish_nfev=10,
+        restarts=Restarts(growth=1, stall=20),
+        x0=_starts(data, arx, par),
+        rng=generator(rng),
+    )
+    budget = _POLISH_NFEV * (arx.na + 1)
+    z = gauss_newton_polish(first, par, raw.z, budget).x
+    cost = first
+    for _ in range(_REWEIGHTS if weights is None else 0):
+        # Each output's residual variance at the current fit is its noise
+        # level; the misfit the first weighting left inflates it, so the
+        # weights are re-estimated until they settle.
+        a = par.to_denominator(z)
+        sigma2 = np.array([part.sse(a) for part in first.parts]) / data.n
+        new = 1.0 / np.maximum(sigma2, 1e-300)
+        settled = cost is not first and np.allclose(new, cost.weights, rtol=0.1)
+        cost = SharedProjectedCost(arx, data, new)
+        z = gauss_newton_polish(cost, par, z, budget).x
+        if settled:
+            break
+    a = par.to_denominator(z)
+    return SharedDenominatorModel(
+        a=a,
+        b=cost.numerators(a),
+        arx=arx,
+        ts=data.ts,
+        output_names=data.output_names,
+        output_units=data.output_units,
+        input_name=data.input_name,
+        input_unit=data.input_unit,
+        u_offset=data.u_offset,
+        y_offsets=data.y_offsets,
+        method="spiral",
+        cost=float(cost(a)),
+        weights=cost.weights,
+        costs=cost.per_output(a),
+        covariance=_covariance(cost, a, data, arx),
+        result={
+            "nfev": int(raw.nfev),
+            "nit": int(raw.nit),
+            "n_restarts": int(raw.n_restarts),
+            "message": str(raw.message),
+            "elapsed": time.perf_counter() - t0,
+        },
+    )
+
+
+def _covariance(cost: SharedProjectedCost, a, data: IOData, arx: ARX):
+    """``s^2 (J_a' J_a)^-1`` of the weighted projected residual at `a`, or
+    None where ``J_a' J_a`` is singular or `a` unstable."""
+    if not is_stable_polynomial(a):
+        return None
+    sse, _, hess = cost.normal_equations(a)
+    dof = data.n * data.n_outputs - arx.na - data.n_outputs * arx.nb
+    if dof <= 0:
+        return None
+    try:
+        return (sse / dof) * np.linalg.inv(hess)
+    except np.linalg.LinAlgError:
+        return None

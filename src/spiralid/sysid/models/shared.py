@@ -1,0 +1,295 @@
+"""Several outputs, one denominator: :class:`SharedDenominatorModel`.
+
+A flexible structure's sensors (hub angle, hub velocity, end-point
+acceleration, tip deflection) are driven by one torque and share the
+structure's modes: their transfer functions have one denominator ``A(q)``
+and a numerator each,
+
+    y_i(t) = B_i(q) / A(q) u(t),   i = 1..p,
+
+a single-input multi-output (SIMO) output-error model. The modes are the
+complex pole pairs of ``A``, with intervals from the covariance of ``a``
+(:func:`~spiralid.sysid.models.modes.mode_table`), and each mode's share in
+each output from that output's residues: a sensor near a node of a mode
+barely sees it, the others do.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal
+
+from .arx import ARX
+from .identified import IdentifiedModel
+from .modes import ModeTable, mode_table
+from .polynomials import is_stable_polynomial, max_pole_radius
+
+__all__ = ["SharedDenominatorModel", "SharedModes"]
+
+
+@dataclass(frozen=True)
+class SharedModes:
+    """The shared denominator's modes, with each mode's share per output.
+
+    Attributes
+    ----------
+    table : ModeTable
+        Frequencies (Hz), damping ratios and their 95 % intervals, from the
+        covariance of the shared denominator; its ``share`` and flags are
+        those of the output where the mode is strongest.
+    share : ndarray, shape (m, p)
+        Each mode's resonant peak as a share of each output's (a column per
+        output, :attr:`ModeTable.share` of ``B_i / A``).
+    output_names : tuple of str
+    """
+
+    table: ModeTable
+    share: np.ndarray
+    output_names: tuple[str, ...]
+
+    def __len__(self) -> int:
+        return len(self.table)
+
+    def to_dict(self) -> dict:
+        out = self.table.to_dict()
+        out["share_by_output"] = {
+            name: [_plain(v) for v in self.share[:, k]]
+            for k, name in enumerate(self.output_names)
+        }
+        return out
+
+    def __str__(self) -> str:
+        t = self.table
+        if not len(t):
+            return "no modes (no complex pole pair)"
+        lo_f, hi_f = t.frequency_interval.T
+        lo_z, hi_z = t.damping_interval.T
+        names = [n[:14] for n in self.output_names]
+        head = (
+            f"{'mode':>4}  {'frequency (Hz) [95 %]':>30}  {'damping [95 %]':>30}  "
+            + "  ".join(f"{n:>14}" for n in names)
+        )
+        lines = [head]
+        for i in range(len(t)):
+            freq = f"{t.frequency[i]:.4g} [{lo_f[i]:.4g}, {hi_f[i]:.4g}]"
+            damp = f"{t.damping[i]:.4f} [{lo_z[i]:.4f}, {hi_z[i]:.4f}]"
+            shares = "  ".join(f"{100 * s:13.1f}%" for s in self.share[i])
+            lines.append(f"{i + 1:>4}  {freq:>30}  {damp:>30}  {shares}")
+        return "\n".join(lines)
+
+
+def _plain(value) -> float | None:
+    return float(value) if np.isfinite(value) else None
+
+
+@dataclass
+class SharedDenominatorModel:
+    """A single-input multi-output model with one denominator.
+
+    Parameters
+    ----------
+    a : ndarray, shape (na,)
+        The shared denominator ``A = 1 + a_1 q^-1 + ...``.
+    b : ndarray, shape (p, nb)
+        One numerator per output (coefficients of ``q^-nk .. q^-(nk+nb-1)``).
+    arx : ARX
+        The structure each output has (``na``, ``nb``, ``nk``).
+    ts : float
+        Sample time in seconds.
+    output_names, output_units : tuple of str
+        One per output.
+    input_name, input_unit : str
+    u_offset : float
+    y_offsets : tuple of float
+        Offsets removed from the record (as :class:`IdentifiedModel`'s).
+    method : str
+        The estimator.
+    cost : float
+        The weighted joint cost the estimator minimised (percent RMS error,
+        see :class:`~spiralid.sysid.estimation.shared.SharedProjectedCost`).
+    weights : ndarray, shape (p,)
+        The outputs' weights in that cost (``1 / sigma_i^2``).
+    costs : ndarray, shape (p,)
+        Each output's own paper cost, eq. (2), at the estimate.
+    covariance : ndarray, shape (na, na), or None
+        The covariance of ``a`` (variable projection: the numerators
+        projected out), for the modes' intervals.
+    result : dict
+        What the estimator reports (budget, messages, timings).
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    arx: ARX
+    ts: float
+    output_names: tuple[str, ...]
+    output_units: tuple[str, ...] = ()
+    input_name: str = "u"
+    input_unit: str = ""
+    u_offset: float = 0.0
+    y_offsets: tuple[float, ...] = ()
+    method: str = "spiral"
+    cost: float = float("nan")
+    weights: np.ndarray | None = None
+    costs: np.ndarray | None = None
+    covariance: np.ndarray | None = None
+    result: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.a = np.asarray(self.a, dtype=float).ravel()
+        self.b = np.atleast_2d(np.asarray(self.b, dtype=float))
+        p = self.b.shape[0]
+        if self.a.shape != (self.arx.na,) or self.b.shape[1] != self.arx.nb:
+            raise ValueError(
+                f"`a` and `b` must have shapes ({self.arx.na},) and (p, "
+                f"{self.arx.nb}) for {self.arx}; got {self.a.shape} and {self.b.shape}"
+            )
+        self.output_names = tuple(self.output_names)
+        if len(self.output_names) != p:
+            raise ValueError(
+                f"`output_names` must name each of the {p} outputs; got "
+                f"{self.output_names}"
+            )
+        self.output_units = tuple(self.output_units) or ("",) * p
+        self.y_offsets = tuple(float(v) for v in self.y_offsets) or (0.0,) * p
+
+    @property
+    def n_outputs(self) -> int:
+        return int(self.b.shape[0])
+
+    def theta(self, i: int) -> np.ndarray:
+        """Output `i`'s ARX theta ``[a, b_i]``."""
+        return np.r_[self.a, self.b[i]]
+
+    def simulate(self, u) -> np.ndarray:
+        """Free run of every output from rest, shape (N, p)."""
+        u = np.asarray(getattr(u, "u", u), dtype=float)
+        return np.column_stack(
+            [self.arx.simulate(self.theta(i), u) for i in range(self.n_outputs)]
+        )
+
+    def output_model(self, which: int | str) -> IdentifiedModel:
+        """One output's transfer function ``B_i / A`` as an
+        :class:`IdentifiedModel`, which :func:`~spiralid.sysid.validate`
+        validates on that output (its covariance is not carried: the
+        intervals belong to the shared modes)."""
+        i = which if isinstance(which, int) else self.output_names.index(which)
+        return IdentifiedModel(
+            self.theta(i),
+            arx=self.arx,
+            ts=self.ts,
+            method=self.method,
+            cost=float(self.costs[i]) if self.costs is not None else float("nan"),
+            input_name=self.input_name,
+            output_name=self.output_names[i],
+            input_unit=self.input_unit,
+            output_unit=self.output_units[i],
+            u_offset=self.u_offset,
+            y_offset=self.y_offsets[i],
+        )
+
+    @property
+    def poles(self) -> np.ndarray:
+        return np.roots(np.r_[1.0, self.a]) if self.arx.na else np.zeros(0, complex)
+
+    @property
+    def is_stable(self) -> bool:
+        return bool(is_stable_polynomial(self.a))
+
+    @property
+    def max_pole_radius(self) -> float:
+        return float(max_pole_radius(self.a))
+
+    @property
+    def modes(self) -> SharedModes:
+        """The shared modes with 95 % intervals and each one's share per
+        output."""
+        b_full = [np.r_[np.zeros(self.arx.nk), bi] for bi in self.b]
+        tables = [
+            mode_table(self.a, bi, self.ts, covariance=self.covariance) for bi in b_full
+        ]
+        share = (
+            np.column_stack([t.share for t in tables]) if tables else np.zeros((0, 0))
+        )
+        strongest = int(np.argmax(np.nansum(share, axis=0))) if share.size else 0
+        return SharedModes(tables[strongest], share, self.output_names)
+
+    def to_control(self):
+        """The model as a python-control SIMO state-space system in z
+        (``dt = ts``): one state for the shared denominator, a row of ``C``
+        per output (``scipy.signal.tf2ss`` of the numerators over ``A``).
+        Needs python-control (``pip install "spiralid[control]"``)."""
+        try:
+            import control
+        except ImportError:
+            raise ImportError(
+                'to_control() needs python-control: pip install "spiralid[control]"'
+            ) from None
+        polys = [self.arx.polynomials(self.theta(i)) for i in range(self.n_outputs)]
+        num = np.array([n for n, _ in polys])
+        # Leading zero columns (the delay nk) are a strictly proper system's:
+        # left in, scipy warns of badly conditioned coefficients.
+        lead = np.argmax(np.any(num != 0.0, axis=0)) if np.any(num) else 0
+        a, b, c, d = signal.tf2ss(num[:, lead:], polys[0][1])
+        return control.ss(a, b, c, d, self.ts)
+
+    def to_dict(self) -> dict:
+        """A JSON-safe form (what ``model.json`` holds)."""
+        return {
+            "kind": "shared-denominator",
+            "structure": {"na": self.arx.na, "nb": self.arx.nb, "nk": self.arx.nk},
+            "ts": self.ts,
+            "method": self.method,
+            "a": self.a.tolist(),
+            "b": self.b.tolist(),
+            "input_name": self.input_name,
+            "input_unit": self.input_unit,
+            "output_names": list(self.output_names),
+            "output_units": list(self.output_units),
+            "u_offset": self.u_offset,
+            "y_offsets": list(self.y_offsets),
+            "cost": _plain(self.cost),
+            "costs": None if self.costs is None else [_plain(c) for c in self.costs],
+            "weights": None if self.weights is None else self.weights.tolist(),
+            "covariance": None if self.covariance is None else self.covariance.tolist(),
+            "modes": self.modes.to_dict(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> SharedDenominatorModel:
+        """The model :meth:`to_dict` wrote."""
+        if d.get("kind") != "shared-denominator":
+            raise ValueError(
+                f"field 'kind' must be 'shared-denominator'; got {d.get('kind')!r}"
+            )
+        s = d["structure"]
+
+        def array(key):
+            value = d.get(key)
+            return None if value is None else np.asarray(value, dtype=float)
+
+        return cls(
+            a=np.asarray(d["a"], dtype=float),
+            b=np.asarray(d["b"], dtype=float),
+            arx=ARX(int(s["na"]), int(s["nb"]), int(s["nk"])),
+            ts=float(d["ts"]),
+            output_names=tuple(d["output_names"]),
+            output_units=tuple(d.get("output_units") or ()),
+            input_name=str(d.get("input_name", "u")),
+            input_unit=str(d.get("input_unit", "")),
+            u_offset=float(d.get("u_offset", 0.0)),
+            y_offsets=tuple(d.get("y_offsets") or ()),
+            method=str(d.get("method", "")),
+            cost=float(d["cost"]) if d.get("cost") is not None else float("nan"),
+            costs=array("costs"),
+            weights=array("weights"),
+            covariance=array("covariance"),
+        )
+
+    def __repr__(self) -> str:
+        return (
+            f"SharedDenominatorModel({self.arx}, outputs={self.output_names}, "
+            f"method={self.method!r}, cost={self.cost:.6g})"
+        )

@@ -1,0 +1,100 @@
+"""One denominator for several outputs (issue 30): the shared-denominator
+cost, estimate and model (`sysid/estimation/shared.py`,
+`sysid/models/shared.py`)."""
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from spiralid.sysid import ARX, IOData, PaperCost, identify, validate
+from spiralid.sysid.estimation.shared import SharedProjectedCost
+from spiralid.sysid.models.shared import SharedDenominatorModel
+
+TS = 0.01
+# Two modes at 3 Hz (damping 0.03) and 11 Hz (0.05), sampled by zero-order hold.
+MODES = ((3.0, 0.03), (11.0, 0.05))
+
+
+def _denominator() -> np.ndarray:
+    poles = []
+    for f, zeta in MODES:
+        wn = 2 * np.pi * f
+        s = -zeta * wn + 1j * wn * np.sqrt(1 - zeta**2)
+        poles += [np.exp(s * TS), np.exp(np.conj(s) * TS)]
+    return np.poly(poles).real
+
+
+A = _denominator()
+# Sensor 2 sits near a node of the 11 Hz mode: its numerator nearly cancels
+# that pole pair in its own response (the zeros put on it).
+B = np.array([[0.0, 0.02, 0.015, -0.01, 0.004], [0.0, 0.01, 0.0, 0.0, 0.0]])
+
+
+def _record(seed=0, n=1500, noise=(0.002, 0.002)) -> IOData:
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = np.column_stack([signal.lfilter(b, A, u) for b in B])
+    y += rng.standard_normal(y.shape) * np.array(noise)
+    return IOData(u, y, ts=TS, output_name=("near", "far"), output_unit=("m", "m"))
+
+
+def test_the_shared_cost_of_one_output_is_the_papers_cost():
+    data = _record().output(0)
+    arx = ARX(4, 4, 1)
+    shared = SharedProjectedCost(arx, data)
+    a = A[1:] * 0.99 ** np.arange(1, 5)
+    theta = np.r_[a, shared.numerators(a)[0]]
+    # With one output and the default weight, 100 sqrt(sse / sum y^2) is
+    # eq. (2) at gain "auto" for the projected numerator.
+    assert shared(a) == pytest.approx(float(PaperCost(arx, data)(theta)), rel=1e-10)
+
+
+def test_two_outputs_give_one_denominator_with_intervals_that_hold_the_truth():
+    data = _record(1)
+    fit = identify(data, ARX(4, 4, 1), rng=0, max_nfev=3000)
+    assert isinstance(fit, SharedDenominatorModel) and fit.n_outputs == 2
+    np.testing.assert_allclose(fit.a, A[1:], atol=2e-3)
+    np.testing.assert_allclose(fit.b, B[:, 1:], atol=2e-3)
+    modes = fit.modes
+    lo, hi = modes.table.frequency_interval.T
+    truth = np.array([f for f, _ in MODES])
+    assert np.all((lo <= truth) & (truth <= hi))
+    assert modes.share.shape == (2, 2)
+    # Each output's transfer function validates on its own output.
+    for k, name in enumerate(data.output_names):
+        v = validate(fit.output_model(name), data.output(k))
+        assert v.fit_percent > 90
+
+
+def test_noise_weights_come_from_the_first_fit():
+    data = _record(2, noise=(0.0005, 0.02))
+    fit = identify(data, ARX(4, 4, 1), rng=0, max_nfev=2000)
+    # 1 / sigma^2: the quiet sensor weighs about (0.02 / 0.0005)^2 more.
+    ratio = fit.weights[0] / fit.weights[1]
+    assert 400 < ratio < 4000
+    given = identify(data, ARX(4, 4, 1), rng=0, max_nfev=2000, weights=[1.0, 1.0])
+    np.testing.assert_array_equal(given.weights, [1.0, 1.0])
+
+
+def test_the_model_round_trips_through_json_and_refuses_bad_input():
+    fit = identify(_record(3), ARX(4, 4, 1), rng=0, max_nfev=1000)
+    again = SharedDenominatorModel.from_dict(fit.to_dict())
+    np.testing.assert_array_equal(again.a, fit.a)
+    np.testing.assert_array_equal(again.b, fit.b)
+    assert again.output_names == ("near", "far")
+    np.testing.assert_array_equal(again.simulate(np.ones(5)), fit.simulate(np.ones(5)))
+    with pytest.raises(ValueError, match="`weights` must be 2 finite numbers"):
+        identify(_record(3), ARX(4, 4, 1), weights=[1.0, -1.0])
+    with pytest.raises(ValueError, match="`method` 'oe' takes one output"):
+        identify(_record(3), ARX(4, 4, 1), method="oe")
+    with pytest.raises(ValueError, match="`refine` does not apply to a record of 2"):
+        identify(_record(3), ARX(4, 4, 1), refine=True)
+
+
+def test_to_control_is_a_simo_system():
+    control = pytest.importorskip("control")
+    fit = identify(_record(4), ARX(4, 4, 1), rng=0, max_nfev=1000)
+    sys = fit.to_control()
+    assert (sys.noutputs, sys.ninputs) == (2, 1) and sys.dt == TS
+    _, y = control.forced_response(sys, U=np.r_[1.0, np.zeros(49)])
+    np.testing.assert_allclose(y.T, fit.simulate(np.r_[1.0, np.zeros(49)]), atol=1e-9)
