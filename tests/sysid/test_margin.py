@@ -168,7 +168,7 @@ def test_the_margin_is_on_the_other_poles_of_a_known_integrator():
     [
         # The paper's searches keep eq. (3)'s penalty as printed: no margin.
         (dict(method="sda", max_time_constant=5.0), ["`max_time_constant`", "'sda'"]),
-        (dict(method="ebsda", max_time_constant=None), ["`max_time_constant`", "'ebsda'"]),
+        (dict(method="ebsda", max_time_constant=None), ["max_time_constant", "ebsda"]),
         (dict(method="ls", max_time_constant=2.0), ["`max_time_constant`", "'ls'"]),
         (dict(method="oe", max_time_constant=0.0), ["seconds > 0"]),
         (dict(method="oe", max_time_constant=0.005), ["at least the sample time"]),
