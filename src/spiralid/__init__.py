@@ -32,6 +32,8 @@ _NAMES = {
     "choose": "sysid",
     "choose_order": "sysid",
     "validate": "sysid",
+    "SharedDenominatorModel": "sysid",
+    "validate_outputs": "sysid",
 }
 __all__ = ["__version__", *_SUBPACKAGES, *_NAMES]
 

@@ -29,6 +29,8 @@ from .models.polynomials import max_pole_radius as max_pole_radius
 from .models.polynomials import random_stable_polynomial as random_stable_polynomial
 from .models.polynomials import step_down as step_down
 from .models.polynomials import step_up as step_up
+from .models.shared import SharedDenominatorModel as SharedDenominatorModel
+from .models.shared import SharedModes as SharedModes
 
 # --- validation (validate, plots) ---
 # isort: split
@@ -39,6 +41,9 @@ from .validation.correlation import CorrelationTest as CorrelationTest
 from .validation.correlation import independence_test as independence_test
 from .validation.correlation import whiteness_test as whiteness_test
 from .validation.higher_order import billings_voon as billings_voon
+from .validation.outputs import OutputsValidation as OutputsValidation
+from .validation.outputs import joint_fit as joint_fit
+from .validation.outputs import validate_outputs as validate_outputs
 from .validation.selection import choose as choose
 from .validation.selection import choose_order as choose_order
 from .validation.selection import fits_by_order as fits_by_order
@@ -61,11 +66,14 @@ __all__ = [
     "ModalParametrization",
     "ModeTable",
     "NARXModel",
+    "OutputsValidation",
     "PaperCost",
     "ParetoIdentification",
     "PolynomialNARX",
     "ProjectedCost",
     "Realization",
+    "SharedDenominatorModel",
+    "SharedModes",
     "Validation",
     "arx_least_squares",
     "billings_voon",
@@ -81,6 +89,7 @@ __all__ = [
     "identify_pareto",
     "independence_test",
     "is_stable_polynomial",
+    "joint_fit",
     "knee_point",
     "max_pole_radius",
     "modes_from_poles",
@@ -92,6 +101,7 @@ __all__ = [
     "step_down",
     "step_up",
     "validate",
+    "validate_outputs",
     "whiteness_test",
 ]
 
