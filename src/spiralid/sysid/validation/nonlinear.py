@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .correlation import check_lags
+from .fit import _bounded_run, _format_fit, _gain, _signals_of, fit_percent, rmse
 from .higher_order import BillingsVoon, billings_voon
-from .validate import _bounded_run, _format_fit, _gain, _signals_of, fit_percent, rmse
 
 __all__ = ["NARXValidation", "validate_narx"]
 
