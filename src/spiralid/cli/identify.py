@@ -230,6 +230,46 @@ def write_arx_model(staged, model, v_est, v_val, headline: str) -> str:
     return summary
 
 
+def _run_shared(args, progress, arx, est, val, options) -> int:
+    """`spiralid identify --output a,b,...`: one denominator for every
+    output (identify on a record of several outputs), validated output by
+    output with a joint fit."""
+    from spiralid.sysid import identify, validate_outputs
+
+    with _open_folder(args.out, args.force) as folder:
+        progress.phase("estimation", f"estimating {arx} for {est.n_outputs} outputs")
+        model = identify(est, arx, method=args.method, **options)
+        progress.phase("validation", "validating every output on both parts")
+        v_est = validate_outputs(model, est, label=f"{args.method} (estimation)")
+        v_val = validate_outputs(
+            model, val, warmup=est, label=f"{args.method} (validation)"
+        )
+        progress.phase("writing", "writing files")
+        staged = folder.path
+        (staged / "model.json").write_text(json.dumps(model.to_dict(), indent=2))
+        (staged / "validation.json").write_text(
+            json.dumps(
+                {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
+            )
+        )
+        summary = "\n\n".join(
+            [
+                f"{arx} with one denominator for {', '.join(model.output_names)} "
+                f"on {args.data}",
+                f"joint cost (weighted, % RMS): {model.cost:.6g}",
+                v_est.summary(modes=False),
+                v_val.summary(),
+            ]
+        )
+        (staged / "summary.txt").write_text(summary + "\n")
+        _write_timings(staged, progress)
+        written = folder.commit(last="model.json")
+    if not args.quiet:
+        print(summary)
+        print(f"\nwrote {_listing(written, args.out)}")
+    return 0
+
+
 def _write_timings(staged, progress, model=None) -> None:
     """timings.json: the seconds of each phase of the command (load,
     estimation or search, validation, writing), the estimator's own parts
@@ -357,6 +397,8 @@ def run(args, argv: list[str]) -> int:
         arx, est, val = _load_parts(args, progress, _structure)
         # The budget rule is identify()'s (estimators.search_options).
         options = _identify_options(args, arx)
+        if est.n_outputs > 1:
+            return _run_shared(args, progress, arx, est, val, options)
         with _open_folder(args.out, args.force) as folder:
             steps = _search_steps(args)
             progress.phase("estimation", f"estimating {arx} by {args.method}", **steps)

@@ -48,6 +48,13 @@ def _column(value: str) -> str | int:
     return int(value) if value.isdigit() else value
 
 
+def _columns(value: str) -> str | int | list:
+    """--output: one column, or several separated by commas (a record of
+    several outputs)."""
+    parts = [v.strip() for v in value.split(",")]
+    return _column(parts[0]) if len(parts) == 1 else [_column(v) for v in parts]
+
+
 def _number(kind: type, allowed: str, ok):
     """An argparse type: `kind` parsed from text, accepted when `ok` holds."""
 
@@ -111,10 +118,11 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--output",
-        type=_column,
+        type=_columns,
         default=None,
         help="output column or variable; default 'y', or "
-        "'end_acceleration_m_s2' in files written by `spiralid simulate`",
+        "'end_acceleration_m_s2' in files written by `spiralid simulate`; "
+        "several separated by commas (a,b,c) for one model of every output",
     )
     p.add_argument(
         "--ts",
@@ -156,6 +164,10 @@ def _load_data(args, default_ts: float | None = None):
         for k, v in (("input_unit", args.input_unit), ("output_unit", args.output_unit))
         if v is not None
     }
+    if "output_unit" in units and data.n_outputs > 1:
+        # One unit for every output, or one each separated by commas.
+        given = units["output_unit"].split(",")
+        units["output_unit"] = given[0] if len(given) == 1 else tuple(given)
     return replace(data, **units) if units else data
 
 

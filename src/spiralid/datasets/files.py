@@ -26,7 +26,7 @@ SIMULATE_UNITS = {
 def read_record(
     source: str | Path,
     input: str | int | None = None,
-    output: str | int | None = None,
+    output: str | int | list | None = None,
     ts: float | None = None,
     default_ts: float | None = None,
 ) -> IOData:
@@ -38,7 +38,8 @@ def read_record(
         A name of :data:`spiralid.datasets.NAMES`, or a file ending in
         ``.csv``, ``.npz`` or ``.mat``.
     input, output : str or int, optional
-        Column (CSV: name or 0-based index) or variable (NPZ, MAT) names.
+        Column (CSV: name or 0-based index) or variable (NPZ, MAT) names;
+        `output` may be a list of them (a record of several outputs).
         Default ``u`` and ``y``, or for a CSV written by ``spiralid
         simulate`` its torque and end-point acceleration (with their units).
     ts : float, optional
@@ -74,7 +75,8 @@ def read_record(
     if suffix in (".npz", ".mat"):
         input = "u" if input is None else input
         output = "y" if output is None else output
-        if isinstance(input, int) or isinstance(output, int):
+        outputs = output if isinstance(output, list | tuple) else [output]
+        if isinstance(input, int) or any(isinstance(o, int) for o in outputs):
             raise ValueError(
                 f"`input` and `output` must be variable names for {suffix} files"
             )
@@ -97,6 +99,11 @@ def _read_csv(file: Path, input, output, ts, default_ts) -> IOData:
         data = replace(
             data,
             input_unit=SIMULATE_UNITS.get(data.input_name, data.input_unit),
-            output_unit=SIMULATE_UNITS.get(data.output_name, data.output_unit),
+            output_unit=tuple(
+                SIMULATE_UNITS.get(name, unit)
+                for name, unit in zip(data.output_names, data.output_units, strict=True)
+            )
+            if data.n_outputs > 1
+            else SIMULATE_UNITS.get(data.output_name, data.output_unit),
         )
     return data

@@ -624,6 +624,9 @@ def _identify_shared(data: IOData, arx: ARX, method, given: dict):
             "a record of several outputs is fitted to its simulation error from "
             f"rest; got predictor={given['predictor']!r}, initial={given['initial']!r}"
         )
+    if given["integrator"] is not True and given["integrator"] in (0, False):
+        # No integrator, however spelt (the command passes a count).
+        given = {k: v for k, v in given.items() if k != "integrator"}
     refuse_options(
         given,
         SHARED_OPTIONS + SHARED_OWN,

@@ -65,8 +65,9 @@ class OutputsValidation:
     modes: SharedModes
     label: str = ""
 
-    def summary(self) -> str:
-        """A plain-text table: each output's fit, the joint fit, the modes."""
+    def summary(self, modes: bool = True) -> str:
+        """A plain-text table: each output's fit, the joint fit and (unless
+        `modes` is False) the modes."""
         title = f"Validation of {self.label}" if self.label else "Validation"
         width = max(len(n) for n in self.outputs)
         lines = [title, "-" * max(len(title), 40)]
@@ -74,7 +75,12 @@ class OutputsValidation:
             flag = " (diverged)" if v.diverged else ""
             lines.append(f"fit % of {name:<{width}}  {v.fit_percent:8.2f}{flag}")
         lines.append(f"joint fit %{' ' * (width - 2)}  {self.joint_fit_percent:8.2f}")
-        lines += ["", "Shared modes (share of each output's peaks)", str(self.modes)]
+        if modes:
+            lines += [
+                "",
+                "Shared modes (share of each output's peaks)",
+                str(self.modes),
+            ]
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
