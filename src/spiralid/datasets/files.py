@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
+from spiralid.datasets.shipped import NAMES, load
 from spiralid.sysid.data import IOData, _csv_table
 
 __all__ = ["read_record"]
@@ -52,20 +53,18 @@ def read_record(
     -------
     IOData
     """
-    from spiralid import datasets
-
     file = Path(source)
-    if not file.exists() and str(source) in datasets.NAMES:
+    if not file.exists() and str(source) in NAMES:
         if (input, output) != (None, None):
             raise ValueError(
                 f"`input` and `output` do not apply to the shipped data set "
                 f"{str(source)!r}"
             )
-        return datasets.load(str(source), ts)
+        return load(str(source), ts)
     if not file.exists():
         raise ValueError(
             f"data file {str(source)!r} does not exist (shipped data sets: "
-            f"{', '.join(datasets.NAMES)})"
+            f"{', '.join(NAMES)})"
         )
     if not file.is_file():
         raise ValueError(f"data file {str(source)!r} is not a file")

@@ -12,6 +12,10 @@ in modules named for what they hold, each depending only on those above it:
   ``METHODS``, the result type ``EstimatorResult``, the budget rule and the
   safe start.
 - :mod:`~spiralid.sysid.models.identified`: :class:`IdentifiedModel`.
+- :mod:`~spiralid.sysid.estimation.options`: the one option contract
+  (which options each method and structure takes).
+- :mod:`~spiralid.sysid.estimation.narx`: NARX training, given this
+  module's default ARX as its linear start.
 
 Initial condition of the simulation (``initial``)
 -------------------------------------------------
@@ -47,17 +51,25 @@ from dataclasses import replace
 
 import numpy as np
 
-from spiralid._checks import box_bounds, generator, is_default, refuse_options
+from spiralid._checks import box_bounds, generator, refuse_options
 
 from ..data import IOData, single_output_record
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from ..models.narx import NARX, PolynomialNARX
 from ..models.polynomials import integrator_count, with_integrator
+from . import narx as _narx
 from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
-from .estimators import DEFAULT_METHOD, METHODS, Problem, method_options
+from .estimators import DEFAULT_METHOD, METHODS, Problem
 from .margin import AUTO, max_radius
+from .options import (
+    IDENTIFY_DEFAULTS,
+    _check_method,
+    check_method_options,
+    identify_options,
+    refused_options,
+)
 from .outputerror import steiglitz_mcbride
 from .parametrizations import (
     DEFAULT_PARAMETRIZATION,
@@ -83,131 +95,6 @@ __all__ = [
 
 def _check_bounds(bounds, p: int) -> np.ndarray:
     return np.column_stack(box_bounds(bounds, p))
-
-
-# identify's arguments by name with their defaults; an argument equal to
-# its default is never refused, whatever the method or structure.
-IDENTIFY_DEFAULTS = dict(
-    predictor="simulation",
-    initial="rest",
-    rng=None,
-    gain="auto",
-    penalty=1e6,
-    integrator=False,
-    max_time_constant=AUTO,
-    cancel=None,
-    parametrization=None,
-    bounds=None,
-    refine=False,
-    safe_start=None,
-    # A NARX's early stopping and weight decay (identify_narx's).
-    holdout=0.2,
-    decay=1e-3,
-)
-# Names identify's methods no longer take, and what to use instead.
-_RENAMED = {
-    "restart_after": (
-        "`restart_after` of method 'spiral' is now `restarts`: "
-        "restarts=Restarts(stall=k, growth=1) (False for none)"
-    ),
-    "polish_iterations": (
-        "`polish_iterations` of the NARX method 'spiral' is now `polish_nfev`"
-    ),
-}
-
-
-def identify_options(method: str, structure, refine: bool = False) -> tuple[str, ...]:
-    """Every option :func:`identify` takes for `method` and `structure`,
-    its own arguments and ``**options`` alike; the one table `identify`,
-    the command line and the tests check against.
-
-    ``rng`` for every method and structure: one call can then loop over
-    methods, and a deterministic method (``"ls"``, ``"oe"``, forward
-    regression) has nothing to seed (a documented acceptance, not an
-    option ignored by mistake).
-    For an ARX structure: ``predictor``, ``initial``, ``gain``,
-    ``penalty`` and ``integrator`` always;
-    ``max_time_constant`` for the methods with ``Method.margin`` and a
-    search with ``refine=True``; ``cancel`` for those with
-    ``Method.cancel``; then
-    :func:`~spiralid.sysid.estimation.estimators.method_options`.
-    For a NARX: ``predictor``, ``initial``, ``holdout``, ``decay`` and the
-    method's NARX estimator's options; a PolynomialNARX (forward
-    regression) takes ``predictor`` and ``initial`` only.
-
-    Examples
-    --------
-    >>> identify_options("ls", ARX(2, 2, 1))
-    ('rng', 'predictor', 'initial', 'gain', 'penalty', 'integrator')
-    >>> identify_options("oe", NARX(2, 2, 1))
-    ('rng', 'predictor', 'initial', 'holdout', 'decay', 'max_rounds', 'patience')
-    """
-    if isinstance(structure, PolynomialNARX):
-        return ("rng", "predictor", "initial")
-    if isinstance(structure, NARX):
-        own = ("rng", "predictor", "initial", "holdout", "decay")
-        return (*own, *method_options(method, narx=True))
-    spec = METHODS[method]
-    out = ["rng", "predictor", "initial", "gain", "penalty", "integrator"]
-    if spec.margin or (spec.search and _is_true(refine)):
-        out.append("max_time_constant")
-    if spec.cancel:
-        out.append("cancel")
-    return (*out, *method_options(method))
-
-
-def _is_true(value) -> bool:
-    return isinstance(value, bool | np.bool_) and bool(value)
-
-
-def _check_method(method) -> str:
-    """`method` as a key of METHODS (any case), or a one-line ValueError."""
-    if isinstance(method, str):
-        # As minimize and scipy.optimize.minimize: names in any case.
-        method = method.lower()
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
-    return method
-
-
-def refused_options(method: str, options: dict, structure=None) -> list[str]:
-    """The names in `options` that :func:`check_method_options` refuses
-    for `method` and `structure` (default an ARX), in their order."""
-    structure = ARX(1, 1, 0) if structure is None else structure
-    applicable = identify_options(method, structure, options.get("refine", False))
-    defaults = IDENTIFY_DEFAULTS
-    return [
-        name
-        for name, value in options.items()
-        if name not in applicable
-        and not (name in defaults and is_default(value, defaults[name]))
-    ]
-
-
-def check_method_options(method: str, options: dict, structure=None) -> None:
-    """The one check of the options given to `method` for `structure`
-    (default an ARX) against :func:`identify_options`, for `identify`, the
-    command line and study files alike: a one-line ValueError naming the
-    first option that does not apply, the method and the options that do,
-    before any work. An option equal to :data:`IDENTIFY_DEFAULTS`' value is
-    never refused."""
-    method = _check_method(method)
-    structure = ARX(1, 1, 0) if structure is None else structure
-    for name in options:
-        if name in _RENAMED:
-            raise ValueError(_RENAMED[name])
-    kind = ""
-    if isinstance(structure, NARX | PolynomialNARX):
-        if METHODS[method].narx is None:
-            able = tuple(name for name, m in METHODS.items() if m.narx is not None)
-            raise ValueError(
-                f"`method` {method!r} does not train NARX models; use one of {able}"
-            )
-        kind = f" for a {type(structure).__name__}"
-    applicable = identify_options(method, structure, options.get("refine", False))
-    refuse_options(
-        options, applicable, f"method {method!r}{kind}", defaults=IDENTIFY_DEFAULTS
-    )
 
 
 def identify(
@@ -434,12 +321,15 @@ def identify(
     )
     check_method_options(method, given, arx)
     if not isinstance(arx, ARX):
-        from .narx import identify_narx
-
         takes = identify_options(method, arx)
         narx = {k: v for k, v in given.items() if k in takes}
-        return identify_narx(
-            data, arx, method=method, estimate=METHODS[method].narx, **narx
+        return _narx.identify_narx(
+            data,
+            arx,
+            method=method,
+            estimate=METHODS[method].narx,
+            linear_estimator=_default_arx,
+            **narx,
         )
     count = integrator_count(integrator, arx.na)
     if count:
@@ -447,6 +337,12 @@ def identify(
         return _identify_integrating(data, arx, count, dict(method=method, **given))
     problem, options = _problem(method, data, arx, given)
     return _estimate(method, problem, options, t_start)
+
+
+def _default_arx(data: IOData, arx: ARX, integrator: int, rng) -> np.ndarray:
+    """The default method's ARX theta, a NARX's linear start: handed to
+    the NARX estimator so that it does not import this module back."""
+    return identify(data, arx, integrator=integrator, rng=rng).theta
 
 
 def _problem(method: str, data: IOData, arx: ARX, given: dict):

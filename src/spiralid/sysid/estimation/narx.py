@@ -56,240 +56,17 @@ import numpy as np
 from scipy import optimize
 
 from spiralid._checks import generator, integer
+from spiralid.choices import DEFAULT_METHOD
 from spiralid.optim import MINIMIZE_OPTIONS, SpiralSearch, minimize
 from spiralid.optim.result import OptimiserResult
 
 from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
-from ..models.narx import NARX, NARXModel, PolynomialNARX, Scaling
+from ..models.narx import NARX, NARXModel, PolynomialNARX
+from .frols import frols
+from .narx_problem import NARXProblem, narx_result
 
 __all__ = ["NARXProblem", "identify_narx"]
-
-_ROUND = 10  # LM iterations per early-stopping round
-
-
-class NARXProblem:
-    """A NARX estimation: record, structure, scaling, split and costs.
-
-    Parameters
-    ----------
-    data : IOData
-        Estimation record.
-    structure : NARX or PolynomialNARX
-    predictor : {"simulation", "one-step"}
-    initial : {"rest", "measured"}
-    holdout : float
-        Share of the record held back for early stopping, in [0, 0.5).
-    rng : numpy.random.Generator
-    """
-
-    def __init__(self, data, structure, predictor, initial, holdout, rng):
-        self.data = data
-        self.structure = structure
-        self.predictor = predictor
-        self.initial = initial
-        self.rng = rng
-        self.scaling = Scaling.from_data(data, structure.integrator)
-        s = self.scaling
-        self.ulag = structure.input_lags(data.u, s)
-        self.t0, self.hist, self.ystart = structure._history(data.y, s, initial)
-        self.phi, self.target = structure.regressors(data.u, data.y, s)
-        n = data.n
-        self.split = n - round(holdout * n) if holdout > 0 else n
-        lo = max(self.t0, structure.max_lag if predictor == "one-step" else 0)
-        self.train = slice(lo, self.split)
-        self.hold = slice(self.split, n) if self.split < n else None
-        y = data.y
-        self.rms_train = float(np.sqrt(np.mean(y[self.train] ** 2))) or 1.0
-        self.rms_hold = (
-            float(np.sqrt(np.mean(y[self.hold] ** 2))) or 1.0 if self.hold else 1.0
-        )
-        self.rms_all = float(np.sqrt(np.mean(y[lo:] ** 2))) or 1.0
-        self.lo = lo
-        self.nfev = 0
-
-    # -- outputs ---------------------------------------------------------------
-    def output(self, params) -> np.ndarray:
-        """The predictor's output over the whole record, rows for a batch."""
-        st, s = self.structure, self.scaling
-        if self.predictor == "one-step":
-            z = st.evaluate(params, self.phi)
-            if st.integrator:
-                prev = np.r_[0.0, self.data.y[:-1]]
-                return prev + z * s.y_scale
-            return s.y_shift + s.y_scale * z
-        z = st.free_run_scaled(params, self.ulag[self.t0 :], self.hist)
-        y = st._unscale(z, s, self.ystart)
-        if self.t0:
-            head = np.broadcast_to(self.data.y[: self.t0], (*y.shape[:-1], self.t0))
-            y = np.concatenate([head, y], axis=-1)
-        return y
-
-    def costs(self, params) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Training, held-back and whole-record costs (percent RMS), one per
-        row of `params`."""
-        with np.errstate(over="ignore", invalid="ignore"):
-            e = self.data.y - self.output(np.atleast_2d(params))
-            tr = 100.0 * np.sqrt(np.mean(e[..., self.train] ** 2, axis=-1))
-            tr /= self.rms_train
-            if self.hold is not None:
-                ho = 100.0 * np.sqrt(np.mean(e[..., self.hold] ** 2, axis=-1))
-                ho /= self.rms_hold
-            else:
-                ho = tr
-            al = 100.0 * np.sqrt(np.mean(e[..., self.lo :] ** 2, axis=-1))
-            al /= self.rms_all
-        bad = ~np.isfinite(tr)
-        for arr in (tr, ho, al):
-            arr[bad] = np.inf
-        return tr, ho, al
-
-    def objective(self, P: np.ndarray) -> np.ndarray:
-        """The searches' vectorised objective: training cost of each row."""
-        self.nfev += np.atleast_2d(P).shape[0]
-        return self.costs(np.atleast_2d(P))[0]
-
-    # -- Levenberg-Marquardt ----------------------------------------------------
-    def residual_and_jacobian(self, predictor: str):
-        """Scaled training residual and its exact Jacobian (callables), with
-        the weight decay's rows ``sqrt(decay M) w`` on the network's weights
-        (not the bypass) appended when `decay` > 0."""
-        fun, jac = self._residual_and_jacobian(predictor)
-        decay = getattr(self, "decay", 0.0)
-        st = self.structure
-        if decay <= 0.0 or not isinstance(st, NARX) or st.h == 0:
-            return fun, jac
-        net = np.arange(st.h * (st.n_regressors + 2))
-        m = self.train.stop - self.train.start
-        w = math.sqrt(decay * m)
-
-        def fun_decay(p):
-            return np.r_[fun(p), w * p[net]]
-
-        def jac_decay(p):
-            extra = np.zeros((net.size, p.size))
-            extra[np.arange(net.size), net] = w
-            return np.vstack([jac(p), extra])
-
-        return fun_decay, jac_decay
-
-    def _residual_and_jacobian(self, predictor: str):
-        st, s = self.structure, self.scaling
-        tr = self.train
-        scale = s.y_scale
-
-        if predictor == "one-step":
-            phi, target = self.phi[tr], self.target[tr]
-
-            def fun(p):
-                self.nfev += 1
-                return target - st.evaluate(p, phi)
-
-            def jac(p):
-                self.nfev += 1
-                return -st.jacobian(p, phi)
-
-            return fun, jac
-
-        cache = {}
-
-        def run(p):
-            key = p.tobytes()
-            if key not in cache:
-                cache.clear()
-                z, sens = st.free_run_jacobian(p, self.ulag[self.t0 :], self.hist)
-                if st.integrator:
-                    with np.errstate(all="ignore"):
-                        z, sens = np.cumsum(z), np.cumsum(sens, axis=0)
-                    z = z + self.ystart / scale
-                    full = np.r_[self.data.y[: self.t0] / scale, z]
-                else:
-                    full = np.r_[(self.data.y[: self.t0] - s.y_shift) / scale, z]
-                fsens = np.vstack([np.zeros((self.t0, p.size)), sens])
-                cache[key] = (full, fsens)
-            return cache[key]
-
-        ref = (
-            self.data.y / scale if st.integrator else (self.data.y - s.y_shift) / scale
-        )
-
-        def fun(p):
-            self.nfev += 1
-            full, _ = run(p)
-            r = ref[tr] - full[tr]
-            return np.where(np.isfinite(r), r, 1e10)
-
-        def jac(p):
-            _, fsens = run(p)
-            return -np.nan_to_num(fsens[tr], nan=0.0, posinf=0.0, neginf=0.0)
-
-        return fun, jac
-
-    def whole(self) -> NARXProblem:
-        """The same problem with nothing held back: training covers the
-        whole record (the refit after early stopping)."""
-        other = NARXProblem.__new__(NARXProblem)
-        other.__dict__.update(self.__dict__)
-        n = self.data.n
-        other.split, other.hold = n, None
-        other.train = slice(self.train.start, n)
-        other.rms_train = self.rms_all
-        other.nfev = 0
-        return other
-
-    def polish(
-        self, p0, predictor: str, max_rounds: int = 50, patience: int = 3
-    ) -> tuple[np.ndarray, int]:
-        """Levenberg-Marquardt in rounds with early stopping on the held-back
-        cost; returns the parameters with the lowest held-back cost (the
-        training cost when nothing is held back) and the round that reached
-        them (0: the start).
-
-        Parameters
-        ----------
-        p0 : ndarray
-            Start.
-        predictor : {"simulation", "one-step"}
-            The error minimised.
-        max_rounds : int
-            Rounds of 10 evaluations at most.
-        patience : int
-            Rounds without a lower held-back cost before stopping.
-        """
-        fun, jac = self.residual_and_jacobian(predictor)
-        p = np.asarray(p0, dtype=float).copy()
-        pick = 1 if self.hold is not None else 0
-        best_p, best = p.copy(), self._score(p, predictor, pick)
-        waited = best_round = 0
-        m = fun(p).size
-        if m <= p.size:
-            return best_p, 0
-        for rounds in range(1, max_rounds + 1):
-            try:
-                with np.errstate(all="ignore"):
-                    res = optimize.least_squares(
-                        fun, p, jac=jac, method="lm", max_nfev=_ROUND
-                    )
-            except (ValueError, np.linalg.LinAlgError):
-                break
-            moved = not np.array_equal(res.x, p)
-            p = res.x
-            score = self._score(p, predictor, pick)
-            if score < best * (1.0 - 1e-9):
-                best_p, best, waited, best_round = p.copy(), score, 0, rounds
-            else:
-                waited += 1
-            if waited >= patience or not moved or res.status > 0:
-                break
-        return best_p, best_round
-
-    def _score(self, p, predictor: str, pick: int) -> float:
-        if predictor == self.predictor:
-            return float(self.costs(p)[pick][0])
-        other = NARXProblem.__new__(NARXProblem)
-        other.__dict__.update(self.__dict__)
-        other.predictor = predictor
-        return float(other.costs(p)[pick][0])
 
 
 def _linear_start(problem: NARXProblem, method: str = "default"):
@@ -298,9 +75,10 @@ def _linear_start(problem: NARXProblem, method: str = "default"):
 
     ``"default"``: for a free run from rest, the default method's ARX
     (``identify(data, ARX(ny + 1, nu, nk), integrator=k)`` for ``k``
-    integrators, ``ARX(ny, nu, nk)`` without), so a NARX contains the
-    linear model a user would get; otherwise (a one-step predictor, a run
-    from measured samples, which ``"spiral"`` does not fit) and for
+    integrators, ``ARX(ny, nu, nk)`` without, through the problem's
+    ``linear_estimator``), so a NARX contains the linear model a user would
+    get; otherwise (a one-step predictor, a run from measured samples,
+    which ``"spiral"`` does not fit, or no ``linear_estimator``) and for
     ``"ls"``: least squares of the one-step error.
     """
     st = problem.structure
@@ -309,7 +87,8 @@ def _linear_start(problem: NARXProblem, method: str = "default"):
     data = problem.data
     k = st.integrator
     free_run = problem.predictor == "simulation" and problem.initial == "rest"
-    if method == "ls" or not free_run:
+    estimator = getattr(problem, "linear_estimator", None)
+    if method == "ls" or not free_run or estimator is None:
         arx = ARX(st.ny, st.nu, st.nk)
         if k:
             # One step ahead, the increment's error is the output's.
@@ -318,10 +97,8 @@ def _linear_start(problem: NARXProblem, method: str = "default"):
         a, b = theta[: st.ny], theta[st.ny :]
         what = f"ARX({st.ny}, {st.nu}, {st.nk}) of the increments" if k else str(arx)
         return st.from_arx(a, b, problem.scaling), f"{what} by least squares"
-    from .identify import DEFAULT_METHOD, identify
-
     arx = ARX(st.ny + (1 if k else 0), st.nu, st.nk)
-    theta = identify(data, arx, integrator=k, rng=problem.rng).theta
+    theta = estimator(data, arx, k, problem.rng)
     a = theta[: arx.na]
     if k:
         # A = C (1 - z^-1): the increments' denominator C is A's running sum
@@ -390,7 +167,7 @@ def _train(problem, starts: dict, linear, predictor: str, options: dict, t0, **e
     p, kept = _contain(problem, p, linear, predictor)
     if kept:
         name, rounds = "linear", 0
-    return _result(
+    return narx_result(
         problem,
         p,
         t0,
@@ -402,96 +179,7 @@ def _train(problem, starts: dict, linear, predictor: str, options: dict, t0, **e
     )
 
 
-def _result(problem, p, t0, **extra) -> OptimiserResult:
-    tr, ho, al = problem.costs(np.atleast_2d(p))
-    out = OptimiserResult(
-        x=np.asarray(p, dtype=float),
-        fun=float(al[0]),
-        train_cost=float(tr[0]),
-        holdout_cost=float(ho[0]),
-        nfev=int(problem.nfev),
-        elapsed=time.perf_counter() - t0,
-        success=True,
-        status=0,
-    )
-    out.update(extra)
-    linear = out.get("linear_params")
-    if linear is not None:
-        out["linear_cost"] = float(problem.whole().costs(np.atleast_2d(linear))[2][0])
-    out.setdefault("nit", 0)
-    out.setdefault("message", "")
-    out.setdefault("n_restarts", 0)
-    out.setdefault("history", None)
-    return out
-
-
 # -- the estimators -------------------------------------------------------------
-
-
-def frols(problem: NARXProblem) -> OptimiserResult:
-    """Forward-regression orthogonal least squares of a polynomial NARX.
-
-    Parameters
-    ----------
-    problem : NARXProblem
-        With a :class:`PolynomialNARX` structure; the fitted structure (its
-        chosen terms) replaces it.
-
-    Returns
-    -------
-    OptimiserResult
-        ``x`` the coefficients, ``err`` the chosen terms' error reduction
-        ratios in order.
-    """
-    t0 = time.perf_counter()
-    st = problem.structure
-    cands = st.candidates()
-    # Every sample: forward regression stops by its own rule, no early
-    # stopping needs a held-back part.
-    rows = slice(st.max_lag, problem.data.n)
-    P = st.term_matrix(problem.phi[rows], cands)
-    y = problem.target[rows]
-    yy = float(y @ y) or 1.0
-    Q = P.copy()
-    chosen: list[int] = []
-    errs: list[float] = []
-    cap = min(st.n_terms or len(cands), len(cands), y.size - 1)
-    while len(chosen) < cap:
-        norms = np.einsum("ij,ij->j", Q, Q)
-        g = (Q.T @ y) / np.where(norms > 0, norms, np.inf)
-        err = g**2 * norms / yy
-        err[chosen] = -1.0
-        # Columns already spanned by the chosen ones (norm ~ 0) carry nothing.
-        err[norms <= 1e-12 * np.einsum("ij,ij->j", P, P)] = -1.0
-        j = int(np.argmax(err))
-        if err[j] <= 0:
-            break
-        chosen.append(j)
-        errs.append(float(err[j]))
-        w = Q[:, j].copy()
-        Q -= np.outer(w, (w @ Q) / (w @ w))
-        if st.n_terms is None and 1.0 - sum(errs) < st.tolerance:
-            break
-    terms = tuple(cands[j] for j in chosen)
-    coef, *_ = np.linalg.lstsq(P[:, chosen], y, rcond=None)
-    fitted = PolynomialNARX(
-        st.ny,
-        st.nu,
-        st.nk,
-        degree=st.degree,
-        n_terms=len(terms),
-        tolerance=st.tolerance,
-        integrator=st.integrator,
-        terms=terms,
-    )
-    problem.structure = fitted
-    return _result(
-        problem,
-        coef,
-        t0,
-        err=np.asarray(errs),
-        message="Forward-regression orthogonal least squares (ERR order).",
-    )
 
 
 def estimate_ls(
@@ -632,7 +320,7 @@ def estimate_search(problem: NARXProblem, *, rule: str, **options) -> OptimiserR
         vectorized=True,
         **opts,
     )
-    return _result(
+    return narx_result(
         problem,
         raw.x,
         t0,
@@ -759,6 +447,7 @@ def identify_narx(
     rng=None,
     holdout: float = 0.2,
     decay: float = 1e-3,
+    linear_estimator=None,
     **options,
 ) -> NARXModel:
     """Estimate a NARX model with the estimator `estimate` (the method's
@@ -790,6 +479,12 @@ def identify_narx(
         seeds 0-4 of ``benchmarks/nonparametric.py``'s nonlinear
         acceleration record (median validation fit 58.7 % without, 62.2 %
         with; 1e-4 gave 61.1 %, 1e-2 62.2 %).
+    linear_estimator : callable or None
+        ``linear_estimator(data, arx, integrator, rng) -> theta``: the
+        default method's ARX, the linear start of a free run from rest.
+        :func:`~spiralid.sysid.identify` passes its own, so this module
+        imports neither it nor the estimators' table (no import circle,
+        tests/test_layout.py). None: the least-squares ARX.
     **options
         The estimator's own options (a search's ``max_nfev``...).
 
@@ -821,6 +516,7 @@ def identify_narx(
         data, structure, predictor, initial, float(holdout), generator(rng)
     )
     problem.decay = float(decay)
+    problem.linear_estimator = linear_estimator
     res = estimate(problem, **options)
     history = res.get("history")
     return NARXModel(
