@@ -107,7 +107,7 @@ def test_ebsda_approaches_the_zdt1_front():
     "fun, match",
     [
         (lambda x: np.full((x.shape[0], 2), np.nan), "non-finite objective"),
-        (lambda x: np.zeros((x.shape[0] - 1, 2)), r"must return \(10, k\)"),
+        (lambda x: np.zeros((x.shape[0] - 1, 2)), r"must return \(1, k\)"),
         (lambda x: np.zeros((x.shape[0], 4)), "2 or 3 objectives"),
     ],
 )
@@ -123,13 +123,14 @@ def test_step_rate_rules_are_refused():
 
 
 def _later(bad):
-    """An objective that turns bad after the first population."""
+    """An objective that turns bad after the first population (two calls:
+    its first point, then the rest)."""
     calls = []
 
     def fun(x):
         calls.append(1)
         f = np.column_stack([x[:, 0], 1 - x[:, 0]])
-        return bad(f) if len(calls) > 1 else f
+        return bad(f) if len(calls) > 2 else f
 
     return fun
 
@@ -166,7 +167,8 @@ def test_seed_points_take_the_first_places_of_the_population():
     seeds = [[0.25, 0.5], [2.0, 0.5]]  # the second is clipped into the box
     minimize_pareto(fun, [(0, 1)] * 2, n_points=10, max_nfev=40, rng=0,
                     vectorized=True, x0=seeds)  # fmt: skip
-    np.testing.assert_array_equal(seen[0][:2], [[0.25, 0.5], [1.0, 0.5]])
+    first = np.vstack(seen[:2])  # the first point, then the rest
+    np.testing.assert_array_equal(first[:2], [[0.25, 0.5], [1.0, 0.5]])
     with pytest.raises(ValueError, match="`x0`"):
         minimize_pareto(fun, [(0, 1)] * 2, n_points=10, max_nfev=40,
                         vectorized=True, x0=[[0.1, 0.2, 0.3]])  # fmt: skip
@@ -316,6 +318,16 @@ def test_arguments_and_the_objective_count_are_checked_before_spending():
     with pytest.raises(ValueError, match="2 or 3 objectives; got 4"):
         minimize_pareto(four, [(0, 1)] * 2, n_points=10, max_nfev=40, rng=0)
     assert len(calls) == 1  # one point, not the whole population
+    batches = []
+
+    def four_batched(x):
+        batches.append(x.shape[0])
+        return np.zeros((x.shape[0], 4))
+
+    with pytest.raises(ValueError, match="2 or 3 objectives; got 4"):
+        minimize_pareto(four_batched, [(0, 1)] * 2, n_points=100, max_nfev=400,
+                        rng=0, vectorized=True)  # fmt: skip
+    assert batches == [1]  # a batch of one point, not of the population
     with pytest.raises(ValueError, match="finite vector of length 2; got"):
         minimize_pareto(_zdt1, [(0, 1)] * 2, n_points=10, vectorized=True,
                         options={"ref_point": [1, 1, 1]})  # fmt: skip
@@ -331,5 +343,5 @@ def test_nfev_counts_every_evaluation_with_three_objectives():
 
     res = minimize_pareto(three, [(0, 1)] * 3, n_points=100, max_nfev=400,
                           rng=0, vectorized=True)  # fmt: skip
-    assert seen[0] == 100 and res.weights.shape[0] == 91
+    assert seen[:2] == [1, 99] and res.weights.shape[0] == 91
     assert res.nfev == sum(seen) <= 400

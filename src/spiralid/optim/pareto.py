@@ -201,16 +201,14 @@ def _reference_point(ref: np.ndarray | None, f: np.ndarray) -> np.ndarray:
 
 def _first_population(fun, x: np.ndarray, vectorized: bool) -> np.ndarray:
     """The initial population's objective vectors, the objective count
-    checked as soon as it is known: after the first point when `fun` takes
-    one point at a time (no evaluation is spent on the rest), after the one
-    call when it takes a batch."""
-    first = x if vectorized else x[:1]
-    f = _evaluate(fun, first, vectorized, None)
+    checked after the first point: only `fun`'s answer tells the count, so
+    one evaluation is spent before the check and none on the rest of the
+    population. A vectorised `fun` gets a batch of that one point, then one
+    batch of the rest."""
+    f = _evaluate(fun, x[:1], vectorized, None)
     k = f.shape[1]
     if k not in (2, 3):
         raise ValueError(f"`fun` must return 2 or 3 objectives; got {k}")
-    if vectorized:
-        return f
     return np.vstack([f, _evaluate(fun, x[1:], vectorized, k)])
 
 
@@ -245,8 +243,8 @@ def minimize_pareto(
         (n,), or with ``vectorized=True`` ``fun(X) -> (m, k)`` for ``X`` of
         shape (m, n); ``k`` is 2 or 3. A non-finite value is an error.
         Every other argument is checked before `fun` is first called, and
-        ``k`` as soon as it returns: after one point, or after the first
-        batch when vectorised.
+        ``k`` after its first point (a batch of that one point when
+        vectorised), before the rest of the population is evaluated.
     bounds : sequence of (low, high), (n, 2) array or scipy.optimize.Bounds
         The search box; points are kept inside it.
     method : str, SpiralRule or LearnedMetricSpiral
