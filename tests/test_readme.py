@@ -91,6 +91,16 @@ def test_readme_own_data_commands_run_and_model_json_loads(
     assert "z^8" in capsys.readouterr().out  # the transfer function
 
 
+def test_readme_several_outputs_commands_give_the_rigs_modes(tmp_path):
+    run_commands(block(README, "outputs-commands"), tmp_path)
+    model = json.loads((tmp_path / "rig-modes" / "model.json").read_text())
+    assert model["output_names"] == ["hub_velocity_rad_s", "end_acceleration_m_s2"]
+    freq = [m["frequency_hz"] for m in model["modes"]["modes"]]
+    # The FEM's three modes (FlexibleManipulator().modes(3)) within 0.5 %.
+    for f in (13.3105, 35.1080, 64.8340):
+        assert min(abs(g - f) / f for g in freq) < 0.005
+
+
 def test_docs_methods_example_runs(monkeypatch, tmp_path, capsys):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MPLBACKEND", "Agg")
