@@ -29,7 +29,7 @@ from scipy import linalg
 
 from spiralid.optim.result import OptimiserResult
 
-__all__ = ["levenberg_marquardt"]
+__all__ = ["damped_descent", "levenberg_marquardt"]
 
 # Damping: first value, and the largest before a step is given up (the
 # scaled step is then ~1e-8 of a Gauss-Newton step: nothing lowers the cost).
@@ -47,6 +47,112 @@ STOPS = {
     5: "The cost fell by less than its stall tolerance over the stall window: "
     "the end of a flat valley.",
 }
+
+
+def damped_descent(
+    evaluate: Callable[[np.ndarray], tuple[float, object]],
+    linearise: Callable,
+    x0: np.ndarray,
+    *,
+    max_nfev: int,
+    project: Callable[[np.ndarray], np.ndarray | None] | None = None,
+    converged: Callable | None = None,
+    linearising_counts: bool = False,
+    grow: float = 10.0,
+    lam_max: float = _LAMBDA_MAX,
+) -> dict:
+    """The one Levenberg-Marquardt loop: Marquardt's damping schedule, the
+    projected trial point, acceptance and the stops every polish shares.
+
+    How a step is solved is the caller's: :func:`levenberg_marquardt` from
+    the residual's Jacobian (QR, columns scaled), the variable-projection
+    polish (:func:`~spiralid.sysid.estimation.varpro.gauss_newton_polish`)
+    from normal equations formed in compiled loops.
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(x) -> (cost, state)``: one evaluation; `state` (the
+        residual, say) is handed to `linearise` at an accepted point.
+    linearise : callable
+        ``linearise(x, cost, state) -> (cost_here, step, stationary)`` at
+        the current point: ``step(lam)`` the damped step (None when it
+        cannot be solved: the damping grows tenfold), `stationary` True at
+        a stationary point, and `cost_here` the cost at `x` when the
+        linearisation computes it (used when `x0` was not evaluated).
+    x0 : ndarray
+        Start, feasible.
+    max_nfev : int
+        Cap on evaluations.
+    project : callable, optional
+        ``project(x) -> x'`` into the feasible set, or None when it cannot.
+    converged : callable, optional
+        ``converged(x_before, x, cost_before, cost, nfev)`` after each
+        accepted step: a stop's name, or None to go on.
+    linearising_counts : bool
+        A linearisation counts as an evaluation, and `x0` is not evaluated
+        first (its cost comes from the first linearisation).
+    grow : float
+        The damping's factor after a rejected trial point.
+    lam_max : float
+        The largest damping before the step is given up.
+
+    Returns
+    -------
+    dict
+        ``x``, ``cost`` (None when nothing was evaluated), ``state``,
+        ``nfev``, ``njev`` (linearisations not counted as evaluations),
+        ``nit`` (accepted steps), ``lam`` and ``stop``: ``"cap"`` (the
+        evaluations ran out), ``"stationary"``, ``"no decrease"`` (no damped
+        step lowers the cost) or what `converged` returned.
+    """
+    project = project or (lambda x: x)
+    x = np.array(x0, dtype=float)
+    cost = state = None
+    nfev = njev = nit = 0
+    if not linearising_counts:
+        cost, state = evaluate(x)
+        nfev = 1
+    lam = _LAMBDA0
+    stop = "cap"
+    while nfev < max_nfev:
+        here, step, stationary = linearise(x, cost, state)
+        if linearising_counts:
+            nfev += 1
+        else:
+            njev += 1
+        cost = here if cost is None else cost
+        if stationary:
+            stop = "stationary"
+            break
+        stepped = False
+        while nfev < max_nfev and lam <= lam_max:
+            s = step(lam)
+            trial = None if s is None else project(x + s)
+            if trial is None:
+                lam *= 10.0
+                continue
+            cost_trial, state_trial = evaluate(trial)
+            nfev += 1
+            if cost_trial < cost:  # NaN compares False: rejected
+                before = (x, cost)
+                x, cost, state = trial, cost_trial, state_trial
+                lam = max(lam / 10.0, 1e-12)
+                nit += 1
+                stepped = True
+                break
+            lam *= grow
+        if not stepped:
+            stop = "no decrease" if lam > lam_max else "cap"
+            break
+        if converged is not None:
+            reason = converged(before[0], x, before[1], cost, nfev)
+            if reason is not None:
+                stop = reason
+                break
+    return dict(
+        x=x, cost=cost, state=state, nfev=nfev, njev=njev, nit=nit, lam=lam, stop=stop
+    )
 
 
 def levenberg_marquardt(
@@ -93,66 +199,57 @@ def levenberg_marquardt(
         (a key of :data:`STOPS`), ``status`` (1 when the cap ended it,
         otherwise 0), ``success`` and ``message``.
     """
-    project = project or (lambda x: x)
-    x = np.array(x0, dtype=float)
-    r = residual(x)
-    cost = float(r @ r)
-    nfev, njev, nit, lam = 1, 0, 0, _LAMBDA0
-    status = 0
-    checkpoint = (nfev, cost)
-    while nfev < max_nfev:
+
+    def evaluate(x):
+        r = residual(x)
+        return float(r @ r), r
+
+    def linearise(x, cost, r):
         jac = jacobian(x)
-        njev += 1
         scale = np.linalg.norm(jac, axis=0)
         scale[scale == 0.0] = 1.0
         q, upper = linalg.qr(jac / scale, mode="economic", check_finite=False)
         qtr = q.T @ r
         gradient = upper.T @ qtr
-        if cost == 0.0 or np.max(np.abs(gradient)) <= tol * np.sqrt(cost):
-            status = 1
-            break
-        stepped = False
-        while nfev < max_nfev and lam <= _LAMBDA_MAX:
-            trial = project(x + _damped_step(upper, qtr, lam) / scale)
-            if trial is None:
-                lam *= 10.0
-                continue
-            r_trial = residual(trial)
-            nfev += 1
-            cost_trial = float(r_trial @ r_trial)
-            if cost_trial < cost:  # NaN compares False: rejected
-                fall, moved = (cost - cost_trial) / cost, trial - x
-                x, r, cost = trial, r_trial, cost_trial
-                lam = max(lam / 10.0, 1e-12)
-                nit += 1
-                stepped = True
-                break
-            lam *= 10.0
-        if not stepped:
-            status = 4 if lam > _LAMBDA_MAX else 0
-            break
-        if fall <= tol:
-            status = 2
-            break
-        if np.linalg.norm(moved) <= tol * (np.linalg.norm(x) + tol):
-            status = 3
-            break
+        stationary = cost == 0.0 or np.max(np.abs(gradient)) <= tol * np.sqrt(cost)
+        return cost, (lambda lam: _damped_step(upper, qtr, lam) / scale), stationary
+
+    # The stall window's start: (evaluations, cost), first the start's.
+    checkpoint = [1, None]
+
+    def converged(before, x, cost_before, cost, nfev):
+        if checkpoint[1] is None:
+            checkpoint[1] = cost_before
+        if (cost_before - cost) / cost_before <= tol:
+            return 2
+        if np.linalg.norm(x - before) <= tol * (np.linalg.norm(x) + tol):
+            return 3
         if stall is not None and nfev - checkpoint[0] >= stall[0]:
             if checkpoint[1] - cost <= stall[1] * checkpoint[1]:
-                status = 5
-                break
-            checkpoint = (nfev, cost)
+                return 5
+            checkpoint[:] = [nfev, cost]
+        return None
+
+    out = damped_descent(
+        evaluate,
+        linearise,
+        x0,
+        max_nfev=max_nfev,
+        project=project,
+        converged=converged,
+    )
+    status = {"cap": 0, "stationary": 1, "no decrease": 4}.get(out["stop"], out["stop"])
+    x, r = out["x"], out["state"]
     jac = jacobian(x)
-    njev += 1
     return OptimiserResult(
         x=x,
-        cost=0.5 * cost,
+        cost=0.5 * out["cost"],
         fun=r,
         jac=jac,
         optimality=float(np.max(np.abs(jac.T @ r))) if x.size else 0.0,
-        nfev=nfev,
-        njev=njev,
-        nit=nit,
+        nfev=out["nfev"],
+        njev=out["njev"] + 1,
+        nit=out["nit"],
         n_restarts=0,
         history=None,
         stop=status,

@@ -37,7 +37,8 @@ Glorot-uniform (``+-sqrt(6 / (n_in + h))``), hidden biases and output
 weights at zero, so every start is exactly its linear (ARX) model. The last
 `holdout` share (default 0.2) of the estimation record is held back: the
 free run covers the whole record but the training residuals only the part
-before it; Levenberg-Marquardt runs in rounds of 10 iterations and stops
+before it; Levenberg-Marquardt (:mod:`.levenberg`, the one implementation
+of the ARX polish too) runs in rounds of 10 evaluations and stops
 after `patience` (3) rounds without a lower held-back cost, returning the
 parameters with the lowest held-back cost. Searches minimise the training
 cost only. The Levenberg-Marquardt fits add a weight decay on the
@@ -53,7 +54,6 @@ import math
 import time
 
 import numpy as np
-from scipy import optimize
 
 from spiralid._checks import generator, integer
 from spiralid.choices import DEFAULT_METHOD
@@ -64,7 +64,8 @@ from ..data import IOData
 from ..models.arx import ARX, arx_least_squares
 from ..models.narx import NARX, NARXModel, PolynomialNARX
 from .frols import frols
-from .narx_problem import NARXProblem, narx_result
+from .levenberg import levenberg_marquardt
+from .narx_problem import _TOL, NARXProblem, narx_result
 
 __all__ = ["NARXProblem", "identify_narx"]
 
@@ -401,13 +402,10 @@ def estimate_spiral(
         search.step()
         nit += 1
         if nit % polish_every == 0:
-            res = optimize.least_squares(
-                fun,
-                search.x,
-                jac=jac,
-                method="lm",
-                max_nfev=polish_nfev,
-            )
+            with np.errstate(all="ignore"):
+                res = levenberg_marquardt(
+                    fun, jac, search.x, max_nfev=polish_nfev, tol=_TOL
+                )
             # The centre must stay in the box: a polish that left it is
             # clipped back (and scored there).
             x = np.clip(res.x, box[:, 0], box[:, 1])

@@ -9,15 +9,18 @@ import math
 import time
 
 import numpy as np
-from scipy import optimize
 
 from spiralid.optim.result import OptimiserResult
 
 from ..models.narx import NARX, Scaling
+from .levenberg import levenberg_marquardt
 
 __all__ = ["NARXProblem", "narx_result"]
 
-_ROUND = 10  # LM iterations per early-stopping round
+_ROUND = 10  # LM evaluations per early-stopping round
+# LM's tolerances (gradient, relative fall, step), SciPy's 1e-8 as before
+# the polish moved onto levenberg.py.
+_TOL = 1e-8
 
 
 class NARXProblem:
@@ -219,9 +222,7 @@ class NARXProblem:
         for rounds in range(1, max_rounds + 1):
             try:
                 with np.errstate(all="ignore"):
-                    res = optimize.least_squares(
-                        fun, p, jac=jac, method="lm", max_nfev=_ROUND
-                    )
+                    res = levenberg_marquardt(fun, jac, p, max_nfev=_ROUND, tol=_TOL)
             except (ValueError, np.linalg.LinAlgError):
                 break
             moved = not np.array_equal(res.x, p)
@@ -231,7 +232,8 @@ class NARXProblem:
                 best_p, best, waited, best_round = p.copy(), score, 0, rounds
             else:
                 waited += 1
-            if waited >= patience or not moved or res.status > 0:
+            # A stop other than the evaluation cap (stop 0) is convergence.
+            if waited >= patience or not moved or res.stop != 0:
                 break
         return best_p, best_round
 

@@ -37,6 +37,7 @@ from ..data import IOData
 from ..models.arx import ARX
 from ..models.polynomials import is_stable_polynomial
 from .cost import PaperCost
+from .levenberg import damped_descent
 
 __all__ = ["ProjectedCost", "gauss_newton_polish"]
 
@@ -248,8 +249,10 @@ def gauss_newton_polish(
     (:meth:`ProjectedCost.residual`) chained with the parametrisation's
     ``jacobian``; the damping ``lambda`` of ``(J'J + lambda diag(J'J))``
     shrinks after a successful step and grows after a failed one (Marquardt,
-    1963). The normal equations are formed in compiled loops: on a shared
-    machine a threaded BLAS on these thin matrices is several times slower.
+    1963), in the one Levenberg-Marquardt loop
+    (:func:`~spiralid.sysid.estimation.levenberg.damped_descent`). The
+    normal equations are formed in compiled loops: on a shared machine a
+    threaded BLAS on these thin matrices is several times slower.
 
     Parameters
     ----------
@@ -275,61 +278,63 @@ def gauss_newton_polish(
     """
     box = parametrization.bounds
     lo, hi = box[:, 0], box[:, 1]
-    x = np.clip(np.asarray(x0, dtype=float), lo, hi)
 
-    def sse_at(pt):
-        return cost.sse(parametrization.to_denominator(pt))
+    def evaluate(pt):
+        return cost.sse(parametrization.to_denominator(pt)), None
 
-    lam = 1e-3
-    nfev, nit, status = 0, 0, 1
-    message = "Evaluation budget used."
-    sse = None
-    while nfev < max_nfev:
+    def linearise(x, _sse, _state):
         s0, g_a, h_a = cost.normal_equations(parametrization.to_denominator(x))
-        nfev += 1
-        sse = s0 if sse is None else sse
         m = parametrization.jacobian(x)
         grad = m.T @ g_a
         hess = m.T @ h_a @ m
         diag = np.maximum(np.diag(hess), 1e-300)
-        moved = False
-        while nfev < max_nfev:
-            # Coordinates on a bound whose descent direction leaves the box
-            # stay there; the step is solved for the others.
-            free = ~(((x <= lo) & (grad > 0)) | ((x >= hi) & (grad < 0)))
-            step = np.zeros_like(x)
+        # Coordinates on a bound whose descent direction leaves the box
+        # stay there; the step is solved for the others.
+        free = ~(((x <= lo) & (grad > 0)) | ((x >= hi) & (grad < 0)))
+
+        def step(lam):
+            out = np.zeros_like(x)
             sub = hess[np.ix_(free, free)] + lam * np.diag(diag[free])
             try:
-                step[free] = -np.linalg.solve(sub, grad[free])
+                out[free] = -np.linalg.solve(sub, grad[free])
             except np.linalg.LinAlgError:
-                lam *= 10.0
-                continue
-            trial = np.clip(x + step, lo, hi)
-            s1 = sse_at(trial)
-            nfev += 1
-            if np.isfinite(s1) and s1 < sse:
-                small = np.all(np.abs(trial - x) <= 1e-10 * (hi - lo))
-                x, sse = trial, s1
-                lam = max(lam / 10.0, 1e-12)
-                nit += 1
-                moved = True
-                if small:
-                    status, message = 0, "Step below tolerance."
-                break
-            lam *= 4.0
-            if lam > 1e12:
-                break
-        if status == 0 or not moved:
-            if not moved and nfev < max_nfev:
-                status, message = 0, "No decrease along the damped step."
-            break
+                return None
+            return out
+
+        return s0, step, False
+
+    def converged(before, x, _sse_before, _sse, _nfev):
+        small = np.all(np.abs(x - before) <= 1e-10 * (hi - lo))
+        return "small" if small else None
+
+    # The one Levenberg-Marquardt loop (levenberg.py) with this problem's
+    # normal equations, the box as its projection, and the damping growing
+    # fourfold after a rejected point as this polish always has.
+    out = damped_descent(
+        evaluate,
+        linearise,
+        np.clip(np.asarray(x0, dtype=float), lo, hi),
+        max_nfev=max_nfev,
+        project=lambda pt: np.clip(pt, lo, hi),
+        converged=converged,
+        linearising_counts=True,
+        grow=4.0,
+        lam_max=1e12,
+    )
+    x, sse, stop = out["x"], out["cost"], out["stop"]
+    if stop == "small":
+        status, message = 0, "Step below tolerance."
+    elif stop == "no decrease" and out["nfev"] < max_nfev:
+        status, message = 0, "No decrease along the damped step."
+    else:
+        status, message = 1, "Evaluation budget used."
     return OptimiserResult(
         x=x,
         fun=cost.fun_of_sse(sse)
         if sse is not None
         else cost(parametrization.to_denominator(x)),
-        nfev=nfev,
-        nit=nit,
+        nfev=out["nfev"],
+        nit=out["nit"],
         status=status,
         message=message,
         success=True,
