@@ -1,10 +1,17 @@
 """Levenberg-Marquardt with a projection, against SciPy and hand-worked cases."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy import optimize
 
-from spiralid.sysid.estimation.levenberg import STOPS, levenberg_marquardt
+import spiralid
+from spiralid.sysid.estimation.levenberg import (
+    STOPS,
+    damped_descent,
+    levenberg_marquardt,
+)
 
 
 def _exponential_fit():
@@ -81,3 +88,64 @@ def test_cap_and_stall_are_reported():
     stalled = levenberg_marquardt(residual, jacobian, x0, stall=(2, 1.0))
     assert stalled.stop == 5 and stalled.status == 0
     assert "flat valley" in stalled.message
+
+
+def test_damped_descent_with_normal_equations_reaches_the_same_minimum():
+    # The variable-projection polish's way in: the step from normal
+    # equations, the linearisation counted as an evaluation.
+    residual, jacobian = _exponential_fit()
+
+    def evaluate(x):
+        r = residual(x)
+        return float(r @ r), None
+
+    def linearise(x, _cost, _state):
+        r, jac = residual(x), jacobian(x)
+        grad, hess = jac.T @ r, jac.T @ jac
+
+        def step(lam):
+            return -np.linalg.solve(hess + lam * np.diag(np.diag(hess)), grad)
+
+        return float(r @ r), step, False
+
+    out = damped_descent(
+        evaluate,
+        linearise,
+        np.array([1.0, 0.5, 0.0]),
+        max_nfev=200,
+        linearising_counts=True,
+        grow=4.0,
+    )
+    ref = levenberg_marquardt(residual, jacobian, np.array([1.0, 0.5, 0.0]))
+    np.testing.assert_allclose(out["x"], ref.x, rtol=1e-6)
+    assert (
+        out["nfev"] <= 200
+        and out["njev"] == 0
+        and out["stop"] in ("cap", "no decrease")
+    )
+
+
+def test_damped_descent_stops_when_the_evaluations_run_out():
+    residual, jacobian = _exponential_fit()
+
+    def evaluate(x):
+        r = residual(x)
+        return float(r @ r), r
+
+    def linearise(x, cost, r):
+        jac = jacobian(x)
+        return cost, (lambda lam: -np.linalg.lstsq(jac, r, rcond=None)[0]), False
+
+    out = damped_descent(evaluate, linearise, np.array([1.0, 0.5, 0.0]), max_nfev=3)
+    assert out["nfev"] == 3 and out["stop"] == "cap" and out["nit"] >= 1
+
+
+def test_every_levenberg_marquardt_in_the_package_is_levenbergs():
+    # One loop (issue 28): no estimator runs SciPy's LM or a damping loop
+    # of its own.
+    for path in Path(spiralid.__file__).parent.rglob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        if path.name == "levenberg.py":
+            continue
+        assert 'method="lm"' not in text, path
+        assert "lam *=" not in text, path
