@@ -496,7 +496,7 @@ def _time_constant(value, ts: float) -> float | None:
     return seconds
 
 
-# What the shared-denominator estimate of several outputs takes (issue 30):
+# What the shared-denominator estimate of several outputs takes:
 # its own options beside the common ones.
 SHARED_OPTIONS = ("rng", "predictor", "initial", "max_time_constant")
 SHARED_OWN = ("n_points", "max_nfev", "weights")

@@ -1,5 +1,5 @@
 """Validation of a model of several outputs: each output's fit and a joint
-fit (issue 30).
+fit.
 
 A :class:`~spiralid.sysid.models.shared.SharedDenominatorModel` is validated
 output by output: each output's transfer function ``B_i / A``
