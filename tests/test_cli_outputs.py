@@ -39,7 +39,7 @@ def test_an_option_a_shared_model_does_not_take_is_refused(tmp_path):
     rec = paper_experiment().run(FlexibleManipulator(), rng=0)
     np.savez(tmp_path / "rig.npz", u=rec.u, vel=rec.hub_velocity,
              acc=rec.end_acceleration, ts=rec.ts)  # fmt: skip
-    out = run("identify", "rig.npz", "--output", "vel,acc", "--method", "oe",
+    out = run("identify", "rig.npz", "--output", "vel,acc", "--method", "sda",
               "--out", "m", cwd=tmp_path)  # fmt: skip
     assert out.returncode == 2 and len(out.stderr.splitlines()) == 1
     assert "takes one output" in out.stderr

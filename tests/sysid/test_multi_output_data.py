@@ -86,8 +86,8 @@ def test_single_output_functions_refuse_several_in_one_line():
         PaperCost(ARX(1, 1, 0), d)
     # identify takes several outputs by its default method alone (one shared
     # denominator, tests/sysid/test_shared.py).
-    with pytest.raises(ValueError, match="`method` 'ls' takes one output"):
-        identify(d, ARX(1, 1, 0), method="ls")
+    with pytest.raises(ValueError, match="`method` 'sda' takes one output"):
+        identify(d, ARX(1, 1, 0), method="sda")
     model = identify(d.output("a"), ARX(1, 1, 0), method="ls")
     with pytest.raises(ValueError, match=r"validate .* takes one"):
         validate(model, d)

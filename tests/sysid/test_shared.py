@@ -85,9 +85,11 @@ def test_the_model_round_trips_through_json_and_refuses_bad_input():
     np.testing.assert_array_equal(again.simulate(np.ones(5)), fit.simulate(np.ones(5)))
     with pytest.raises(ValueError, match="`weights` must be 2 finite numbers"):
         identify(_record(3), ARX(4, 4, 1), weights=[1.0, -1.0])
-    with pytest.raises(ValueError, match="`method` 'oe' takes one output"):
-        identify(_record(3), ARX(4, 4, 1), method="oe")
-    with pytest.raises(ValueError, match="`refine` does not apply to a record of 2"):
+    with pytest.raises(ValueError, match="`method` 'sda' takes one output"):
+        identify(_record(3), ARX(4, 4, 1), method="sda")
+    with pytest.raises(ValueError, match="`max_nfev` does not apply to method 'oe'"):
+        identify(_record(3), ARX(4, 4, 1), method="oe", max_nfev=100)
+    with pytest.raises(ValueError, match="`refine` does not apply to method 'spiral'"):
         identify(_record(3), ARX(4, 4, 1), refine=True)
 
 
@@ -119,3 +121,27 @@ def test_each_output_is_validated_and_the_joint_fit_combines_them():
     assert "joint fit %" in report.summary() and "far" in report.summary()
     with pytest.raises(ValueError, match="`data` must hold the model's outputs"):
         validate_outputs(fit, val.output("far"))
+
+
+def test_output_error_and_least_squares_for_the_same_structure():
+    data = _record(6)
+    oe = identify(data, ARX(4, 4, 1), method="oe")
+    spiral = identify(data, ARX(4, 4, 1), rng=0, max_nfev=2000)
+    ls = identify(data, ARX(4, 4, 1), method="ls")
+    assert (oe.method, ls.method) == ("oe", "ls")
+    # One minimum on this record: the search and output error agree.
+    np.testing.assert_allclose(oe.a, spiral.a, atol=1e-6)
+    np.testing.assert_allclose(oe.a, A[1:], atol=2e-3)
+    # Least squares of the joint equation error, by hand: stacked rows.
+    rows, rhs = [], []
+    for i in range(2):
+        one = data.output(i)
+        phi = ARX(4, 4, 1).regressors(one)[4:]
+        block = np.zeros((phi.shape[0], 12))
+        block[:, :4] = phi[:, :4]
+        block[:, 4 + 4 * i : 8 + 4 * i] = phi[:, 4:]
+        w = np.sqrt(ls.weights[i])
+        rows.append(w * block)
+        rhs.append(w * one.y[4:])
+    theta = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
+    np.testing.assert_allclose(np.r_[ls.a, ls.b.ravel()], theta, rtol=1e-9)

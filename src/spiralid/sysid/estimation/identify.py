@@ -496,24 +496,18 @@ def _time_constant(value, ts: float) -> float | None:
     return seconds
 
 
-# What the shared-denominator estimate of several outputs takes:
-# its own options beside the common ones.
-SHARED_OPTIONS = ("rng", "predictor", "initial", "max_time_constant")
-SHARED_OWN = ("n_points", "max_nfev", "weights")
-
-
 def _identify_shared(data: IOData, arx: ARX, method, given: dict):
     """`identify` on a record of several outputs: one denominator for all
-    (:func:`~spiralid.sysid.estimation.shared.identify_shared`); for now by
-    the default method only."""
-    from .shared import identify_shared
+    (:func:`~spiralid.sysid.estimation.shared.identify_shared`) by the
+    methods of :data:`~spiralid.sysid.estimation.shared.SHARED_METHODS`."""
+    from .shared import SHARED_METHODS, identify_shared
 
     method = _check_method(method)
-    if method != DEFAULT_METHOD:
+    if method not in SHARED_METHODS:
         raise ValueError(
             f"`method` {method!r} takes one output; a record of several outputs "
-            f"{data.output_names} is identified by {DEFAULT_METHOD!r} (one shared "
-            "denominator), or pass data.output(name)"
+            f"{data.output_names} is identified by one of {tuple(SHARED_METHODS)} "
+            "(one shared denominator), or pass data.output(name)"
         )
     if given["predictor"] != "simulation" or given["initial"] != "rest":
         raise ValueError(
@@ -523,16 +517,16 @@ def _identify_shared(data: IOData, arx: ARX, method, given: dict):
     if given["integrator"] is not True and given["integrator"] in (0, False):
         # No integrator, however spelt (the command passes a count).
         given = {k: v for k, v in given.items() if k != "integrator"}
+    takes = ("rng", "predictor", "initial", *SHARED_METHODS[method])
     refuse_options(
         given,
-        SHARED_OPTIONS + SHARED_OWN,
-        f"a record of {data.n_outputs} outputs (one shared denominator)",
+        takes,
+        f"method {method!r} on a record of {data.n_outputs} outputs (one shared "
+        "denominator)",
         IDENTIFY_DEFAULTS,
     )
-    own = {k: given[k] for k in SHARED_OWN if k in given}
-    return identify_shared(
-        data, arx, rng=given["rng"], max_time_constant=given["max_time_constant"], **own
-    )
+    own = {k: given[k] for k in SHARED_METHODS[method] if k in given}
+    return identify_shared(data, arx, method=method, rng=given["rng"], **own)
 
 
 def _identify_integrating(

@@ -45,7 +45,12 @@ from .margin import AUTO, max_radius
 from .modal import ModalParametrization
 from .varpro import ProjectedCost, gauss_newton_polish
 
-__all__ = ["SharedProjectedCost", "identify_shared"]
+__all__ = [
+    "SHARED_METHODS",
+    "SharedProjectedCost",
+    "identify_shared",
+    "joint_least_squares",
+]
 
 # The final polishes' budget, in evaluations per searched coordinate (the
 # single-output polish runs LM to its tolerances; this is its like).
@@ -138,36 +143,55 @@ class SharedProjectedCost:
         return np.array([part.numerator(a) for part in self.parts])
 
 
-def _starts(data: IOData, arx: ARX, par: ModalParametrization) -> np.ndarray:
-    """Each output's least-squares denominator (stabilised), in modal
-    coordinates: a sensor's own estimate of the shared modes."""
-    from ..models.arx import arx_least_squares
+def _coordinates(theta_a, par: ModalParametrization, arx: ARX) -> np.ndarray:
+    """A least-squares denominator as modal coordinates: stabilised, inside
+    the margin, clipped to the box."""
     from ..models.polynomials import step_up
     from .margin import project_denominator
     from .parametrizations import KMAX, stabilise
 
-    rows = []
-    for i in range(data.n_outputs):
-        theta = stabilise(arx_least_squares(data.output(i), arx), arx)
-        a = step_up(theta[: arx.na])
-        if par.max_radius is not None:
-            a = project_denominator(a, par.max_radius, KMAX)
-        rows.append(par.from_denominator(a))
+    theta = stabilise(np.r_[theta_a, np.zeros(arx.nb)], arx)
+    a = step_up(theta[: arx.na])
+    if par.max_radius is not None:
+        a = project_denominator(a, par.max_radius, KMAX)
     box = par.bounds
-    return np.clip(np.array(rows), box[:, 0], box[:, 1])
+    return np.clip(par.from_denominator(a), box[:, 0], box[:, 1])
+
+
+def _starts(data: IOData, arx: ARX, par: ModalParametrization) -> np.ndarray:
+    """Each output's least-squares denominator, in modal coordinates: a
+    sensor's own estimate of the shared modes."""
+    from ..models.arx import arx_least_squares
+
+    return np.array(
+        [
+            _coordinates(arx_least_squares(data.output(i), arx)[: arx.na], par, arx)
+            for i in range(data.n_outputs)
+        ]
+    )
+
+
+# The methods a record of several outputs takes, and the options of each
+# (beside rng, predictor and initial, which every one accepts as identify's).
+SHARED_METHODS = {
+    "spiral": ("max_time_constant", "n_points", "max_nfev", "weights"),
+    "oe": ("max_time_constant", "weights"),
+    "ls": ("weights",),
+}
 
 
 def identify_shared(
     data: IOData,
     arx: ARX,
     *,
+    method: str = "spiral",
     rng=None,
     n_points: int = 50,
     max_nfev: int = 10_000,
     weights=None,
     max_time_constant: float | str | None = AUTO,
 ) -> SharedDenominatorModel:
-    """One denominator for every output of `data`, by the spiral search.
+    """One denominator for every output of `data`.
 
     Parameters
     ----------
@@ -176,12 +200,19 @@ def identify_shared(
     arx : ARX
         Each output's structure: ``na`` shared poles, ``nb`` numerator
         coefficients per output after ``nk`` delays.
+    method : {"spiral", "oe", "ls"}
+        ``"spiral"``: the spiral search over the shared modes (Eb-SDA over
+        the modal coordinates, Gauss-Newton polish every 5 iterations,
+        restarts after 20 stalled ones, first points at each output's
+        least-squares denominator), then polished. ``"oe"``: output error,
+        the same polish from each output's least-squares denominator and
+        the joint least-squares one, the lowest cost kept (no search).
+        ``"ls"``: least squares of the equation error of every output with
+        one ``A`` (the joint ARX estimate; its poles may be unstable).
     rng : int, Generator or None
         Seeds the search.
     n_points, max_nfev : int
-        The search's population and budget of joint-cost evaluations, as
-        the single-output ``"spiral"`` (Eb-SDA over the modes, polish every
-        5 iterations, restarts after 20 stalled ones).
+        The search's population and budget of joint-cost evaluations.
     weights : array_like, shape (p,), optional
         ``lambda_i`` of the joint cost; default estimated: a first fit in
         each output's scale, then ``1 / sigma_i^2`` from its residuals
@@ -194,27 +225,73 @@ def identify_shared(
     -------
     SharedDenominatorModel
     """
-    from spiralid.optim.restarts import Restarts
-
-    from .memetic import projected_spiral
-
     t0 = time.perf_counter()
     if not isinstance(data, IOData):
         raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
     if not isinstance(arx, ARX) or arx.na < 1:
         raise ValueError(f"`arx` must be an ARX with na >= 1; got {arx!r}")
+    if method not in SHARED_METHODS:
+        raise ValueError(
+            f"`method` must be one of {tuple(SHARED_METHODS)} for several outputs; "
+            f"got {method!r}"
+        )
     n_points = integer(n_points, "n_points", 2)
     max_nfev = integer(max_nfev, "max_nfev", n_points)
-    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
-        seconds = data.n * data.ts
-    elif max_time_constant is None:
-        seconds = None
-    else:
-        seconds = float(max_time_constant)
-    par = ModalParametrization(arx.na, data.ts, max_radius=max_radius(data.ts, seconds))
     first = SharedProjectedCost(arx, data, None if weights is None else weights)
-    raw = projected_spiral(
-        first,
+    if method == "ls":
+        theta = joint_least_squares(data, arx, first.weights)
+        a, b = theta[: arx.na], theta[arx.na :].reshape(data.n_outputs, arx.nb)
+        return _model(data, arx, "ls", first, a, b, None, {"elapsed": 0.0}, t0)
+    par = ModalParametrization(
+        arx.na, data.ts, max_radius=_radius(data, max_time_constant)
+    )
+    starts = _starts(data, arx, par)
+    if method == "spiral":
+        raw = _search(first, par, starts, n_points, max_nfev, rng)
+        z, result = (
+            raw.z,
+            {
+                "nfev": int(raw.nfev),
+                "nit": int(raw.nit),
+                "n_restarts": int(raw.n_restarts),
+                "message": str(raw.message),
+            },
+        )
+    else:
+        joint = joint_least_squares(data, arx, first.weights)[: arx.na]
+        budget = _POLISH_NFEV * (arx.na + 1)
+        polished = [
+            gauss_newton_polish(first, par, x, budget)
+            for x in (*starts, _coordinates(joint, par, arx))
+        ]
+        z = min(polished, key=lambda r: r.fun).x
+        result = {
+            "message": "Output error from each output's and the joint "
+            "least-squares denominators; the lowest cost kept."
+        }
+    cost, z = _weighted_polish(first, par, z, data, arx, weights is None, starts)
+    a = par.to_denominator(z)
+    cov = _covariance(cost, a, data, arx)
+    return _model(data, arx, method, cost, a, cost.numerators(a), cov, result, t0)
+
+
+def _radius(data: IOData, max_time_constant) -> float | None:
+    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
+        return max_radius(data.ts, data.n * data.ts)
+    if max_time_constant is None:
+        return None
+    return max_radius(data.ts, float(max_time_constant))
+
+
+def _search(cost, par, starts, n_points, max_nfev, rng):
+    """The spiral search over the shared modes (the single-output
+    ``"spiral"``'s settings)."""
+    from spiralid.optim.restarts import Restarts
+
+    from .memetic import projected_spiral
+
+    return projected_spiral(
+        cost,
         par,
         "ebsda",
         n_points=n_points,
@@ -222,13 +299,19 @@ def identify_shared(
         polish_every=5,
         polish_nfev=10,
         restarts=Restarts(growth=1, stall=20),
-        x0=_starts(data, arx, par),
+        x0=starts,
         rng=generator(rng),
     )
+
+
+def _weighted_polish(first, par, z, data, arx, reweight: bool, starts):
+    """Gauss-Newton from `z` (and, for output error, from every start),
+    then the noise weights re-estimated and polished again until they
+    settle; the cost used last and the coordinates."""
     budget = _POLISH_NFEV * (arx.na + 1)
-    z = gauss_newton_polish(first, par, raw.z, budget).x
+    z = gauss_newton_polish(first, par, z, budget).x
     cost = first
-    for _ in range(_REWEIGHTS if weights is None else 0):
+    for _ in range(_REWEIGHTS if reweight else 0):
         # Each output's residual variance at the current fit is its noise
         # level; the misfit the first weighting left inflates it, so the
         # weights are re-estimated until they settle.
@@ -240,10 +323,14 @@ def identify_shared(
         z = gauss_newton_polish(cost, par, z, budget).x
         if settled:
             break
-    a = par.to_denominator(z)
+    return cost, z
+
+
+def _model(data, arx, method, cost, a, b, covariance, result, t0):
+    result = dict(result, elapsed=time.perf_counter() - t0)
     return SharedDenominatorModel(
         a=a,
-        b=cost.numerators(a),
+        b=b,
         arx=arx,
         ts=data.ts,
         output_names=data.output_names,
@@ -252,19 +339,44 @@ def identify_shared(
         input_unit=data.input_unit,
         u_offset=data.u_offset,
         y_offsets=data.y_offsets,
-        method="spiral",
-        cost=float(cost(a)),
+        method=method,
+        cost=float(cost(a)) if is_stable_polynomial(a) else float("nan"),
         weights=cost.weights,
-        costs=cost.per_output(a),
-        covariance=_covariance(cost, a, data, arx),
-        result={
-            "nfev": int(raw.nfev),
-            "nit": int(raw.nit),
-            "n_restarts": int(raw.n_restarts),
-            "message": str(raw.message),
-            "elapsed": time.perf_counter() - t0,
-        },
+        costs=cost.per_output(a) if is_stable_polynomial(a) else None,
+        covariance=covariance,
+        result=result,
     )
+
+
+def joint_least_squares(data: IOData, arx: ARX, weights=None) -> np.ndarray:
+    """``[a, b_1, .., b_p]``: least squares of every output's equation error
+    ``y_i(t) + sum_k a_k y_i(t-k) - sum_j b_ij u(t-nk-j)`` with one ``a``,
+    each output's rows weighted by ``sqrt(lambda_i)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.signal import lfilter
+    >>> u = np.random.default_rng(0).standard_normal(400)
+    >>> y = np.column_stack([lfilter([0, 1.0], [1, -0.5], u),
+    ...                      lfilter([0, 2.0, 1.0], [1, -0.5], u)])
+    >>> theta = joint_least_squares(IOData(u, y, ts=1.0), ARX(1, 2, 1))
+    >>> theta.round(9).tolist()
+    [-0.5, 1.0, 0.0, 2.0, 1.0]
+    """
+    p = data.n_outputs
+    weights = np.ones(p) if weights is None else np.asarray(weights, dtype=float)
+    blocks, rhs = [], []
+    for i in range(p):
+        one = data.output(i)
+        phi = arx.regressors(one)[arx.max_lag :]
+        w = np.sqrt(weights[i])
+        row = np.zeros((phi.shape[0], arx.na + p * arx.nb))
+        row[:, : arx.na] = phi[:, : arx.na]
+        row[:, arx.na + i * arx.nb : arx.na + (i + 1) * arx.nb] = phi[:, arx.na :]
+        blocks.append(w * row)
+        rhs.append(w * one.y[arx.max_lag :])
+    return np.linalg.lstsq(np.vstack(blocks), np.concatenate(rhs), rcond=None)[0]
 
 
 def _covariance(cost: SharedProjectedCost, a, data: IOData, arx: ARX):
