@@ -145,3 +145,38 @@ def test_output_error_and_least_squares_for_the_same_structure():
         rhs.append(w * one.y[4:])
     theta = np.linalg.lstsq(np.vstack(rows), np.concatenate(rhs), rcond=None)[0]
     np.testing.assert_allclose(np.r_[ls.a, ls.b.ravel()], theta, rtol=1e-9)
+
+
+def test_each_output_has_its_own_known_integrators():
+    from spiralid.sysid.models.polynomials import with_integrator
+
+    rng = np.random.default_rng(7)
+    u = rng.standard_normal(1500)
+    # Output 1 integrates the modes once (a velocity to an angle), output 2
+    # does not: one A, a numerator each, and (1 - z^-1) for output 1 only.
+    y = np.column_stack(
+        [
+            signal.lfilter(B[0], np.r_[1.0, with_integrator(A[1:])], u),
+            signal.lfilter(B[1], A, u),
+        ]
+    )
+    y += 0.002 * rng.standard_normal(y.shape)
+    data = IOData(u, y, ts=TS, output_name=("angle", "rate"))
+    fit = identify(data, ARX(4, 4, 1), rng=0, max_nfev=2000, integrator=(1, 0))
+    assert fit.integrators == (1, 0)
+    np.testing.assert_allclose(fit.a, A[1:], atol=2e-3)
+    angle = fit.output_model("angle")
+    assert angle.integrator == 1 and angle.arx == ARX(5, 4, 1)
+    np.testing.assert_allclose(angle.free_denominator, A[1:], atol=2e-3)
+    # The free run holds the ramp: fit above 95 % on both outputs.
+    for k, name in enumerate(data.output_names):
+        assert validate(fit.output_model(name), data.output(k)).fit_percent > 95
+    again = SharedDenominatorModel.from_dict(fit.to_dict())
+    assert again.integrators == (1, 0)
+    control = pytest.importorskip("control")
+    impulse = np.r_[1.0, np.zeros(49)]
+    _, response = control.forced_response(fit.to_control(), U=impulse)
+    np.testing.assert_allclose(response.T, fit.simulate(impulse), atol=1e-9)
+    np.testing.assert_allclose(again.simulate(u[:50]), fit.simulate(u[:50]))
+    with pytest.raises(ValueError, match="`integrator` must be one count or one per"):
+        identify(data, ARX(4, 4, 1), integrator=(1, 0, 0))

@@ -62,19 +62,23 @@ def _time_constant(text: str) -> float | str | None:
     return v
 
 
-def _integrator_count(text: str) -> int:
-    """--integrator K: a count of known integrators, 0 or more."""
-    try:
-        count = int(text)
-    except ValueError:
-        count = -1
-    if count < 0:
+def _integrator_count(text: str) -> int | tuple[int, ...]:
+    """--integrator K: a count of known integrators, 0 or more; or one per
+    output separated by commas (2,1,0,0) with several --output columns."""
+    counts = []
+    for part in text.split(","):
+        try:
+            counts.append(int(part))
+        except ValueError:
+            counts.append(-1)
+    if min(counts) < 0:
         import argparse
 
         raise argparse.ArgumentTypeError(
-            f"must be a count of integrators >= 0; got {text!r}"
+            f"must be a count of integrators >= 0, or one per output (2,1,0); "
+            f"got {text!r}"
         )
-    return count
+    return counts[0] if len(counts) == 1 else tuple(counts)
 
 
 def _narx_structure(args):
@@ -86,6 +90,12 @@ def _narx_structure(args):
     # A NARX's linear start takes up to two known integrators (a hub angle
     # driven by a torque has two); forward regression has one at most.
     most = 2 if args.model == "narx" else 1
+    if isinstance(args.integrator, tuple):
+        raise UsageError(
+            f"--integrator {','.join(map(str, args.integrator))}: one count per "
+            "output applies to several --output columns, not to --model "
+            f"{args.model}"
+        )
     if args.integrator > most:
         raise UsageError(
             f"--model {args.model} takes at most {most} integrator(s); got "
@@ -518,7 +528,8 @@ def add_parser(sub) -> None:
         metavar="K",
         help="the output integrates (K known poles at z = 1, default 1; 2 for "
         "the rig's hub angle from torque): --na counts them, the method "
-        "estimates the other poles",
+        "estimates the other poles; with several --output columns one count "
+        "each (2,1,0,0), outside the shared --na poles",
     )
     p.add_argument("--points", type=_positive_int, default=50, help="search points")
     p.add_argument(

@@ -514,10 +514,7 @@ def _identify_shared(data: IOData, arx: ARX, method, given: dict):
             "a record of several outputs is fitted to its simulation error from "
             f"rest; got predictor={given['predictor']!r}, initial={given['initial']!r}"
         )
-    if given["integrator"] is not True and given["integrator"] in (0, False):
-        # No integrator, however spelt (the command passes a count).
-        given = {k: v for k, v in given.items() if k != "integrator"}
-    takes = ("rng", "predictor", "initial", *SHARED_METHODS[method])
+    takes = ("rng", "predictor", "initial", "integrator", *SHARED_METHODS[method])
     refuse_options(
         given,
         takes,
@@ -526,7 +523,14 @@ def _identify_shared(data: IOData, arx: ARX, method, given: dict):
         IDENTIFY_DEFAULTS,
     )
     own = {k: given[k] for k in SHARED_METHODS[method] if k in given}
-    return identify_shared(data, arx, method=method, rng=given["rng"], **own)
+    return identify_shared(
+        data,
+        arx,
+        method=method,
+        rng=given["rng"],
+        integrator=given["integrator"],
+        **own,
+    )
 
 
 def _identify_integrating(

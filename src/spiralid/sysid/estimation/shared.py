@@ -32,6 +32,7 @@ weighted residual variance per degree of freedom.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -59,27 +60,65 @@ _POLISH_NFEV = 40
 _REWEIGHTS = 5
 
 
+def _integrators(integrators, p: int) -> tuple[int, ...]:
+    """Each output's count of known integrators: one count for all, or one
+    per output; a one-line ValueError otherwise."""
+    from ..models.polynomials import integrator_count
+
+    if integrators is None:
+        return (0,) * p
+    values = (
+        list(integrators)
+        if isinstance(integrators, list | tuple)
+        else [integrators] * p
+    )
+    if len(values) != p:
+        raise ValueError(
+            f"`integrator` must be one count or one per output ({p}); got "
+            f"{integrators!r}"
+        )
+    return tuple(integrator_count(v, 2) for v in values)
+
+
+def _summed(one: IOData, count: int) -> IOData:
+    """`one` with its input summed `count` times (the known integrators)."""
+    u = one.u
+    for _ in range(count):
+        u = np.cumsum(u)
+    return replace(one, u=u) if count else one
+
+
 class SharedProjectedCost:
     """``J(A)`` over denominators, every output's numerator projected out.
 
     Parameters
     ----------
     arx : ARX
-        Each output's structure.
+        Each output's structure, without its known integrators.
     data : IOData
         A record of ``p >= 1`` outputs.
     weights : array_like, shape (p,), optional
         ``lambda_i``; default ``1 / mean(y_i^2)`` (each output in its own
         scale).
+    integrators : sequence of int, optional
+        Each output's known integrators ``k_i`` (poles at ``z = 1`` outside
+        the shared ``A``): output ``i`` is ``B_i / A`` applied to the
+        ``k_i``-fold running sum of the input (as a single output's
+        ``identify(integrator=k)``); default none.
 
     The value reported is a percent RMS error:
     ``100 sqrt(J / sum_i lambda_i ||y_i||^2)``, which with the default
     weights is the RMS over the outputs of their percent errors.
     """
 
-    def __init__(self, arx: ARX, data: IOData, weights=None) -> None:
+    def __init__(self, arx: ARX, data: IOData, weights=None, integrators=None) -> None:
         self.arx = arx
-        self.parts = [ProjectedCost(arx, data.output(i)) for i in range(data.n_outputs)]
+        self.data = data
+        self.integrators = _integrators(integrators, data.n_outputs)
+        self.parts = [
+            ProjectedCost(arx, _summed(data.output(i), k))
+            for i, k in enumerate(self.integrators)
+        ]
         energy = np.array([float(np.sum(part.data.y**2)) for part in self.parts])
         if weights is None:
             weights = data.n / np.maximum(energy, np.finfo(float).tiny)
@@ -93,6 +132,10 @@ class SharedProjectedCost:
             )
         self.weights = weights
         self._norm = float(weights @ energy)
+
+    def reweighted(self, weights) -> SharedProjectedCost:
+        """The same cost with other weights."""
+        return SharedProjectedCost(self.arx, self.data, weights, self.integrators)
 
     def fun_of_sse(self, sse: float) -> float:
         return 100.0 * float(np.sqrt(max(sse, 0.0) / self._norm))
@@ -158,15 +201,17 @@ def _coordinates(theta_a, par: ModalParametrization, arx: ARX) -> np.ndarray:
     return np.clip(par.from_denominator(a), box[:, 0], box[:, 1])
 
 
-def _starts(data: IOData, arx: ARX, par: ModalParametrization) -> np.ndarray:
-    """Each output's least-squares denominator, in modal coordinates: a
-    sensor's own estimate of the shared modes."""
+def _starts(cost: SharedProjectedCost, par: ModalParametrization) -> np.ndarray:
+    """Each output's least-squares denominator (of its record with the
+    input summed for its integrators), in modal coordinates: a sensor's own
+    estimate of the shared modes."""
     from ..models.arx import arx_least_squares
 
+    arx = cost.arx
     return np.array(
         [
-            _coordinates(arx_least_squares(data.output(i), arx)[: arx.na], par, arx)
-            for i in range(data.n_outputs)
+            _coordinates(arx_least_squares(part.data, arx)[: arx.na], par, arx)
+            for part in cost.parts
         ]
     )
 
@@ -189,6 +234,7 @@ def identify_shared(
     n_points: int = 50,
     max_nfev: int = 10_000,
     weights=None,
+    integrator=0,
     max_time_constant: float | str | None = AUTO,
 ) -> SharedDenominatorModel:
     """One denominator for every output of `data`.
@@ -217,6 +263,11 @@ def identify_shared(
         ``lambda_i`` of the joint cost; default estimated: a first fit in
         each output's scale, then ``1 / sigma_i^2`` from its residuals
         (module docstring).
+    integrator : int or sequence of int
+        Known integrators (poles at ``z = 1``) of every output, or of each:
+        ``(2, 1, 0, 0)`` for the rig's hub angle, hub velocity, end-point
+        acceleration and tip deflection. They are outside the shared ``A``:
+        ``arx.na`` counts the shared poles only.
     max_time_constant : float, "auto" or None
         The stability margin, as :func:`~spiralid.sysid.identify`'s:
         ``"auto"`` keeps every pole's time constant within the record.
@@ -237,15 +288,15 @@ def identify_shared(
         )
     n_points = integer(n_points, "n_points", 2)
     max_nfev = integer(max_nfev, "max_nfev", n_points)
-    first = SharedProjectedCost(arx, data, None if weights is None else weights)
+    first = SharedProjectedCost(arx, data, weights, integrator)
     if method == "ls":
-        theta = joint_least_squares(data, arx, first.weights)
+        theta = joint_least_squares(_parts_record(first), arx, first.weights)
         a, b = theta[: arx.na], theta[arx.na :].reshape(data.n_outputs, arx.nb)
         return _model(data, arx, "ls", first, a, b, None, {"elapsed": 0.0}, t0)
     par = ModalParametrization(
         arx.na, data.ts, max_radius=_radius(data, max_time_constant)
     )
-    starts = _starts(data, arx, par)
+    starts = _starts(first, par)
     if method == "spiral":
         raw = _search(first, par, starts, n_points, max_nfev, rng)
         z, result = (
@@ -258,7 +309,8 @@ def identify_shared(
             },
         )
     else:
-        joint = joint_least_squares(data, arx, first.weights)[: arx.na]
+        joint = joint_least_squares(_parts_record(first), arx, first.weights)
+        joint = joint[: arx.na]
         budget = _POLISH_NFEV * (arx.na + 1)
         polished = [
             gauss_newton_polish(first, par, x, budget)
@@ -319,7 +371,7 @@ def _weighted_polish(first, par, z, data, arx, reweight: bool, starts):
         sigma2 = np.array([part.sse(a) for part in first.parts]) / data.n
         new = 1.0 / np.maximum(sigma2, 1e-300)
         settled = cost is not first and np.allclose(new, cost.weights, rtol=0.1)
-        cost = SharedProjectedCost(arx, data, new)
+        cost = cost.reweighted(new)
         z = gauss_newton_polish(cost, par, z, budget).x
         if settled:
             break
@@ -344,14 +396,23 @@ def _model(data, arx, method, cost, a, b, covariance, result, t0):
         weights=cost.weights,
         costs=cost.per_output(a) if is_stable_polynomial(a) else None,
         covariance=covariance,
+        integrators=cost.integrators,
         result=result,
     )
 
 
-def joint_least_squares(data: IOData, arx: ARX, weights=None) -> np.ndarray:
+def _parts_record(cost: SharedProjectedCost) -> list[IOData]:
+    """Each output's record as its part of `cost` sees it (the input summed
+    for its integrators)."""
+    return [part.data for part in cost.parts]
+
+
+def joint_least_squares(data, arx: ARX, weights=None) -> np.ndarray:
     """``[a, b_1, .., b_p]``: least squares of every output's equation error
     ``y_i(t) + sum_k a_k y_i(t-k) - sum_j b_ij u(t-nk-j)`` with one ``a``,
-    each output's rows weighted by ``sqrt(lambda_i)``.
+    each output's rows weighted by ``sqrt(lambda_i)``. `data` is a record
+    of several outputs, or a list of single-output records (one per output,
+    each with its own input).
 
     Examples
     --------
@@ -364,11 +425,15 @@ def joint_least_squares(data: IOData, arx: ARX, weights=None) -> np.ndarray:
     >>> theta.round(9).tolist()
     [-0.5, 1.0, 0.0, 2.0, 1.0]
     """
-    p = data.n_outputs
+    records = (
+        [data.output(i) for i in range(data.n_outputs)]
+        if isinstance(data, IOData)
+        else list(data)
+    )
+    p = len(records)
     weights = np.ones(p) if weights is None else np.asarray(weights, dtype=float)
     blocks, rhs = [], []
-    for i in range(p):
-        one = data.output(i)
+    for i, one in enumerate(records):
         phi = arx.regressors(one)[arx.max_lag :]
         w = np.sqrt(weights[i])
         row = np.zeros((phi.shape[0], arx.na + p * arx.nb))

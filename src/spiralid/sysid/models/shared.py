@@ -24,7 +24,7 @@ from scipy import signal
 from .arx import ARX
 from .identified import IdentifiedModel
 from .modes import ModeTable, mode_table
-from .polynomials import is_stable_polynomial, max_pole_radius
+from .polynomials import is_stable_polynomial, max_pole_radius, with_integrator
 
 __all__ = ["SharedDenominatorModel", "SharedModes"]
 
@@ -41,7 +41,9 @@ class SharedModes:
         those of the output where the mode is strongest.
     share : ndarray, shape (m, p)
         Each mode's resonant peak as a share of each output's (a column per
-        output, :attr:`ModeTable.share` of ``B_i / A``).
+        output, :attr:`ModeTable.share` of ``B_i / A``: after the output's
+        known integrators are taken out, whose poles at ``z = 1`` would
+        hold an infinite peak).
     output_names : tuple of str
     """
 
@@ -116,6 +118,9 @@ class SharedDenominatorModel:
     covariance : ndarray, shape (na, na), or None
         The covariance of ``a`` (variable projection: the numerators
         projected out), for the modes' intervals.
+    integrators : tuple of int
+        Each output's known integrators, poles at ``z = 1`` outside the
+        shared ``A``: output ``i`` is ``B_i / (A (1 - z^-1)^k_i)``.
     result : dict
         What the estimator reports (budget, messages, timings).
     """
@@ -135,6 +140,7 @@ class SharedDenominatorModel:
     weights: np.ndarray | None = None
     costs: np.ndarray | None = None
     covariance: np.ndarray | None = None
+    integrators: tuple[int, ...] = ()
     result: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -154,20 +160,34 @@ class SharedDenominatorModel:
             )
         self.output_units = tuple(self.output_units) or ("",) * p
         self.y_offsets = tuple(float(v) for v in self.y_offsets) or (0.0,) * p
+        self.integrators = tuple(int(k) for k in self.integrators) or (0,) * p
+        if len(self.integrators) != p or min(self.integrators) < 0:
+            raise ValueError(
+                f"`integrators` must be {p} counts >= 0 (one per output); got "
+                f"{self.integrators}"
+            )
 
     @property
     def n_outputs(self) -> int:
         return int(self.b.shape[0])
 
     def theta(self, i: int) -> np.ndarray:
-        """Output `i`'s ARX theta ``[a, b_i]``."""
-        return np.r_[self.a, self.b[i]]
+        """Output `i`'s ARX theta ``[a, b_i]`` with its known integrators in
+        the denominator (the structure of :meth:`output_arx`)."""
+        return np.r_[with_integrator(self.a, self.integrators[i]), self.b[i]]
+
+    def output_arx(self, i: int) -> ARX:
+        """Output `i`'s structure: the shared poles and its integrators."""
+        return ARX(self.arx.na + self.integrators[i], self.arx.nb, self.arx.nk)
 
     def simulate(self, u) -> np.ndarray:
         """Free run of every output from rest, shape (N, p)."""
         u = np.asarray(getattr(u, "u", u), dtype=float)
         return np.column_stack(
-            [self.arx.simulate(self.theta(i), u) for i in range(self.n_outputs)]
+            [
+                self.output_arx(i).simulate(self.theta(i), u)
+                for i in range(self.n_outputs)
+            ]
         )
 
     def output_model(self, which: int | str) -> IdentifiedModel:
@@ -178,7 +198,8 @@ class SharedDenominatorModel:
         i = which if isinstance(which, int) else self.output_names.index(which)
         return IdentifiedModel(
             self.theta(i),
-            arx=self.arx,
+            arx=self.output_arx(i),
+            integrator=self.integrators[i],
             ts=self.ts,
             method=self.method,
             cost=float(self.costs[i]) if self.costs is not None else float("nan"),
@@ -227,7 +248,17 @@ class SharedDenominatorModel:
             raise ImportError(
                 'to_control() needs python-control: pip install "spiralid[control]"'
             ) from None
-        polys = [self.arx.polynomials(self.theta(i)) for i in range(self.n_outputs)]
+        # Over the common denominator A (1 - z^-1)^kmax: each numerator times
+        # the integrators its output lacks.
+        kmax = max(self.integrators)
+        common = ARX(self.arx.na + kmax, self.arx.nb + kmax, self.arx.nk)
+        rows = []
+        for i, k in enumerate(self.integrators):
+            extra = np.convolve(self.b[i], np.r_[1.0, with_integrator([], kmax - k)])
+            extra = np.r_[extra, np.zeros(common.nb - extra.size)]
+            theta = np.r_[with_integrator(self.a, kmax), extra]
+            rows.append(common.polynomials(theta))
+        polys = rows
         num = np.array([n for n, _ in polys])
         # Leading zero columns (the delay nk) are a strictly proper system's:
         # left in, scipy warns of badly conditioned coefficients.
@@ -254,6 +285,7 @@ class SharedDenominatorModel:
             "costs": None if self.costs is None else [_plain(c) for c in self.costs],
             "weights": None if self.weights is None else self.weights.tolist(),
             "covariance": None if self.covariance is None else self.covariance.tolist(),
+            "integrators": list(self.integrators),
             "modes": self.modes.to_dict(),
         }
 
@@ -286,6 +318,7 @@ class SharedDenominatorModel:
             costs=array("costs"),
             weights=array("weights"),
             covariance=array("covariance"),
+            integrators=tuple(d.get("integrators") or ()),
         )
 
     def __repr__(self) -> str:
