@@ -180,3 +180,35 @@ def test_each_output_has_its_own_known_integrators():
     np.testing.assert_allclose(again.simulate(u[:50]), fit.simulate(u[:50]))
     with pytest.raises(ValueError, match="`integrator` must be one count or one per"):
         identify(data, ARX(4, 4, 1), integrator=(1, 0, 0))
+
+
+def test_the_stabilisation_diagram_keeps_the_true_modes_and_flags_the_rest():
+    from spiralid.sysid import stabilisation
+    from spiralid.sysid.validation.stabilisation import _classify
+
+    # The rule by hand: 1 % in frequency, 5 % in damping.
+    prev_f, prev_z = np.array([10.0, 30.0]), np.array([0.02, 0.05])
+    assert _classify(prev_f, prev_z, 10.05, 0.0205, 0.01, 0.05) == "stable"
+    assert _classify(prev_f, prev_z, 10.05, 0.03, 0.01, 0.05) == "frequency"
+    assert _classify(prev_f, prev_z, 20.0, 0.02, 0.01, 0.05) == "new"
+    diagram = stabilisation(_record(8), [4, 6, 8], nk=1, rng=0, max_nfev=1500)
+    assert diagram.orders == (4, 6, 8)
+    stable = diagram.stable_modes(min_orders=3)
+    np.testing.assert_allclose(stable, [f for f, _ in MODES], rtol=1e-3)
+    first = diagram.status[diagram.order == 4]
+    assert set(first) == {"new"}  # nothing below the first order
+    assert diagram.to_dict()["modes"][0]["order"] == 4
+    with pytest.raises(ValueError, match="`orders` must be"):
+        stabilisation(_record(8), [0, 2])
+
+
+def test_the_stabilisation_figure_draws_every_mode():
+    from spiralid.sysid import plots, stabilisation
+
+    data = _record(9)
+    diagram = stabilisation(data, [4, 6], nk=1, rng=0, max_nfev=800)
+    fig = plots.plot_stabilisation(diagram, data)
+    ax = fig.axes[0]
+    drawn = sum(len(line.get_xdata()) for line in ax.lines)
+    assert drawn == diagram.frequency.size
+    assert ax.get_xlabel() == "frequency (Hz)" and ax.get_title()

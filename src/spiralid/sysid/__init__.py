@@ -48,6 +48,8 @@ from .validation.selection import choose as choose
 from .validation.selection import choose_order as choose_order
 from .validation.selection import fits_by_order as fits_by_order
 from .validation.selection import knee_point as knee_point
+from .validation.stabilisation import StabilisationDiagram as StabilisationDiagram
+from .validation.stabilisation import stabilisation as stabilisation
 from .validation.validate import Realization as Realization
 from .validation.validate import Validation as Validation
 from .validation.validate import fit_percent as fit_percent
@@ -74,6 +76,7 @@ __all__ = [
     "Realization",
     "SharedDenominatorModel",
     "SharedModes",
+    "StabilisationDiagram",
     "Validation",
     "arx_least_squares",
     "billings_voon",
@@ -97,6 +100,7 @@ __all__ = [
     "psd",
     "random_stable_polynomial",
     "realization_tests",
+    "stabilisation",
     "steiglitz_mcbride",
     "step_down",
     "step_up",

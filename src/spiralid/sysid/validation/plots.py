@@ -17,12 +17,14 @@ from spiralid._checks import positive
 
 from ..spectra import PSD, Modes, Peaks
 from .correlation import CorrelationTest
+from .mode_plots import plot_stabilisation
 
 __all__ = [
     "plot_convergence",
     "plot_pole_zero",
     "plot_psd",
     "plot_residual_tests",
+    "plot_stabilisation",
     "plot_time_response",
     "plot_validations",
 ]
