@@ -212,3 +212,13 @@ def test_the_stabilisation_figure_draws_every_mode():
     drawn = sum(len(line.get_xdata()) for line in ax.lines)
     assert drawn == diagram.frequency.size
     assert ax.get_xlabel() == "frequency (Hz)" and ax.get_title()
+
+
+def test_the_search_never_ends_above_output_error():
+    # The spiral's best is polished beside output error's starts, and the
+    # lowest cost kept (before the noise weights, which both then share).
+    for seed in range(3):
+        data = _record(20 + seed, noise=(0.01, 0.004))
+        spiral = identify(data, ARX(4, 4, 1), rng=seed, max_nfev=300, weights=[1, 1])
+        oe = identify(data, ARX(4, 4, 1), method="oe", weights=[1, 1])
+        assert spiral.cost <= oe.cost * (1 + 1e-12)

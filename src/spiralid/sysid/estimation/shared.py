@@ -250,9 +250,11 @@ def identify_shared(
         ``"spiral"``: the spiral search over the shared modes (Eb-SDA over
         the modal coordinates, Gauss-Newton polish every 5 iterations,
         restarts after 20 stalled ones, first points at each output's
-        least-squares denominator), then polished. ``"oe"``: output error,
-        the same polish from each output's least-squares denominator and
-        the joint least-squares one, the lowest cost kept (no search).
+        least-squares denominator), its best then polished beside output
+        error's starts and the lowest cost kept, so it never ends above
+        output error. ``"oe"``: output error, the same polish from each
+        output's least-squares denominator and the joint least-squares one,
+        the lowest cost kept (no search).
         ``"ls"``: least squares of the equation error of every output with
         one ``A`` (the joint ARX estimate; its poles may be unstable).
     rng : int, Generator or None
@@ -297,31 +299,29 @@ def identify_shared(
         arx.na, data.ts, max_radius=_radius(data, max_time_constant)
     )
     starts = _starts(first, par)
+    joint = joint_least_squares(_parts_record(first), arx, first.weights)
+    # Output error: the polish from each output's and the joint least-squares
+    # denominators. The search adds its own best to them, so it never ends
+    # above output error (the single-output "spiral"'s safe start).
+    points = [*starts, _coordinates(joint[: arx.na], par, arx)]
+    result = {
+        "message": "Output error from each output's and the joint "
+        "least-squares denominators; the lowest cost kept."
+    }
     if method == "spiral":
         raw = _search(first, par, starts, n_points, max_nfev, rng)
-        z, result = (
-            raw.z,
-            {
-                "nfev": int(raw.nfev),
-                "nit": int(raw.nit),
-                "n_restarts": int(raw.n_restarts),
-                "message": str(raw.message),
-            },
-        )
-    else:
-        joint = joint_least_squares(_parts_record(first), arx, first.weights)
-        joint = joint[: arx.na]
-        budget = _POLISH_NFEV * (arx.na + 1)
-        polished = [
-            gauss_newton_polish(first, par, x, budget)
-            for x in (*starts, _coordinates(joint, par, arx))
-        ]
-        z = min(polished, key=lambda r: r.fun).x
+        points.insert(0, raw.z)
         result = {
-            "message": "Output error from each output's and the joint "
-            "least-squares denominators; the lowest cost kept."
+            "nfev": int(raw.nfev),
+            "nit": int(raw.nit),
+            "n_restarts": int(raw.n_restarts),
+            "message": f"{raw.message} Then polished beside output error from "
+            "the least-squares denominators; the lowest cost kept.",
         }
-    cost, z = _weighted_polish(first, par, z, data, arx, weights is None, starts)
+    budget = _POLISH_NFEV * (arx.na + 1)
+    polished = [gauss_newton_polish(first, par, x, budget) for x in points]
+    z = min(polished, key=lambda r: r.fun).x
+    cost, z = _weighted_polish(first, par, z, data, arx, weights is None)
     a = par.to_denominator(z)
     cov = _covariance(cost, a, data, arx)
     return _model(data, arx, method, cost, a, cost.numerators(a), cov, result, t0)
@@ -356,12 +356,10 @@ def _search(cost, par, starts, n_points, max_nfev, rng):
     )
 
 
-def _weighted_polish(first, par, z, data, arx, reweight: bool, starts):
-    """Gauss-Newton from `z` (and, for output error, from every start),
-    then the noise weights re-estimated and polished again until they
-    settle; the cost used last and the coordinates."""
+def _weighted_polish(first, par, z, data, arx, reweight: bool):
+    """The noise weights re-estimated at `z` and the fit polished again
+    until they settle; the cost used last and the coordinates."""
     budget = _POLISH_NFEV * (arx.na + 1)
-    z = gauss_newton_polish(first, par, z, budget).x
     cost = first
     for _ in range(_REWEIGHTS if reweight else 0):
         # Each output's residual variance at the current fit is its noise
