@@ -222,3 +222,29 @@ def test_the_search_never_ends_above_output_error():
         spiral = identify(data, ARX(4, 4, 1), rng=seed, max_nfev=300, weights=[1, 1])
         oe = identify(data, ARX(4, 4, 1), method="oe", weights=[1, 1])
         assert spiral.cost <= oe.cost * (1 + 1e-12)
+
+
+def test_a_sensor_at_a_node_of_a_mode_still_gets_that_mode_from_the_others():
+    # Sensor "node" sits at a node of the 11 Hz mode: its numerator holds
+    # that mode's pole pair (a zero pair on it), so its own response barely
+    # shows the mode; sensor "near" sees both.
+    poles = np.roots(A)
+    upper = poles[poles.imag > 0]
+    eleven = upper[np.argmax(np.abs(np.angle(upper)))]
+    zeros = np.poly([eleven, np.conj(eleven)]).real
+    node = np.convolve([0.0, 0.02, 0.01], zeros)
+    rng = np.random.default_rng(11)
+    u = rng.standard_normal(1500)
+    y = np.column_stack([signal.lfilter(B[0], A, u), signal.lfilter(node, A, u)])
+    y += rng.standard_normal(y.shape) * np.array([0.004, 0.001])
+    data = IOData(u, y, ts=TS, output_name=("near", "node"))
+    shared = identify(data, ARX(4, 4, 1), rng=0, max_nfev=2000)
+    alone = identify(data.output("node"), ARX(4, 4, 1), rng=0, max_nfev=2000)
+
+    def error_at_11_hz(table):
+        return np.min(np.abs(table.frequency - 11.0)) / 11.0 if len(table) else 1.0
+
+    assert error_at_11_hz(shared.modes.table) < 0.005
+    share = shared.modes.share[np.argmin(np.abs(shared.modes.table.frequency - 11))]
+    assert share[1] < share[0] / 10  # the node sensor barely sees it
+    assert error_at_11_hz(alone.modes) > 0.005
