@@ -63,7 +63,9 @@ from rest over the whole record, scored on the last third), median wall
 time per identification, and the machine load.
 
 Scaling with the order (``--scaling``): ``spiral`` (default budget, seeds
-0..``--seeds``-1), OE and LS at ARX(n, n, 0) for n in ``--orders``
+0..``--seeds``-1, ``stop`` from ``--stop``: ``converged``, its default, or
+``budget``, the whole budget as before), OE and LS at ARX(n, n, 0) for n in
+``--orders``
 (default 2, 4, 8, 12, 16, 24, 32) on ``rig`` and ``rig-8000``; median time,
 cost as a ratio to OE's, spiral's time as a ratio to OE's, and the growth
 exponent ``k`` of ``time ~ n^k`` fitted by least squares on log-log over
@@ -389,10 +391,10 @@ def summarise(rows, records, methods):
 
 
 def scaling_one(task):
-    record, order, method, seed = task
+    record, order, method, seed, stop = task
     est, _ = load_record(record).split(2 / 3)
     arx = ARX(order, order, 0)
-    kw = {"rng": seed} if method == "spiral" else {}
+    kw = {"rng": seed, "stop": stop} if method == "spiral" else {}
     t0 = time.perf_counter()
     fit = identify(est, arx, method=method.lower(), **kw)
     return dict(record=record, order=order, method=method, seed=seed,
@@ -450,14 +452,16 @@ def scaling(args) -> None:
         for method, seeds in (("LS", 1), ("OE", 1), ("spiral", args.seeds))
         for seed in range(seeds)
     ]
-    scaling_one(("rig", 8, "spiral", 0))  # warm the compiled kernels
+    tasks = [(*task, args.stop) for task in tasks]
+    scaling_one(("rig", 8, "spiral", 0, args.stop))  # warm the compiled kernels
     load0 = os.getloadavg()
     t0 = time.perf_counter()
     # One worker: the times are the point, and two would share the cores.
     rows = [scaling_one(task) for task in tasks]
     print(summarise_scaling(rows, records, orders))
     print(
-        f"\n{len(tasks)} identifications in {time.perf_counter() - t0:.0f} s; "
+        f"\nspiral with stop={args.stop!r}; "
+        f"{len(tasks)} identifications in {time.perf_counter() - t0:.0f} s; "
         f"load average at start {load0[0]:.2f}, at end {os.getloadavg()[0]:.2f}"
     )
 
@@ -488,6 +492,13 @@ def main(argv=None):
     )
     ap.add_argument("--orders", default=",".join(map(str, SCALING_ORDERS)),
                     help="orders of the scaling table")  # fmt: skip
+    ap.add_argument(
+        "--stop",
+        default="converged",
+        choices=("converged", "budget"),
+        help="the scaling table's spiral stop (its default 'converged', or the "
+        "whole budget)",
+    )
     args = ap.parse_args(argv)
     if args.scaling:
         scaling(args)

@@ -75,6 +75,9 @@ def test_the_default_records_its_choice_among_its_whole_record_minima():
     assert fit.result.get("fun_full", fit.cost) == pytest.approx(chosen["cost"])
     assert IdentifiedModel.from_dict(fit.to_dict()).selection == sel
     assert validate(fit, val, warmup=est).choice == sel["note"]
+    # Only distinct minima are refitted and scored (one alone is not).
+    held = [c["held_back_rms"] for c in sel["candidates"]]
+    assert all((h is None) == (len(held) == 1) for h in held)
 
 
 def test_holdback_none_chooses_by_the_cost_and_bad_shares_are_refused():
@@ -91,3 +94,20 @@ def test_a_record_too_short_to_hold_back_is_chosen_by_cost_and_says_so():
     fit = identify(est, ARX(4, 4, 1), rng=0, max_nfev=500)
     assert fit.selection is None
     assert "too short to hold back" in fit.result.message
+
+
+def test_a_single_minimum_is_chosen_without_a_refit():
+    # One distinct minimum leaves nothing to choose: it is not refitted or
+    # scored (held_back_rms None), and the note says so in words.
+    theta = np.array([-1.5, 0.8, 0.5, 0.3])
+    only = heldback.Candidate("ls", theta, None, theta, 1.0)
+    assert heldback.select([only]) == ("ls", "ls")
+    sel = heldback.Selection(0.2, 100, [only], "ls", "ls")
+    assert sel.to_dict()["candidates"][0]["held_back_rms"] is None
+    assert sel.sentence().startswith("1 distinct minimum")
+
+
+def test_the_refits_are_capped_by_the_order():
+    assert heldback.refit_nfev(8) == heldback.REFIT_NFEV * 9
+    # A quarter of a full polish's default, 100 (p + 1).
+    assert heldback.REFIT_NFEV == 25

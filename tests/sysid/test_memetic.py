@@ -6,7 +6,11 @@ from scipy.signal import lfilter
 
 from spiralid.optim import Restarts
 from spiralid.sysid import ARX, IOData
-from spiralid.sysid.estimation.memetic import frequency_seeds, projected_spiral
+from spiralid.sysid.estimation.memetic import (
+    PatientRestarts,
+    frequency_seeds,
+    projected_spiral,
+)
 from spiralid.sysid.estimation.modal import ModalParametrization
 from spiralid.sysid.estimation.varpro import ProjectedCost
 
@@ -69,3 +73,31 @@ def test_frequency_seeds_sit_at_the_modes():
     assert np.all((seeds >= par.bounds[:, 0]) & (seeds <= par.bounds[:, 1]))
     # Within about a resolution cell (fs / nperseg) of the true modes.
     assert np.abs(np.sort(seeds[:, :2], axis=1) - [12.0, 40.0]).max() < 2.0
+
+
+def test_patience_stops_once_a_restart_finds_no_lower_basin():
+    data, _ = _two_modes(noise=0.05)
+    cost = ProjectedCost(ARX(4, 3, 1), data)
+    par = ModalParametrization(4, data.ts)
+    kw = PLAIN | dict(max_nfev=20_000, polish_every=5, rng=3)
+    full = projected_spiral(
+        cost, par, "ebsda", **kw | dict(restarts=Restarts(growth=1, stall=10))
+    )
+    patient = PatientRestarts(growth=1, stall=10, patience=1)
+    early = projected_spiral(cost, par, "ebsda", **kw | dict(restarts=patient))
+    assert full.status == 1 and not full.converged
+    assert early.converged and early.status == 0 and "Converged" in early.message
+    assert early.nfev < full.nfev
+    # The last population ended no lower than the best before it (by rtol),
+    # and every earlier one lowered it: the first is always a new basin.
+    ends = np.array([c for _, c in early.populations])
+    assert ends[-1] >= ends[:-1].min() * (1 - 1e-6)
+    assert np.all(np.diff(np.minimum.accumulate(ends[:-1])) < 0)
+    # A stop at convergence still polishes the best at the end.
+    assert early.fun <= ends.min()
+
+
+def test_patience_is_checked():
+    for bad, match in ((dict(patience=0), "`patience`"), (dict(rtol=0), "`rtol`")):
+        with pytest.raises(ValueError, match=match):
+            PatientRestarts(**bad)

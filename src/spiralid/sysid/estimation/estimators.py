@@ -328,12 +328,17 @@ def _estimate_ls(problem: Problem) -> EstimatorResult:
 
 
 def _polish(
-    problem: Problem, starts: dict[str, np.ndarray], predictor: str, cost: PaperCost
+    problem: Problem,
+    starts: dict[str, np.ndarray],
+    predictor: str,
+    cost: PaperCost,
+    max_nfev: int | None = None,
 ) -> EstimatorResult:
     """Levenberg-Marquardt from every start; keep the lowest `cost` (ties:
     the first start). The simulation error is not convex, so each start may
     stop in a different local minimum; the choice is on the estimation cost,
-    never on validation data."""
+    never on validation data. `max_nfev` caps each polish (None:
+    :func:`~spiralid.sysid.estimation.outputerror.local_polish`'s own)."""
     t0 = time.perf_counter()
     best = None
     costs, thetas = {}, {}
@@ -344,6 +349,7 @@ def _polish(
             problem.data,
             predictor,
             problem.initial,
+            max_nfev=max_nfev,
             max_radius=problem.max_radius,
         )
         costs[name] = float(cost(theta))
@@ -573,6 +579,9 @@ def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
 # (docs/design-notes.md, "method='spiral'").
 SPIRAL_RESTARTS = Restarts(growth=1.0, stall=20)
 
+# The spiral method's stops (`stop`): the first is the default.
+SPIRAL_STOPS = ("converged", "budget")
+
 
 def _estimate_recommended(
     problem: Problem,
@@ -585,6 +594,7 @@ def _estimate_recommended(
     restarts: bool | Restarts = SPIRAL_RESTARTS,
     frequency_seeds: int = 0,
     holdback: float | None = HOLDBACK,
+    stop: str = "converged",
     x0=None,
     max_iter: int | None = None,
     callback=None,
@@ -624,6 +634,16 @@ def _estimate_recommended(
     stability margin (``max_time_constant``). Default budget ``max_nfev =
     10_000`` evaluations of the search, its polish steps included
     (``benchmarks/identification.py`` measures what each ingredient does).
+
+    `stop` says when the search ends: ``"converged"`` (the default) as soon
+    as a fresh population (a restart) stalls without lowering the best cost
+    by more than 1e-6 of it, i.e. it fell back into a basin already found
+    or a worse one, or at the budget if that comes first
+    (:class:`~spiralid.sysid.estimation.memetic.PatientRestarts` with
+    ``patience=1``; ``result.raw.converged`` says which); ``"budget"``
+    spends the whole budget, as before (restarts drawn uniformly in the
+    box rarely beat the first population, which holds the safe starts:
+    ``benchmarks/identification.py --scaling`` measures both).
     An FIR structure (``na = 0``) has no modes: its cost is quadratic in the
     numerator and the exact minimiser is returned without a search.
     """
@@ -649,6 +669,11 @@ def _estimate_recommended(
         )
     holdback = _holdback_share(holdback)
     restarts = _spiral_restarts(restarts)
+    if stop not in SPIRAL_STOPS:
+        raise ValueError(
+            f"`stop` of method 'spiral' must be one of {', '.join(SPIRAL_STOPS)};"
+            f" got {stop!r}"
+        )
     if frequency_seeds:
         frequency_seeds = integer(frequency_seeds, "frequency_seeds", 0)
     settings = dict(
@@ -657,7 +682,7 @@ def _estimate_recommended(
         max_nfev=10_000 if max_nfev is None else max_nfev,
         polish_every=polish_every,
         polish_nfev=polish_nfev,
-        restarts=restarts,
+        restarts=_patient(restarts) if stop == "converged" else restarts,
         frequency_seeds=frequency_seeds,
         x0=x0,
         max_iter=max_iter,
@@ -699,6 +724,19 @@ def _spiral_restarts(restarts) -> Restarts | None:
     return parsed
 
 
+def _patient(restarts: Restarts | None):
+    """`restarts` that also stop the search once a population finds no
+    lower basin (``stop="converged"``); without restarts there is no second
+    population to judge by, and the budget stays the only stop."""
+    from .memetic import PatientRestarts
+
+    if restarts is None:
+        return None
+    return PatientRestarts(
+        growth=restarts.growth, tol_radius=restarts.tol_radius, stall=restarts.stall
+    )
+
+
 def _holdback_share(holdback) -> float:
     """`holdback` checked: a share in [0, 0.5), None being 0."""
     if holdback is None:
@@ -729,16 +767,23 @@ def _choose_held_back(
     if not result.refine.accepted:
         # The search's own best undercut its polish: that is the minimum.
         minima["search"], costs["search"] = result.x, result.fun
-    part = problem.restricted(problem.data[:start])
-    found = []
-    for name, theta in minima.items():
-        # A local refit without the held-back end stays in the minimum's
-        # basin: the held-back error then judges the basin, not the data it
-        # was fitted to.
-        refit = _polish(part, {name: theta}, part.predictor, part.cost)
-        held = heldback.held_back_rms(refit.x, problem.cost, start)
-        found.append(heldback.Candidate(name, refit.x, held, theta, costs[name]))
+    # The distinct minima first: starts that ended in one minimum need one
+    # refit, and a single minimum leaves nothing to choose (no refit).
+    found = [
+        heldback.Candidate(name, theta, None, theta, costs[name])
+        for name, theta in minima.items()
+    ]
     candidates = heldback.distinct(found, problem.cost)
+    if len(candidates) > 1:
+        part = problem.restricted(problem.data[:start])
+        nfev = heldback.refit_nfev(problem.arx.n_params)
+        for c in candidates:
+            # A local refit without the held-back end stays in the minimum's
+            # basin: the held-back error then judges the basin, not the data
+            # it was fitted to.
+            refit = _polish(part, {c.name: c.theta}, part.predictor, part.cost, nfev)
+            c.theta_part = refit.x
+            c.held_rms = heldback.held_back_rms(refit.x, problem.cost, start)
     chosen, lowest = heldback.select(candidates)
     selection = heldback.Selection(
         holdback, problem.data.n - start, candidates, chosen, lowest

@@ -29,7 +29,16 @@ import numpy as np
 from ..data import IOData
 from .cost import PaperCost
 
-__all__ = ["HOLDBACK", "MARGIN", "Candidate", "Selection", "held_back_rms", "select"]
+__all__ = [
+    "HOLDBACK",
+    "MARGIN",
+    "REFIT_NFEV",
+    "Candidate",
+    "Selection",
+    "held_back_rms",
+    "refit_nfev",
+    "select",
+]
 
 #: The recommended method's default share of the estimation record held back
 #: (as NARX's early stopping holds back 0.2).
@@ -42,16 +51,27 @@ HOLDBACK = 0.2
 #: too short to tell minima apart.
 MARGIN = 0.05
 
+#: Each refit on the first part is capped at this many evaluations per
+#: parameter (and one): it starts at a minimum of the whole record, which
+#: moves little when a fifth of the record is left out, and it only has to
+#: tell basins apart by more than MARGIN, not reach the part's tolerances.
+#: Uncapped refits (``100 (p + 1)``, the polish's default) took longer than
+#: output error itself at ARX(32, 32, 0); measured in
+#: ``benchmarks/selection.py`` and ``benchmarks/drift.py``.
+REFIT_NFEV = 25
+
 
 @dataclass
 class Candidate:
     """One distinct minimum: where it came from, its local refit on the
     first part and that refit's held-back RMS error, and the whole-record
-    fit with its cost."""
+    fit with its cost. A minimum found alone is not refitted (there is
+    nothing to choose): ``held_rms`` None and ``theta_part`` its
+    whole-record fit."""
 
     name: str
     theta_part: np.ndarray
-    held_rms: float
+    held_rms: float | None
     theta: np.ndarray
     cost: float
 
@@ -150,11 +170,19 @@ def distinct(candidates: list[Candidate], cost: PaperCost) -> list[Candidate]:
     return kept
 
 
+def refit_nfev(n_params: int) -> int:
+    """The evaluation cap of each held-back refit, :data:`REFIT_NFEV` per
+    parameter and one, a quarter of a full polish's default."""
+    return REFIT_NFEV * (n_params + 1)
+
+
 def select(candidates: list[Candidate]) -> tuple[str, str]:
     """``(chosen, lowest_cost)``: the lowest whole-record cost, unless
     another candidate's held-back RMS is lower by more than :data:`MARGIN`
-    (then the lowest held-back RMS)."""
+    (then the lowest held-back RMS). One candidate is chosen unscored."""
     lowest = min(candidates, key=lambda c: c.cost)
+    if len(candidates) == 1:
+        return lowest.name, lowest.name
     best = min(candidates, key=lambda c: c.held_rms)
     if best.held_rms < (1.0 - MARGIN) * lowest.held_rms:
         return best.name, lowest.name

@@ -26,6 +26,7 @@ but far less than a population step).
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import signal
@@ -37,7 +38,51 @@ from ..data import IOData
 from ..spectra import PSD, default_nperseg, find_resonances
 from .varpro import ProjectedCost, gauss_newton_polish
 
-__all__ = ["frequency_seeds", "projected_spiral"]
+__all__ = ["RTOL", "PatientRestarts", "frequency_seeds", "projected_spiral"]
+
+#: A population "found a new basin" when it lowered the best cost by more
+#: than this share of it. Two runs into one minimum end within the polish's
+#: tolerances of each other (about 1e-8 of the cost); a different minimum of
+#: the simulation error differs by far more than 1e-6.
+RTOL = 1e-6
+
+
+@dataclass(frozen=True)
+class PatientRestarts(Restarts):
+    """Restarts that also end the search (:func:`projected_spiral`): once
+    ``patience`` populations in a row have stalled without lowering the
+    best cost by more than ``rtol`` of it, the search stops before its
+    budget.
+
+    Each such population fell into a basin already found (or a worse one),
+    and the restarts are drawn alike, so more of them are not expected to
+    pay. The first population counts too: with ``patience=1`` a search
+    whose first population ends at its safe start's minimum and whose first
+    restart finds nothing lower stops there. With patience a population
+    also stalls when its best falls by no more than ``rtol`` (not 1e-9)
+    over ``stall`` iterations: smaller gains are the final polish's work.
+
+    Parameters
+    ----------
+    growth, tol_radius, stall
+        As :class:`~spiralid.optim.Restarts`.
+    patience : int
+        Populations in a row without a new basin that stop the search.
+    rtol : float
+        A new basin lowers the best cost by more than this share of it
+        (default :data:`RTOL`).
+    """
+
+    patience: int = 1
+    rtol: float = RTOL
+
+    def __post_init__(self):
+        super().__post_init__()
+        object.__setattr__(self, "patience", integer(self.patience, "patience", 1))
+        rtol = float(self.rtol)
+        if not 0.0 < rtol < 1.0:
+            raise ValueError(f"`rtol` must be in (0, 1); got {self.rtol!r}")
+        object.__setattr__(self, "rtol", rtol)
 
 
 def frequency_seeds(data: IOData, parametrization, m: int, rng=None) -> np.ndarray:
@@ -134,7 +179,9 @@ def projected_spiral(
         does not count: its ever smaller steps would keep a stalled
         population alive); the best point over all populations is
         returned. ``tol_radius`` is not used (the polished centre is not a
-        collapse test). ``None``: no restarts.
+        collapse test). A :class:`PatientRestarts` also stops the search
+        before the budget once its ``patience`` populations in a row found
+        no lower basin. ``None``: no restarts.
     x0 : array_like, shape (k, na), optional
         Initial points (the rest of the population is uniform in the box).
     max_iter : int, optional
@@ -144,14 +191,17 @@ def projected_spiral(
         the result so far (``x`` in the searched coordinates); returning
         True stops the search.
     rng : int, Generator or None
-
     Returns
     -------
     OptimiserResult
         ``x`` the ARX theta ``[a, b]``, ``fun`` its cost (eq. (2)-(3)),
         ``z`` the searched coordinates, ``status`` (1: budget used, 2:
-        `max_iter`, 0: the callback), ``n_polish`` (polishes that moved the
-        centre) and the rest of :func:`~spiralid.optim.minimize`'s result.
+        `max_iter`, 0: the callback or a :class:`PatientRestarts`'
+        patience), ``n_polish`` (polishes that moved the centre),
+        ``populations`` (``(nfev, cost)`` at which each population stalled
+        or the search ended, its centre's cost), ``converged`` (whether the
+        patience stopped it) and the rest of
+        :func:`~spiralid.optim.minimize`'s result.
     """
     t_start = time.perf_counter()
     n_points = integer(n_points, "n_points", 2)
@@ -161,32 +211,55 @@ def projected_spiral(
         polish_every = integer(polish_every, "polish_every", 1)
     if restarts is not None and not isinstance(restarts, Restarts):
         raise ValueError(f"`restarts` must be a Restarts or None; got {restarts!r}")
+    patience = restarts.patience if isinstance(restarts, PatientRestarts) else None
+    rtol = restarts.rtol if patience is not None else RTOL
+    # With `patience` a population whose best falls by less than `rtol` has
+    # converged as far as the search can tell (the final polish takes it
+    # further, to its tolerances); without, only a 1e-9 fall is none.
+    progress = 1e-9 if patience is None else max(float(rtol), 1e-9)
     n_dim = parametrization.bounds.shape[0]
     max_iter = max_nfev if max_iter is None else integer(max_iter, "max_iter", 1)
     n_polish = 0
     stalled, before = 0, np.inf
+    # The best cost when the current population started, and how many
+    # populations in a row have ended without lowering it (`patience`).
+    populations: list[tuple[int, float]] = []
+    at_start, idle, converged, ended = np.inf, 0, False, False
+    tail = (0, np.inf)
 
     def fun(z):
         return cost(parametrization.to_denominator(z))
 
     def after_step(intermediate) -> bool:
-        nonlocal n_polish, stalled, before
+        nonlocal n_polish, stalled, before, at_start, idle, converged, ended, tail
         called = time.perf_counter()
         search: SpiralSearch = intermediate.search
         due = polish_every and search.nit % polish_every == 0
         if due and search.nfev + polish_nfev <= max_nfev:
             res = gauss_newton_polish(cost, parametrization, search.centre, polish_nfev)
             n_polish += search.move_centre(res.x, res.fun, nfev=res.nfev)
-        # Progress is a fall of the best cost by more than 1e-9 of it: the
-        # polish moves the centre by less at every call near a minimum, and
-        # that must not keep a stalled population alive.
-        stalled = 0 if search.fun < before * (1.0 - 1e-9) else stalled + 1
+        # Progress is a fall of the best cost by more than `progress` of it:
+        # the polish moves the centre by less at every call near a minimum,
+        # and that must not keep a stalled population alive.
+        stalled = 0 if search.fun < before * (1.0 - progress) else stalled + 1
         before = min(before, search.fun)
+        tail = (search.nfev, float(search.costs[0]))
         if restarts is not None and stalled >= restarts.stall_for(n_dim):
+            if not ended:
+                ended = True
+                populations.append((search.nfev, float(search.costs[0])))
+                # A population that ends within `rtol` of the best it
+                # started from found no new basin (the first starts from
+                # none, so it always counts as new).
+                idle = idle + 1 if search.fun >= at_start * (1.0 - rtol) else 0
+                at_start = min(at_start, search.fun)
+                if patience is not None and idle >= patience:
+                    converged = True
+                    return True
             size = restarts.next_size(search.n_points)
             if search.nfev + 2 * size - 1 <= max_nfev:
                 search.restart(size)
-                stalled = 0
+                stalled, ended = 0, False
         if callback is None:
             return False
         # The caller's callback sees the search after the polish and restart.
@@ -210,7 +283,13 @@ def projected_spiral(
         options={"bounds_policy": "clip"},
     )
     z, nfev = res.x, res.nfev
-    if polish_every and res.status != 0 and nfev + polish_nfev <= max_nfev:
+    if not ended and np.isfinite(tail[1]):
+        populations.append(tail)
+    if (
+        polish_every
+        and (res.status != 0 or converged)
+        and nfev + polish_nfev <= max_nfev
+    ):
         end = gauss_newton_polish(cost, parametrization, z, polish_nfev)
         nfev += end.nfev
         if end.fun < res.fun:
@@ -223,8 +302,15 @@ def projected_spiral(
         z=z,
         nfev=nfev,
         n_polish=n_polish,
+        populations=populations,
+        converged=converged,
         elapsed=time.perf_counter() - t_start,
     )
+    if converged:
+        res.message = (
+            f"Converged: {patience} population(s) in a row found no basin "
+            f"lower than the best by more than {rtol:g} of its cost."
+        )
     if res.history.size:
         res.history[-1] = min(res.history[-1], res.fun)
     return res
