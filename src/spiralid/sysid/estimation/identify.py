@@ -285,29 +285,6 @@ def identify(
     (array([-1.5,  0.7,  1. ,  0.5]), True, 0)
     """
     t_start = time.perf_counter()
-    if isinstance(data, IOData) and data.n_outputs > 1 and isinstance(arx, ARX):
-        return _identify_shared(
-            data,
-            arx,
-            method,
-            dict(
-                predictor=predictor,
-                initial=initial,
-                rng=rng,
-                gain=gain,
-                penalty=penalty,
-                integrator=integrator,
-                max_time_constant=max_time_constant,
-                cancel=cancel,
-                **options,
-            ),
-        )
-    single_output_record(data, "identify")
-    if not isinstance(arx, ARX | NARX | PolynomialNARX):
-        raise ValueError(
-            f"`arx` must be an ARX, NARX or PolynomialNARX; got {type(arx).__name__}"
-        )
-    method = _check_method(method)
     given = dict(
         predictor=predictor,
         initial=initial,
@@ -319,6 +296,14 @@ def identify(
         cancel=cancel,
         **options,
     )
+    if isinstance(data, IOData) and data.n_outputs > 1 and isinstance(arx, ARX):
+        return _identify_shared(data, arx, method, given)
+    single_output_record(data, "identify")
+    if not isinstance(arx, ARX | NARX | PolynomialNARX):
+        raise ValueError(
+            f"`arx` must be an ARX, NARX or PolynomialNARX; got {type(arx).__name__}"
+        )
+    method = _check_method(method)
     check_method_options(method, given, arx)
     if not isinstance(arx, ARX):
         takes = identify_options(method, arx)
