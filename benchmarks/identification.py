@@ -65,11 +65,12 @@ time per identification, and the machine load.
 Scaling with the order (``--scaling``): ``spiral`` (default budget, seeds
 0..``--seeds``-1, ``stop`` from ``--stop``: ``converged``, its default, or
 ``budget``, the whole budget as before), OE and LS at ARX(n, n, 0) for n in
-``--orders``
-(default 2, 4, 8, 12, 16, 24, 32) on ``rig`` and ``rig-8000``; median time,
-cost as a ratio to OE's, spiral's time as a ratio to OE's, and the growth
+``--orders`` (default 2, 4, 8, 12, 16, 24, 32) on ``rig`` and ``rig-8000``;
+median time, cost as a ratio to OE's (after the pole-zero cancellation,
+which both apply), spiral's time as a ratio to OE's, and the growth
 exponent ``k`` of ``time ~ n^k`` fitted by least squares on log-log over
-n >= 4.
+n >= 4. Times are the process's processor seconds (BLAS on one thread),
+which other jobs on a shared machine disturb far less than wall time.
 
 Run: ``python benchmarks/identification.py [--seeds 20] [--budget 20000]
 [--records rig,arm] [--methods spiral,OE] [--workers 2] [--jsonl runs.jsonl]``;
@@ -395,10 +396,13 @@ def scaling_one(task):
     est, _ = load_record(record).split(2 / 3)
     arx = ARX(order, order, 0)
     kw = {"rng": seed, "stop": stop} if method == "spiral" else {}
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     fit = identify(est, arx, method=method.lower(), **kw)
+    # Processor time of this one process (BLAS on one thread): on a shared
+    # machine the wall time also counts the other jobs' share of the cores.
     return dict(record=record, order=order, method=method, seed=seed,
-                cost=float(fit.cost), time=time.perf_counter() - t0)  # fmt: skip
+                cost=float(fit.cost), time=time.process_time() - c0,
+                wall=time.perf_counter() - t0)  # fmt: skip
 
 
 def growth_exponent(orders, times) -> float:
