@@ -1,7 +1,7 @@
 """The first `spiralid reproduce` after an install, and the next (prints only).
 
 Run: ``.venv/bin/python benchmarks/first_run.py`` (two runs of the command at
-its defaults: about 40 s on 2 idle cores, minutes on a loaded machine).
+its defaults; docs/results/reproduction.md gives measured times).
 
 1. The command, cold then warm. Cold: an empty ``NUMBA_CACHE_DIR``, so every
    kernel compiles as on a fresh install; warm: the same directory again,
