@@ -342,6 +342,8 @@ def _polish(
     t0 = time.perf_counter()
     best = None
     costs, thetas = {}, {}
+    # Passed only when set, so local_polish's own default stays its own.
+    cap = {} if max_nfev is None else {"max_nfev": max_nfev}
     for name, start in starts.items():
         theta, res = local_polish(
             start,
@@ -349,8 +351,8 @@ def _polish(
             problem.data,
             predictor,
             problem.initial,
-            max_nfev=max_nfev,
             max_radius=problem.max_radius,
+            **cap,
         )
         costs[name] = float(cost(theta))
         thetas[name] = theta

@@ -327,7 +327,10 @@ def identify(
 def _default_arx(data: IOData, arx: ARX, integrator: int, rng) -> np.ndarray:
     """The default method's ARX theta, a NARX's linear start: handed to
     the NARX estimator so that it does not import this module back."""
-    return identify(data, arx, integrator=integrator, rng=rng).theta
+    # The whole budget: the NARX then draws its networks from the generator
+    # where the search left it, so a stop at convergence (the same minimum,
+    # fewer draws) would change every NARX result per seed.
+    return identify(data, arx, integrator=integrator, rng=rng, stop="budget").theta
 
 
 def _problem(method: str, data: IOData, arx: ARX, given: dict):
