@@ -101,3 +101,17 @@ def test_patience_is_checked():
     for bad, match in ((dict(patience=0), "`patience`"), (dict(rtol=0), "`rtol`")):
         with pytest.raises(ValueError, match=match):
             PatientRestarts(**bad)
+
+
+def test_the_learned_metric_rule_restarts_and_stops_inside_the_spiral_method():
+    # Its search keeps its centre's cost as a float, not a population's
+    # array: the spiral method's restart and stop read it through
+    # `centre_cost` (the gallery's "no gradient" route).
+    import spiralid as sid
+
+    est = sid.datasets.robot_arm().split(2 / 3)[0]
+    fit = sid.identify(
+        est, sid.ARX(4, 4, 0), rng=0, rule="learned-metric", polish_every=None,
+        max_nfev=3000,
+    )  # fmt: skip
+    assert np.isfinite(fit.cost) and fit.result["nfev"] <= 3000

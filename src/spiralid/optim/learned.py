@@ -444,6 +444,11 @@ class LearnedMetricSearch(SearchBase):
         return self._c.copy()
 
     @property
+    def centre_cost(self) -> float:
+        """The cost of :attr:`centre`."""
+        return float(self._f)
+
+    @property
     def x(self) -> np.ndarray:
         """The best point evaluated so far."""
         return self._best[0].copy()

@@ -366,6 +366,11 @@ class SpiralSearch(SearchBase):
         """Costs of :attr:`population`."""
         return self._f.copy()
 
+    @property
+    def centre_cost(self) -> float:
+        """The cost of :attr:`centre` (the current run's best)."""
+        return float(self._f[0])
+
     def result(self, status: str = "running", elapsed: float = 0.0, target=None):
         """Package the current state as an
         :class:`~spiralid.optim.result.OptimiserResult` (see :func:`minimize`).

@@ -243,11 +243,11 @@ def projected_spiral(
         # and that must not keep a stalled population alive.
         stalled = 0 if search.fun < before * (1.0 - progress) else stalled + 1
         before = min(before, search.fun)
-        tail = (search.nfev, float(search.costs[0]))
+        tail = (search.nfev, search.centre_cost)
         if restarts is not None and stalled >= restarts.stall_for(n_dim):
             if not ended:
                 ended = True
-                populations.append((search.nfev, float(search.costs[0])))
+                populations.append((search.nfev, search.centre_cost))
                 # A population that ends within `rtol` of the best it
                 # started from found no new basin (the first starts from
                 # none, so it always counts as new).
