@@ -56,8 +56,9 @@ MARGIN = 0.05
 #: moves little when a fifth of the record is left out, and it only has to
 #: tell basins apart by more than MARGIN, not reach the part's tolerances.
 #: Uncapped refits (``100 (p + 1)``, the polish's default) took longer than
-#: output error itself at ARX(32, 32, 0); measured in
-#: ``benchmarks/selection.py`` and ``benchmarks/drift.py``.
+#: output error itself at ARX(32, 32, 0); with the cap the choices and costs
+#: were the same on ``benchmarks/selection.py``'s records (drift.py's among
+#: them; docs/results/identification.md, "How it scales with the order").
 REFIT_NFEV = 25
 
 
