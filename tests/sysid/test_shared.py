@@ -248,3 +248,14 @@ def test_a_sensor_at_a_node_of_a_mode_still_gets_that_mode_from_the_others():
     share = shared.modes.share[np.argmin(np.abs(shared.modes.table.frequency - 11))]
     assert share[1] < share[0] / 10  # the node sensor barely sees it
     assert error_at_11_hz(alone.modes) > 0.005
+
+
+def test_the_subspace_poles_are_the_true_ones_and_a_short_record_is_refused():
+    from spiralid.sysid import subspace_denominator
+
+    data = _record(30, noise=(0.0005, 0.0005))
+    a = subspace_denominator(data, 4)
+    np.testing.assert_allclose(np.sort_complex(np.roots(np.r_[1.0, a])),
+                               np.sort_complex(np.roots(A)), atol=5e-3)  # fmt: skip
+    with pytest.raises(ValueError, match="`n` = 4 needs a longer record"):
+        subspace_denominator(data[:40], 4)

@@ -15,6 +15,7 @@ from .estimation.parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
 from .estimation.parametrizations import default_bounds as default_bounds
 from .estimation.pareto import ParetoIdentification as ParetoIdentification
 from .estimation.pareto import identify_pareto as identify_pareto
+from .estimation.subspace import subspace_denominator as subspace_denominator
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.identified import IdentifiedModel as IdentifiedModel
@@ -104,6 +105,7 @@ __all__ = [
     "steiglitz_mcbride",
     "step_down",
     "step_up",
+    "subspace_denominator",
     "validate",
     "validate_outputs",
     "whiteness_test",
