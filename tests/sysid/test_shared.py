@@ -259,3 +259,22 @@ def test_the_subspace_poles_are_the_true_ones_and_a_short_record_is_refused():
                                np.sort_complex(np.roots(A)), atol=5e-3)  # fmt: skip
     with pytest.raises(ValueError, match="`n` = 4 needs a longer record"):
         subspace_denominator(data[:40], 4)
+
+
+def test_output_error_starts_from_the_subspace_poles_too():
+    from spiralid.sysid.estimation.modal import ModalParametrization
+    from spiralid.sysid.estimation.shared import SharedProjectedCost, _subspace_start
+
+    data = _record(31)
+    par = ModalParametrization(4, TS)
+    start = _subspace_start(SharedProjectedCost(ARX(4, 4, 1), data), par)
+    # The subspace poles, as modal coordinates, are the true modes.
+    np.testing.assert_allclose(
+        np.sort_complex(np.roots(np.r_[1.0, par.to_denominator(start)])),
+        np.sort_complex(np.roots(A)),
+        atol=5e-3,
+    )
+    # Outputs with different integrators have different inputs: no start.
+    mixed = SharedProjectedCost(ARX(4, 4, 1), data, integrators=(1, 0))
+    assert _subspace_start(mixed, par) is None
+    assert "subspace" in identify(data, ARX(4, 4, 1), method="oe").result["message"]

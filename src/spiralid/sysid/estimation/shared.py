@@ -201,6 +201,23 @@ def _coordinates(theta_a, par: ModalParametrization, arx: ARX) -> np.ndarray:
     return np.clip(par.from_denominator(a), box[:, 0], box[:, 1])
 
 
+def _subspace_start(cost: SharedProjectedCost, par: ModalParametrization):
+    """The subspace (PO-MOESP) poles of every output, in modal coordinates,
+    when the outputs share one input (the same integrators) and the record
+    is long enough; None otherwise."""
+    from .subspace import subspace_denominator
+
+    if len(set(cost.integrators)) != 1:
+        return None
+    summed = cost.parts[0].data.u
+    record = replace(cost.data, u=summed)
+    try:
+        a = subspace_denominator(record, cost.arx.na)
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    return _coordinates(a, par, cost.arx)
+
+
 def _starts(cost: SharedProjectedCost, par: ModalParametrization) -> np.ndarray:
     """Each output's least-squares denominator (of its record with the
     input summed for its integrators), in modal coordinates: a sensor's own
@@ -253,8 +270,11 @@ def identify_shared(
         least-squares denominator), its best then polished beside output
         error's starts and the lowest cost kept, so it never ends above
         output error. ``"oe"``: output error, the same polish from each
-        output's least-squares denominator and the joint least-squares one,
-        the lowest cost kept (no search).
+        output's least-squares denominator, the joint least-squares one and
+        the subspace poles
+        (:func:`~spiralid.sysid.estimation.subspace.subspace_denominator`,
+        when every output has the same integrators), the lowest cost kept
+        (no search).
         ``"ls"``: least squares of the equation error of every output with
         one ``A`` (the joint ARX estimate; its poles may be unstable).
     rng : int, Generator or None
@@ -301,12 +321,17 @@ def identify_shared(
     starts = _starts(first, par)
     joint = joint_least_squares(_parts_record(first), arx, first.weights)
     # Output error: the polish from each output's and the joint least-squares
-    # denominators. The search adds its own best to them, so it never ends
-    # above output error (the single-output "spiral"'s safe start).
+    # denominators and the subspace poles. The search adds its own best to
+    # them, so it never ends above output error (the single-output
+    # "spiral"'s safe start).
     points = [*starts, _coordinates(joint[: arx.na], par, arx)]
+    subspace = _subspace_start(first, par)
+    if subspace is not None:
+        points.append(subspace)
     result = {
         "message": "Output error from each output's and the joint "
-        "least-squares denominators; the lowest cost kept."
+        "least-squares denominators and the subspace poles; the lowest cost "
+        "kept."
     }
     if method == "spiral":
         raw = _search(first, par, starts, n_points, max_nfev, rng)
