@@ -111,3 +111,14 @@ def test_the_refits_are_capped_by_the_order():
     assert heldback.refit_nfev(8) == heldback.REFIT_NFEV * 9
     # A quarter of a full polish's default, 100 (p + 1).
     assert heldback.REFIT_NFEV == 25
+
+
+def test_one_minimum_is_not_said_to_validate_best():
+    # A single minimum is never scored on the held-back part, so the note
+    # must not claim it was.
+    only = heldback.Candidate("ls", np.zeros(2), None, np.zeros(2), 2.0)
+    sel = heldback.Selection(0.2, 100, [only], *heldback.select([only]))
+    assert sel.sentence() == (
+        "1 distinct minimum (output error from least squares): nothing to "
+        "choose on the held-back part"
+    )

@@ -109,10 +109,15 @@ class Selection:
         """One line for a summary: what was chosen and why."""
         by_name = {c.name: c for c in self.candidates}
         chosen, lowest = by_name[self.chosen], by_name[self.lowest_cost]
+        if len(self.candidates) == 1:
+            # Nothing was scored: every start ended in this minimum.
+            return (
+                f"1 distinct minimum ({_words(self.chosen)}): nothing to choose "
+                "on the held-back part"
+            )
         if not self.overrode_cost:
             return (
-                f"{len(self.candidates)} distinct minim"
-                f"{'um' if len(self.candidates) == 1 else 'a'}; the lowest cost "
+                f"{len(self.candidates)} distinct minima; the lowest cost "
                 f"({_words(self.chosen)}) also validates best on the held-back "
                 f"{100 * self.holdback:.0f} % of the estimation record"
             )
