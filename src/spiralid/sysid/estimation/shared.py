@@ -403,6 +403,8 @@ def _weighted_polish(first, par, z, data, arx, reweight: bool):
 
 def _model(data, arx, method, cost, a, b, covariance, result, t0):
     result = dict(result, elapsed=time.perf_counter() - t0)
+    # Least squares' poles may be unstable: no simulation cost then.
+    stable = is_stable_polynomial(a)
     return SharedDenominatorModel(
         a=a,
         b=b,
@@ -415,9 +417,9 @@ def _model(data, arx, method, cost, a, b, covariance, result, t0):
         u_offset=data.u_offset,
         y_offsets=data.y_offsets,
         method=method,
-        cost=float(cost(a)) if is_stable_polynomial(a) else float("nan"),
+        cost=float(cost(a)) if stable else float("nan"),
         weights=cost.weights,
-        costs=cost.per_output(a) if is_stable_polynomial(a) else None,
+        costs=cost.per_output(a) if stable else None,
         covariance=covariance,
         integrators=cost.integrators,
         result=result,

@@ -26,6 +26,18 @@ __all__ = ["IdentifiedModel"]
 _MAX_COEFFICIENT = 1e150
 
 
+def python_control():
+    """The python-control module, an optional dependency, or an ImportError
+    saying how to install it (the models' ``to_control``)."""
+    try:
+        import control
+    except ImportError:
+        raise ImportError(
+            'to_control() needs python-control: pip install "spiralid[control]"'
+        ) from None
+    return control
+
+
 @dataclass(eq=False)
 class IdentifiedModel:
     """An estimated ARX model with how it was obtained.
@@ -339,12 +351,7 @@ class IdentifiedModel:
         Needs python-control, an optional dependency:
         ``pip install "spiralid[control]"``.
         """
-        try:
-            import control
-        except ImportError:
-            raise ImportError(
-                'to_control() needs python-control: pip install "spiralid[control]"'
-            ) from None
+        control = python_control()
         dlti = self.to_dlti()
         return control.tf(dlti.num, dlti.den, self.ts)
 

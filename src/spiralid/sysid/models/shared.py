@@ -22,7 +22,7 @@ import numpy as np
 from scipy import signal
 
 from .arx import ARX
-from .identified import IdentifiedModel
+from .identified import IdentifiedModel, python_control
 from .modes import ModeTable, mode_table
 from .polynomials import is_stable_polynomial, max_pole_radius, with_integrator
 
@@ -242,23 +242,17 @@ class SharedDenominatorModel:
         (``dt = ts``): one state for the shared denominator, a row of ``C``
         per output (``scipy.signal.tf2ss`` of the numerators over ``A``).
         Needs python-control (``pip install "spiralid[control]"``)."""
-        try:
-            import control
-        except ImportError:
-            raise ImportError(
-                'to_control() needs python-control: pip install "spiralid[control]"'
-            ) from None
+        control = python_control()
         # Over the common denominator A (1 - z^-1)^kmax: each numerator times
         # the integrators its output lacks.
         kmax = max(self.integrators)
         common = ARX(self.arx.na + kmax, self.arx.nb + kmax, self.arx.nk)
-        rows = []
+        polys = []
         for i, k in enumerate(self.integrators):
             extra = np.convolve(self.b[i], np.r_[1.0, with_integrator([], kmax - k)])
             extra = np.r_[extra, np.zeros(common.nb - extra.size)]
             theta = np.r_[with_integrator(self.a, kmax), extra]
-            rows.append(common.polynomials(theta))
-        polys = rows
+            polys.append(common.polynomials(theta))
         num = np.array([n for n, _ in polys])
         # Leading zero columns (the delay nk) are a strictly proper system's:
         # left in, scipy warns of badly conditioned coefficients.
