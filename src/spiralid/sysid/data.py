@@ -92,11 +92,10 @@ def check_outputs(y, name: str = "y") -> np.ndarray:
     return check_signal(y, name)
 
 
-def _frozen_signal(x, name: str) -> np.ndarray:
+def _frozen(checked: np.ndarray) -> np.ndarray:
     # A private read-only copy: IOData is immutable, and freezing the
     # caller's own array instead would make it read-only behind their back.
-    check = check_outputs if name == "y" else check_signal
-    arr = np.array(check(x, name), dtype=float, order="C", copy=True)
+    arr = np.array(checked, dtype=float, order="C", copy=True)
     arr.flags.writeable = False
     return arr
 
@@ -213,8 +212,8 @@ class IOData:
     output_unit: str | tuple[str, ...] = ""
 
     def __post_init__(self) -> None:
-        u = _frozen_signal(self.u, "u")
-        y = _frozen_signal(self.y, "y")
+        u = _frozen(check_signal(self.u, "u"))
+        y = _frozen(check_outputs(self.y, "y"))
         if u.size != y.shape[0]:
             raise ValueError(
                 f"`u` and `y` must have the same length; got {u.size} and {y.shape[0]}"
