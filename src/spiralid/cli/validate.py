@@ -61,7 +61,7 @@ def _names_in(name: str) -> set[str] | None:
     without a header, or one that cannot be read (reading it says why)."""
     import csv
 
-    from spiralid.sysid.data import _is_number, _split_unit
+    from spiralid.sysid.readers import _is_number, _split_unit
 
     path = Path(name)
     suffix = path.suffix.lower()

@@ -11,7 +11,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from spiralid.datasets.shipped import NAMES, load
-from spiralid.sysid.data import IOData, _csv_table
+from spiralid.sysid.data import IOData
+from spiralid.sysid.readers import _csv_table
 
 __all__ = ["read_record"]
 

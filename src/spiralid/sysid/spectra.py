@@ -18,7 +18,7 @@ from scipy import signal
 
 from spiralid._checks import integer, positive
 
-from .data import check_signal
+from .signals import check_signal
 
 __all__ = [
     "PSD",

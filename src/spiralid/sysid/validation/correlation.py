@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg, stats
 
-from ..data import check_pair, check_signal
+from ..signals import check_pair, check_signal
 
 __all__ = [
     "CorrelationTest",

@@ -11,8 +11,8 @@ import numpy as np
 
 from spiralid._checks import positive
 
-from ..data import check_pair
 from ..estimation.cost import auto_gain
+from ..signals import check_pair
 
 __all__ = ["fit_percent", "rmse"]
 

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..data import check_pair
+from ..signals import check_pair
 from .correlation import (
     _DEFAULT_LEVELS,
     CorrelationTest,
