@@ -1,15 +1,22 @@
 """`spiralid identify --output a,b`: one model of several outputs from the
 command line (issue 30)."""
 
+import html
 import json
+import re
 
 import numpy as np
+import pytest
 from clitools import run
 
 from spiralid.fms import FlexibleManipulator, paper_experiment
 
 
-def test_several_outputs_give_one_denominator_and_a_fit_each(tmp_path):
+@pytest.fixture(scope="module")
+def made(tmp_path_factory):
+    """`spiralid identify --output vel,acc` on the rig's record: the run and
+    its folder."""
+    tmp_path = tmp_path_factory.mktemp("shared")
     rec = paper_experiment().run(FlexibleManipulator(), rng=0)
     np.savez(
         tmp_path / "rig.npz",
@@ -18,21 +25,71 @@ def test_several_outputs_give_one_denominator_and_a_fit_each(tmp_path):
         acc=rec.end_acceleration,
         ts=rec.ts,
     )
-    made = run("identify", "rig.npz", "--output", "vel,acc", "--na", "8", "--nb",
-               "8", "--nk", "1", "--budget", "2000", "--out", "m",
-               cwd=tmp_path)  # fmt: skip
-    assert made.returncode == 0, made.stderr
-    model = json.loads((tmp_path / "m" / "model.json").read_text())
+    out = run("identify", "rig.npz", "--output", "vel,acc", "--na", "8", "--nb",
+              "8", "--nk", "1", "--budget", "2000", "--out", "m",
+              cwd=tmp_path)  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    return out, tmp_path / "m"
+
+
+def test_several_outputs_give_one_denominator_and_a_fit_each(made):
+    made, folder = made
+    model = json.loads((folder / "model.json").read_text())
     assert model["kind"] == "shared-denominator"
     assert model["output_names"] == ["vel", "acc"] and len(model["b"]) == 2
     freq = [m["frequency_hz"] for m in model["modes"]["modes"]]
     # The FEM's first two modes, 13.31 and 35.11 Hz, from both sensors.
     for f in (13.3105, 35.108):
         assert min(abs(np.array(freq) - f)) / f < 0.005
-    report = json.loads((tmp_path / "m" / "validation.json").read_text())
+    report = json.loads((folder / "validation.json").read_text())
     fits = report["validation"]["outputs"]
     assert set(fits) == {"vel", "acc"}
     assert "joint fit %" in made.stdout and "fit % of acc" in made.stdout
+    # The summary's modes table: every mode's interval, as model.json has it.
+    assert "Shared modes" in made.stdout
+    for m in model["modes"]["modes"]:
+        lo, hi = m["frequency_interval_hz"]
+        assert f"[{lo:.4g}, {hi:.4g}]" in made.stdout
+
+
+def _cells(page: str) -> list[str]:
+    return [html.unescape(c) for c in re.findall(r"<td>(.*?)</td>", page)]
+
+
+def test_the_report_holds_the_modes_the_fits_and_the_diagram(made):
+    _, folder = made
+    page = (folder / "report.html").read_text(encoding="utf-8")
+    model = json.loads((folder / "model.json").read_text())
+    checked = json.loads((folder / "validation.json").read_text())
+    cells = _cells(page)
+    # Every mode's frequency and damping intervals, from model.json's numbers
+    # (written by the model, not by the report), and its share per output.
+    modes = model["modes"]["modes"]
+    assert modes
+    for m in modes:
+        lo, hi = m["frequency_interval_hz"]
+        assert f"[{lo:.4g}, {hi:.4g}]" in cells
+        lo, hi = m["damping_interval"]
+        assert f"[{lo:.4f}, {hi:.4f}]" in cells
+    for name in ("vel", "acc"):
+        assert f"share in {name} (%)" in page
+        share = model["modes"]["share_by_output"][name][0]
+        assert f"{100 * share:.1f}" in cells
+    # Each output's fit on both parts and the joint fit.
+    for part in ("estimation", "validation"):
+        for name, v in checked[part]["outputs"].items():
+            assert f"{v['fit_percent']:.2f}" in cells, (part, name)
+        assert f"{checked[part]['joint_fit_percent']:.2f}" in cells
+    # The stabilisation diagram over orders 2-10 around na = 8, and each
+    # output's validation figures, embedded and written beside it.
+    assert "Stabilisation diagram" in page and "na = 2, 4, 6, 8, 10" in page
+    assert page.count("data:image/png;base64,") == 1 + 2 * 4
+    for name in ("vel", "acc"):
+        for kind in ("time", "spectrum", "residuals", "pole_zero"):
+            assert (folder / f"validation_{name}_{kind}.png").stat().st_size > 0
+    assert (folder / "stabilisation.png").exists()
+    timings = json.loads((folder / "timings.json").read_text())
+    assert "stabilisation" in timings
 
 
 def test_an_option_a_shared_model_does_not_take_is_refused(tmp_path):

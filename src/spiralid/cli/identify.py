@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shlex
 
 from .errors import UsageError
 from .options import (
@@ -164,7 +165,7 @@ def _run_narx(args) -> int:
 
 
 # The budget of the searches that have one of their own (identify's
-# "spiral", estimators._estimate_recommended, and every NARX search,
+# "spiral", spiral_method._estimate_recommended, and every NARX search,
 # narx.estimate_search and estimate_spiral), and the iteration cap of the
 # others (spiralid.optim.minimize, differential_evolution): what --help says
 # and what the progress counts toward.
@@ -240,11 +241,13 @@ def write_arx_model(staged, model, v_est, v_val, headline: str) -> str:
     return summary
 
 
-def _run_shared(args, progress, arx, est, val, options) -> int:
+def _run_shared(args, progress, arx, est, val, options, argv) -> int:
     """`spiralid identify --output a,b,...`: one denominator for every
     output (identify on a record of several outputs), validated output by
-    output with a joint fit."""
-    from spiralid.sysid import identify, validate_outputs
+    output with a joint fit; report.html holds the modes, the fits, each
+    output's figures and a stabilisation diagram."""
+    from spiralid.report.shared_output import write_shared_report
+    from spiralid.sysid import identify, stabilisation, validate_outputs
 
     with _open_folder(args.out, args.force) as folder:
         progress.phase("estimation", f"estimating {arx} for {est.n_outputs} outputs")
@@ -254,7 +257,13 @@ def _run_shared(args, progress, arx, est, val, options) -> int:
         v_val = validate_outputs(
             model, val, warmup=est, label=f"{args.method} (validation)"
         )
-        progress.phase("writing", "writing files")
+        orders = _stabilisation_orders(arx, est)
+        progress.phase("stabilisation", f"output error at orders {orders}")
+        same = {k: v for k, v in options.items() if k in _STABILISATION_OPTIONS}
+        diagram = stabilisation(
+            est, orders, nk=arx.nk, method=_STABILISATION_METHOD, **same
+        )
+        progress.phase("writing", "writing files and figures")
         staged = folder.path
         (staged / "model.json").write_text(json.dumps(model.to_dict(), indent=2))
         (staged / "validation.json").write_text(
@@ -262,22 +271,71 @@ def _run_shared(args, progress, arx, est, val, options) -> int:
                 {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
             )
         )
+        headline = (
+            f"{arx} with one denominator for {', '.join(model.output_names)} "
+            f"on {args.data}"
+        )
         summary = "\n\n".join(
             [
-                f"{arx} with one denominator for {', '.join(model.output_names)} "
-                f"on {args.data}",
+                headline,
                 f"joint cost (weighted, % RMS): {model.cost:.6g}",
                 v_est.summary(modes=False),
                 v_val.summary(),
             ]
         )
         (staged / "summary.txt").write_text(summary + "\n")
+        write_shared_report(
+            staged,
+            model,
+            v_est,
+            v_val,
+            headline=headline,
+            diagram=diagram,
+            data=est,
+            stabilisation_note=_stabilisation_note(orders),
+            command="spiralid " + shlex.join(argv),
+        )
         _write_timings(staged, progress)
         written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)
         print(f"\nwrote {_listing(written, args.out)}")
     return 0
+
+
+# The stabilisation diagram of several outputs: output error (the
+# Gauss-Newton polish from the least-squares and subspace denominators, no
+# search) at every other order from 6 below the model's to 2 above, about
+# as long as the spiral search at the model's order alone on the rig.
+_STABILISATION_METHOD = "oe"
+_STABILISATION_OPTIONS = ("integrator", "max_time_constant")
+
+
+def _stabilisation_orders(arx, est) -> list[int]:
+    """``na - 6, na - 4, ..., na + 2`` (at least 1; ``[2]`` for na = 0),
+    without the orders whose structure the estimation part is too short
+    for."""
+    from spiralid.sysid import ARX
+
+    orders = [n for n in range(arx.na - 6, arx.na + 3, 2) if n >= 1] or [2]
+    fit = []
+    for n in orders:
+        try:
+            ARX(n, n, arx.nk).check_length(est, "estimation part")
+        except ValueError:
+            continue
+        fit.append(n)
+    return fit or [arx.na]
+
+
+def _stabilisation_note(orders: list[int]) -> str:
+    return (
+        f"Each order na = {', '.join(map(str, orders))} identified as "
+        f"ARX(na, na, nk) by output error (method "
+        f"'{_STABILISATION_METHOD}', the same known integrators), whatever "
+        "--method fitted the model: a fast fit at each order rather than a "
+        "search."
+    )
 
 
 def _write_timings(staged, progress, model=None) -> None:
@@ -405,10 +463,10 @@ def run(args, argv: list[str]) -> int:
         return _run_narx(args)
     with _progress(args) as progress:
         arx, est, val = _load_parts(args, progress, _structure)
-        # The budget rule is identify()'s (estimators.search_options).
+        # The budget rule is identify()'s (searches.search_options).
         options = _identify_options(args, arx)
         if est.n_outputs > 1:
-            return _run_shared(args, progress, arx, est, val, options)
+            return _run_shared(args, progress, arx, est, val, options, argv)
         with _open_folder(args.out, args.force) as folder:
             steps = _search_steps(args)
             progress.phase("estimation", f"estimating {arx} by {args.method}", **steps)

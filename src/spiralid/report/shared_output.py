@@ -1,0 +1,256 @@
+"""The report of a model of several outputs (one denominator).
+
+``spiralid identify --output a,b,...`` writes ``report.html`` from
+:func:`write_shared_report`: the shared modes with their 95 % intervals and
+each one's share in each output, every output's fit on both parts and the
+joint fit, each output's validation figures, and a stabilisation diagram
+over a range of orders. The numbers are computed in :mod:`spiralid.sysid`
+(the model's ``modes``, ``validate_outputs``, ``stabilisation``); this
+module only lays them out. The reproduction's "modes from every sensor"
+section uses the same tables (:func:`modes_table`, :func:`fits_table`).
+
+Matplotlib is imported only when a figure is drawn.
+"""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import numpy as np
+
+from spiralid.report.html import figure, page, png, table
+
+__all__ = ["fits_table", "modes_table", "shared_report", "write_shared_report"]
+
+
+def _num(value: float, fmt: str) -> str:
+    """`value` in `fmt`, or "-" where it is not finite (no interval: the
+    method gives no covariance)."""
+    return format(value, fmt) if np.isfinite(value) else "-"
+
+
+def _interval(pair, fmt: str) -> str:
+    lo, hi = pair
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return "-"
+    return f"[{lo:{fmt}}, {hi:{fmt}}]"
+
+
+def modes_table(modes) -> tuple[list[str], list[list[str]]]:
+    """The header and rows of a :class:`~spiralid.sysid.SharedModes`: each
+    mode's frequency (Hz) and damping ratio with their 95 % intervals, its
+    share (%) of each output's resonant peaks and its flags.
+
+    Parameters
+    ----------
+    modes : SharedModes
+        ``model.modes`` of a shared-denominator model.
+
+    Returns
+    -------
+    header : list of str
+    rows : list of list of str
+    """
+    t = modes.table
+    pct = round(100 * t.level)
+    header = [
+        "mode",
+        "frequency (Hz)",
+        f"{pct} % interval (Hz)",
+        "damping",
+        f"{pct} % interval",
+        *(f"share in {name} (%)" for name in modes.output_names),
+        "flags",
+    ]
+    f_int, d_int = t.frequency_interval, t.damping_interval
+    rows = [
+        [
+            str(i + 1),
+            _num(t.frequency[i], ".4g"),
+            _interval(f_int[i], ".4g"),
+            _num(t.damping[i], ".4f"),
+            _interval(d_int[i], ".4f"),
+            *(_num(100 * s, ".1f") for s in modes.share[i]),
+            "; ".join(t.notes(i)),
+        ]
+        for i in range(len(t))
+    ]
+    return header, rows
+
+
+def fits_table(v_est, v_val) -> tuple[list[str], list[list[str]]]:
+    """The header and rows of each output's free-run fit (%) on the
+    estimation and validation parts, and the joint fit last.
+
+    Parameters
+    ----------
+    v_est, v_val : OutputsValidation
+        :func:`~spiralid.sysid.validate_outputs` on the two parts.
+
+    Returns
+    -------
+    header : list of str
+    rows : list of list of str
+    """
+
+    def fit(v) -> str:
+        return f"{v.fit_percent:.2f}" + (" (diverged)" if v.diverged else "")
+
+    rows = [
+        [name, fit(v_est.outputs[name]), fit(v)] for name, v in v_val.outputs.items()
+    ]
+    rows.append(
+        [
+            "joint",
+            f"{v_est.joint_fit_percent:.2f}",
+            f"{v_val.joint_fit_percent:.2f}",
+        ]
+    )
+    return ["output", "fit % (estimation)", "fit % (validation)"], rows
+
+
+_FIGURE_CAPTIONS = {
+    "time": "Measured output and the free run of its transfer function B_i / A "
+    "over the validation part (run on from the estimation part), and the error.",
+    "spectrum": "Power spectral density of the measured and the model's output "
+    "on the validation part, measured peaks labelled, the shared modes as "
+    "dotted lines.",
+    "residuals": "Whiteness of the residuals and their independence of the "
+    "input, with 99 % bands.",
+    "pole_zero": "The shared poles (and this output's known integrators) with "
+    "this output's zeros.",
+}
+
+
+def _figures(v_val, diagram, data) -> dict[str, tuple[str, bytes, str]]:
+    """Every figure as ``stem -> (title, PNG, caption)``: the stabilisation
+    diagram first, then each output's validation figures."""
+    out = {}
+    if diagram is not None:
+        from spiralid.sysid.validation.mode_plots import plot_stabilisation
+
+        orders = ", ".join(str(n) for n in diagram.orders)
+        out["stabilisation"] = (
+            "Stabilisation diagram",
+            png(plot_stabilisation(diagram, data)),
+            f"Orders na = {orders}.",
+        )
+    for name, v in v_val.outputs.items():
+        for kind, fig in v.plot().items():
+            stem = f"validation_{_stem(name)}_{kind}"
+            title = f"{name}: {kind.replace('_', '-')}"
+            out[stem] = (title, png(fig), _FIGURE_CAPTIONS.get(kind, ""))
+    return out
+
+
+def _stem(name: str) -> str:
+    """An output's name as a file-name part (letters, digits, _ and -)."""
+    kept = "".join(c if c.isalnum() or c in "_-" else "_" for c in name)
+    return kept or "output"
+
+
+def shared_report(
+    model,
+    v_est,
+    v_val,
+    *,
+    headline: str,
+    diagram=None,
+    data=None,
+    stabilisation_note: str = "",
+    command: str | None = None,
+) -> tuple[str, dict[str, bytes]]:
+    """The HTML page of a shared-denominator model and its figures.
+
+    Parameters
+    ----------
+    model : SharedDenominatorModel
+    v_est, v_val : OutputsValidation
+        The validations on the estimation and validation parts.
+    headline : str
+        The page's first line (what was identified on which record).
+    diagram : StabilisationDiagram, optional
+        Drawn with :func:`~spiralid.sysid.plots.plot_stabilisation`.
+    data : IOData, optional
+        The record whose spectra the diagram draws behind the modes.
+    stabilisation_note : str
+        How the diagram's orders were identified (its caption).
+    command : str, optional
+        The command line recorded in the page.
+
+    Returns
+    -------
+    html : str
+        The page, figures embedded.
+    images : dict of str to bytes
+        Each figure as PNG, by file-name stem.
+    """
+    e = html.escape
+    figures = _figures(v_val, diagram, data)
+    m_head, m_rows = modes_table(model.modes)
+    f_head, f_rows = fits_table(v_est, v_val)
+    integrators = ", ".join(
+        f"{name} {k}"
+        for name, k in zip(model.output_names, model.integrators, strict=True)
+    )
+    parts = [
+        f"<h1>{e(headline)}</h1>",
+        f"<p>Command: <code>{e(command)}</code></p>" if command else "",
+        f"<p>One denominator of {model.arx.na} poles for "
+        f"{model.n_outputs} outputs, a numerator each ({e(str(model.arx))}); "
+        f"method {e(model.method)}, joint cost (weighted, % RMS) "
+        f"{_num(model.cost, '.6g')}. Known integrators outside the shared poles: "
+        f"{e(integrators)}.</p>",
+        "<h2>Shared modes</h2><p>The complex pole pairs of the shared "
+        "denominator, with 95 % intervals from its covariance (variable "
+        "projection, the numerators projected out); a share is the mode's "
+        "resonant peak as a part of that output's peaks (after its known "
+        "integrators are taken out): a sensor near a node of a mode barely "
+        "sees it. An interval shown as - has no covariance behind it.</p>",
+        table(m_head, m_rows, "html"),
+        "<h2>Fits</h2><p>Free-run fit (MATLAB's compare fit) of each output's "
+        "transfer function on the estimation part and, run on from it, the "
+        "validation part; the joint fit is 100 (1 - sqrt(mean_i (1 - "
+        "fit_i / 100)<sup>2</sup>)).</p>",
+        table(f_head, f_rows, "html"),
+    ]
+    if "stabilisation" in figures:
+        title, data_png, caption = figures["stabilisation"]
+        note = stabilisation_note or caption
+        parts.append(
+            "<h2>Stabilisation diagram</h2>"
+            + figure(
+                title,
+                data_png,
+                note + " A mode is stable when the order below has one within "
+                f"{100 * diagram.frequency_tolerance:g} % in frequency and "
+                f"{100 * diagram.damping_tolerance:g} % in damping.",
+            )
+        )
+    for name in v_val.outputs:
+        parts.append(f"<h2>Validation of {e(name)}</h2>")
+        prefix = f"validation_{_stem(name)}_"
+        for stem, (title, data_png, caption) in figures.items():
+            if stem.startswith(prefix):
+                parts.append(figure(title, data_png, caption))
+    images = {stem: data_png for stem, (_, data_png, _) in figures.items()}
+    return page(headline, parts), images
+
+
+def write_shared_report(staged: Path, model, v_est, v_val, **kwargs) -> None:
+    """Write ``report.html`` and every figure's PNG into the folder `staged`.
+
+    Parameters
+    ----------
+    staged : Path
+        The (staging) folder.
+    model : SharedDenominatorModel
+    v_est, v_val : OutputsValidation
+    **kwargs
+        :func:`shared_report`'s keyword arguments (``headline`` first).
+    """
+    text, images = shared_report(model, v_est, v_val, **kwargs)
+    for stem, data in images.items():
+        (Path(staged) / f"{stem}.png").write_bytes(data)
+    (Path(staged) / "report.html").write_text(text, encoding="utf-8")
