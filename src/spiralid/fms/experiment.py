@@ -44,6 +44,11 @@ class Experiment:
       34 dB SNR), ``tach_noise = 0.01`` rad/s; the default
       :class:`~spiralid.fms.sensors.Sensors` otherwise (encoder x4,
       4th-order Butterworth anti-aliasing at 0.35 x Nyquist, 87.5 Hz).
+    - ``deflection_at = ()``, ``acceleration_at = ()``: no sensors along the
+      beam besides the tip's; positions (fractions of the length) add the
+      outputs ``deflection_<x>`` and ``acceleration_<x>`` (see
+      :class:`~spiralid.fms.sensors.Sensors`), and leave the four channels
+      and their noise as without them.
     """
 
     amplitude: float = 0.3
@@ -55,6 +60,8 @@ class Experiment:
     fs: float = 500.0
     accel_noise: float = 1.0
     tach_noise: float = 0.01
+    deflection_at: tuple[float, ...] = ()
+    acceleration_at: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         integer(self.n_pulses, "n_pulses", 1)
@@ -69,7 +76,9 @@ class Experiment:
             )
         # Validate the rest by building the signal once.
         self.torque()
-        Sensors(accel_noise=self.accel_noise, tach_noise=self.tach_noise)
+        sensors = self.sensors()
+        object.__setattr__(self, "deflection_at", sensors.deflection_at)
+        object.__setattr__(self, "acceleration_at", sensors.acceleration_at)
 
     def torque(self) -> np.ndarray:
         """The torque record (N m), sampled at ``fs``.
@@ -92,8 +101,14 @@ class Experiment:
         return u
 
     def sensors(self) -> Sensors:
-        """Default sensors with this experiment's noise levels."""
-        return Sensors(accel_noise=self.accel_noise, tach_noise=self.tach_noise)
+        """Default sensors with this experiment's noise levels and sensors
+        along the beam."""
+        return Sensors(
+            accel_noise=self.accel_noise,
+            tach_noise=self.tach_noise,
+            deflection_at=self.deflection_at,
+            acceleration_at=self.acceleration_at,
+        )
 
     def run(self, rig: FlexibleManipulator | None = None, rng=None) -> Recording:
         """Simulate the experiment on ``rig`` (default rig if None).

@@ -27,6 +27,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 from scipy.linalg import eigh
+from scipy.optimize import brentq
 
 from spiralid._checks import (
     generator,
@@ -36,7 +37,7 @@ from spiralid._checks import (
     real_array,
 )
 from spiralid.fms._zoh import discretise_zoh, simulate_discrete
-from spiralid.fms.beam import assemble
+from spiralid.fms.beam import _hermite, assemble
 from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
 
 __all__ = ["FlexibleManipulator", "Recording", "nonlinear_rig"]
@@ -81,6 +82,20 @@ class Recording:
     state : ndarray or None
         With ``return_state=True``: the exact ``(q, q')`` in the rig's
         generalised coordinates at each sample, shape ``(N, 2 ndof)``.
+    deflection_at : tuple of float
+        Positions of the deflection sensors along the beam, fractions of its
+        length (:attr:`Sensors.deflection_at`); empty by default.
+    deflection : ndarray or None
+        Their exact deflections ``w(x)`` relative to the hub frame (m), shape
+        ``(N, len(deflection_at))``; None without deflection sensors.  Column
+        ``j`` is the output ``deflection_<x_j>`` of :meth:`iodata`.
+    acceleration_at : tuple of float
+        Positions of the further accelerometers
+        (:attr:`Sensors.acceleration_at`); empty by default.
+    acceleration : ndarray or None
+        Their accelerations ``x theta'' + w''(x)`` as the accelerometers
+        report them (m/s^2), shape ``(N, len(acceleration_at))``; None
+        without them.  Column ``j`` is the output ``acceleration_<x_j>``.
     """
 
     t: np.ndarray
@@ -91,15 +106,39 @@ class Recording:
     tip_deflection: np.ndarray
     ts: float
     state: np.ndarray | None = None
+    deflection_at: tuple[float, ...] = ()
+    deflection: np.ndarray | None = None
+    acceleration_at: tuple[float, ...] = ()
+    acceleration: np.ndarray | None = None
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        """Every output :meth:`iodata` takes: the four channels, then one
+        ``deflection_<x>`` per deflection sensor and one
+        ``acceleration_<x>`` per further accelerometer."""
+        sensors = Sensors(
+            deflection_at=self.deflection_at, acceleration_at=self.acceleration_at
+        )
+        return _OUTPUTS + sensors.positional_names
+
+    def _output(self, name: str) -> np.ndarray:
+        if name in _OUTPUTS:
+            return getattr(self, name)
+        k = self.output_names.index(name) - len(_OUTPUTS)
+        if k < len(self.deflection_at):
+            return self.deflection[:, k]
+        return self.acceleration[:, k - len(self.deflection_at)]
 
     def iodata(self, name: str | list[str] = "end_acceleration"):
         """The torque and one output channel, or several, as a
         :class:`spiralid.IOData`.
 
         `name` is one of the recorded outputs (``"hub_angle"``,
-        ``"hub_velocity"``, ``"end_acceleration"``, ``"tip_deflection"``), or
-        a list of them: a record of several outputs that share the torque
-        (``y`` of shape (N, p), each output with its own name and unit).
+        ``"hub_velocity"``, ``"end_acceleration"``, ``"tip_deflection"``, and
+        ``"deflection_<x>"`` for each deflection sensor, see
+        :attr:`output_names`), or a list of them: a record of several
+        outputs that share the torque (``y`` of shape (N, p), each output
+        with its own name and unit).
 
         ``spiralid.sysid.data`` is imported here, inside the method: it is the
         one sanctioned dependency of ``fms`` on the rest of the package, kept
@@ -119,13 +158,14 @@ class Recording:
         from spiralid.sysid.data import IOData
 
         names = list(name) if isinstance(name, list | tuple) else [name]
+        known = self.output_names
         for one in names:
-            if not isinstance(one, str) or one not in _OUTPUTS:
-                raise ValueError(f"`name` must be one of {_OUTPUTS}; got {one!r}")
+            if not isinstance(one, str) or one not in known:
+                raise ValueError(f"`name` must be one of {known}; got {one!r}")
         if not names or len(set(names)) != len(names):
             raise ValueError(f"`name` must list each output once; got {name!r}")
         several = len(names) > 1
-        y = [getattr(self, one) for one in names]
+        y = [self._output(one) for one in names]
         return IOData(
             self.u,
             np.column_stack(y) if several else y[0],
@@ -133,10 +173,16 @@ class Recording:
             input_name="torque",
             output_name=tuple(names) if several else names[0],
             input_unit="N m",
-            output_unit=tuple(_UNITS[one] for one in names)
+            output_unit=tuple(_unit(one) for one in names)
             if several
-            else _UNITS[names[0]],
+            else _unit(names[0]),
         )
+
+
+def _unit(name: str) -> str:
+    if name in _UNITS:
+        return _UNITS[name]
+    return "m/s^2" if name.startswith("acceleration_") else "m"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -372,15 +418,161 @@ class FlexibleManipulator:
             )
         return f[:n]
 
-    def _plant(self) -> tuple[np.ndarray, ...]:
+    def deflection_rows(self, positions) -> np.ndarray:
+        """Rows ``r`` with ``w(x L) = r @ q``: the beam's deflection relative
+        to the hub frame at fractions ``x`` of its length, from the
+        generalised coordinates ``q`` (the Hermite shape functions of the
+        element that holds the point).
+
+        Parameters
+        ----------
+        positions : array_like of float
+            Fractions of the length from the hub, each in [0, 1].
+
+        Returns
+        -------
+        ndarray, shape (len(positions), ndof)
+
+        Examples
+        --------
+        >>> rig = FlexibleManipulator(n_elements=4)
+        >>> rig.deflection_rows([1.0])[0, rig.ndof - 2]   # the tip node's w
+        np.float64(1.0)
+        """
+        x = real_array(positions, "positions").ravel()
+        if not np.all((x >= 0.0) & (x <= 1.0)):
+            raise ValueError(
+                "`positions` must be fractions of the length in [0, 1]; got "
+                f"{positions!r}"
+            )
+        n = self.n_elements
+        le = self.length / n
+        element = np.minimum(np.floor(x * n).astype(int), n - 1)
+        xi = x * n - element
+        shape = _hermite(xi, le).T  # (k, 4): w_e, w_e', w_e+1, w_e+1'
+        rows = np.zeros((x.size, self.ndof))
+        for k, e in enumerate(element):
+            # Node j >= 1 has w_j at q[2j - 1] and w_j' at q[2j]; node 0 is
+            # clamped (no coordinates).
+            first = 0 if e == 0 else 2 * e - 1
+            cols = np.arange(first, 2 * e + 3)
+            rows[k, cols] = shape[k, 4 - cols.size :]
+        return rows
+
+    def mode_shape(self, mode: int, positions, *, frame: str = "hub") -> np.ndarray:
+        """The deflection of a flexible mode along the beam, scaled so that
+        its largest magnitude on the beam is 1.
+
+        Parameters
+        ----------
+        mode : int
+            The flexible mode, 1 for the first (lowest frequency).
+        positions : array_like of float
+            Fractions of the length from the hub, each in [0, 1].
+        frame : {"hub", "inertial"}
+            ``"hub"``: the deflection ``w(x)`` relative to the hub frame (what
+            ``tip_deflection`` and ``deflection_<x>`` record). ``"inertial"``:
+            the displacement ``x theta + w(x)`` (what an accelerometer at
+            ``x`` sees, as ``end_acceleration`` at the tip).
+
+        Returns
+        -------
+        ndarray, shape (len(positions),)
+            The shape; its sign is that of its largest-magnitude value on a
+            grid of 64 points per element, taken as positive.
+
+        Examples
+        --------
+        >>> rig = FlexibleManipulator()
+        >>> float(abs(rig.mode_shape(2, [rig.mode_nodes(2)[0]])[0])) < 1e-9
+        True
+        """
+        f = self._shape(mode, frame)
+        grid = np.linspace(0.0, 1.0, 64 * self.n_elements + 1)
+        on_grid = f(grid)
+        scale = on_grid[np.argmax(np.abs(on_grid))]
+        return f(real_array(positions, "positions").ravel()) / scale
+
+    def mode_nodes(self, mode: int, *, frame: str = "hub") -> np.ndarray:
+        """Where a flexible mode's deflection changes sign along the beam.
+
+        The sign changes on a grid of 64 points per element, each refined
+        to a root of the finite-element interpolant (Brent's method); the
+        clamp at the hub, where the deflection is zero in every mode, is
+        not counted.
+
+        Parameters
+        ----------
+        mode : int
+            The flexible mode, 1 for the first.
+        frame : {"hub", "inertial"}
+            As for :meth:`mode_shape`.
+
+        Returns
+        -------
+        ndarray
+            The nodes as fractions of the length, ascending, in (0, 1].
+
+        Examples
+        --------
+        An accelerometer at 0.832 of the default rig's length barely sees
+        its second mode; in the hub frame that mode's only node is near the
+        hub (the light hub turns back against the beam):
+
+        >>> rig = FlexibleManipulator()
+        >>> rig.mode_nodes(2, frame="inertial").round(3)
+        array([0.348, 0.832])
+        >>> rig.mode_nodes(2).round(3)
+        array([0.056])
+        """
+        f = self._shape(mode, frame)
+        grid = np.linspace(0.0, 1.0, 64 * self.n_elements + 1)[1:]
+        v = f(grid)
+        scale = float(np.max(np.abs(v)))
+        nodes = [float(x) for x, w in zip(grid, v, strict=True) if w == 0.0]
+        for i in np.flatnonzero(v[:-1] * v[1:] < 0.0):
+            nodes.append(
+                brentq(
+                    lambda x: float(f(np.array([x]))[0]) / scale,
+                    grid[i],
+                    grid[i + 1],
+                    xtol=1e-15,
+                )
+            )
+        return np.array(sorted(nodes))
+
+    def _shape(self, mode: int, frame: str):
+        """Mode `mode`'s unscaled deflection as a function of positions."""
+        mode = integer(mode, "mode", 1)
+        if mode > 2 * self.n_elements:
+            raise ValueError(
+                f"`mode` must be at most 2 n_elements = {2 * self.n_elements}; "
+                f"got {mode!r}"
+            )
+        if frame not in ("hub", "inertial"):
+            raise ValueError(f"`frame` must be 'hub' or 'inertial'; got {frame!r}")
+        phi = self._modal[1][:, mode]
+        rigid = self.length * phi[0] if frame == "inertial" else 0.0
+
+        def deflection(x: np.ndarray) -> np.ndarray:
+            return self.deflection_rows(x) @ phi + rigid * x
+
+        return deflection
+
+    def _plant(
+        self,
+        deflection_at: tuple[float, ...] = (),
+        acceleration_at: tuple[float, ...] = (),
+    ) -> tuple[np.ndarray, ...]:
         """Continuous model in modal coordinates, scaled for the exponential.
 
         State ``s = [eta, nu]`` with ``q = Phi eta`` and velocities
         ``nu_0 = eta_0'`` (rigid), ``nu_i = eta_i' / w_i`` (flexible), so
         every entry of ``A`` is of order ``w_i`` rather than ``w_i^2``.
         Returns ``A, B`` and output rows ``(C, D)`` for hub angle, hub
-        velocity, end-point acceleration and tip deflection, plus the
-        velocity scaling.
+        velocity, end-point acceleration and tip deflection, then the
+        deflection at each of `deflection_at` and the acceleration at each
+        of `acceleration_at`, plus the velocity scaling.
         """
         omega, phi = self._modal
         n = self.ndof
@@ -397,14 +589,24 @@ class FlexibleManipulator:
         B = np.concatenate([np.zeros(n), g / scale])
         tip = phi[n - 2]
         h = self.length * phi[0] + tip  # end point's share of each mode
-        C = np.zeros((4, 2 * n))
-        D = np.zeros(4)
+        nd = len(deflection_at)
+        C = np.zeros((4 + nd + len(acceleration_at), 2 * n))
+        D = np.zeros(C.shape[0])
         C[0, :n] = g
         C[1, n:] = g * scale
         C[2, :n] = -h * omega**2
         C[2, n:] = -(h @ cm) * scale
         D[2] = h @ g
         C[3, :n] = tip
+        if deflection_at:
+            C[4 : 4 + nd, :n] = self.deflection_rows(deflection_at) @ phi
+        if acceleration_at:
+            x = np.asarray(acceleration_at)
+            # Each accelerometer's share of each mode, as h is the end point's.
+            hx = np.outer(x, self.length * phi[0]) + self.deflection_rows(x) @ phi
+            C[4 + nd :, :n] = -hx * omega**2
+            C[4 + nd :, n:] = -(hx @ cm) * scale
+            D[4 + nd :] = hx @ g
         return A, B, C, D, scale
 
     def simulate(
@@ -494,7 +696,12 @@ class FlexibleManipulator:
 
         ts = 1.0 / fs_v
         Ad, Bd, C, D, scale = _discrete(
-            self, ts, sensors.antialias_order, sensors.antialias_cutoff
+            self,
+            ts,
+            sensors.antialias_order,
+            sensors.antialias_cutoff,
+            sensors.deflection_at,
+            sensors.acceleration_at,
         )
         _, phi = self._modal
         M = self.mass_matrix
@@ -526,6 +733,11 @@ class FlexibleManipulator:
             hub_velocity = hub_velocity + gen.normal(0.0, sensors.tach_noise, u.size)
         if sensors.accel_noise > 0.0:
             acc = acc + gen.normal(0.0, sensors.accel_noise, u.size)
+        nd = len(sensors.deflection_at)
+        further = y[:, 4 + nd :].copy() if sensors.acceleration_at else None
+        if further is not None and sensors.accel_noise > 0.0:
+            # Drawn after the other channels, so their noise is unchanged.
+            further += gen.normal(0.0, sensors.accel_noise, further.shape[::-1]).T
         state = None
         if s is not None:
             state = np.hstack([s[:, :n] @ phi.T, (s[:, n : 2 * n] * scale) @ phi.T])
@@ -538,6 +750,10 @@ class FlexibleManipulator:
             tip_deflection=y[:, 3].copy(),
             ts=ts,
             state=state,
+            deflection_at=sensors.deflection_at,
+            deflection=y[:, 4 : 4 + nd].copy() if nd else None,
+            acceleration_at=sensors.acceleration_at,
+            acceleration=further,
         )
 
     def _simulate_friction(self, u, s0, ts: float, sensors: Sensors):
@@ -549,7 +765,12 @@ class FlexibleManipulator:
         # The filters' cutoff is relative to the Nyquist frequency: the same
         # filter in Hz at the sub-step's rate.
         Ad, Bd, C, D, _ = _discrete(
-            self, ts / m, sensors.antialias_order, sensors.antialias_cutoff / m
+            self,
+            ts / m,
+            sensors.antialias_order,
+            sensors.antialias_cutoff / m,
+            sensors.deflection_at,
+            sensors.acceleration_at,
         )
         cv = np.zeros(Ad.shape[0])
         plant_c = self._plant()[2]
@@ -609,22 +830,34 @@ def nonlinear_rig(**overrides) -> FlexibleManipulator:
 
 @lru_cache(maxsize=16)
 def _discrete(
-    rig: FlexibleManipulator, ts: float, order: int, cutoff: float
+    rig: FlexibleManipulator,
+    ts: float,
+    order: int,
+    cutoff: float,
+    deflection_at: tuple[float, ...] = (),
+    acceleration_at: tuple[float, ...] = (),
 ) -> tuple[np.ndarray, ...]:
-    """Exact ZOH model of the rig plus anti-aliasing filters (cached)."""
-    A, B, C, D, scale = rig._plant()
+    """Exact ZOH model of the rig plus anti-aliasing filters (cached); the
+    sensors along the beam are outputs after the four channels."""
+    A, B, C, D, scale = rig._plant(deflection_at, acceleration_at)
     if order > 0:
         af, bf, cf = butterworth_ss(order, cutoff * 0.5 / ts)
         npl = A.shape[0]
         nf = order
-        big = np.zeros((npl + 2 * nf, npl + 2 * nf))
-        bb = np.zeros(npl + 2 * nf)
+        # The tachometer and every accelerometer are filtered (a filter each);
+        # the encoder and every deflection are not.
+        first = 4 + len(deflection_at)
+        filtered = [1, 2, *range(first, C.shape[0])]
+        unfiltered = [0, *range(3, first)]
+        size = npl + len(filtered) * nf
+        big = np.zeros((size, size))
+        bb = np.zeros(size)
         big[:npl, :npl] = A
         bb[:npl] = B
-        cc = np.zeros((4, npl + 2 * nf))
+        cc = np.zeros((C.shape[0], size))
         dd = D.copy()
-        cc[[0, 3], :npl] = C[[0, 3]]
-        for k, row in enumerate((1, 2)):
+        cc[unfiltered, :npl] = C[unfiltered]
+        for k, row in enumerate(filtered):
             sl = slice(npl + k * nf, npl + (k + 1) * nf)
             big[sl, sl] = af
             big[sl, :npl] = np.outer(bf, C[row])

@@ -3,8 +3,9 @@
 The Sheffield rig (paper, section "Flexible manipulator system") measures the
 hub angle with a 2048-pulse/revolution incremental encoder, the hub velocity
 with a tachometer and the end-point acceleration with a piezoelectric
-accelerometer.  :class:`Sensors` describes those channels; the rig's
-``simulate`` applies them.
+accelerometer.  :class:`Sensors` describes those channels, and optional
+deflection sensors and accelerometers along the beam (``deflection_at``,
+``acceleration_at``); the rig's ``simulate`` applies them.
 """
 
 from __future__ import annotations
@@ -16,7 +17,37 @@ import numpy as np
 
 from spiralid._checks import integer, is_integer, nonneg, real
 
-__all__ = ["Sensors", "butterworth_ss", "quantise"]
+__all__ = [
+    "Sensors",
+    "acceleration_name",
+    "butterworth_ss",
+    "deflection_name",
+    "quantise",
+]
+
+
+def deflection_name(position: float) -> str:
+    """The output name of a deflection sensor at `position` (a fraction of
+    the beam's length): ``"deflection_<position>"`` with ``%g``.
+
+    Examples
+    --------
+    >>> deflection_name(0.47), deflection_name(1.0)
+    ('deflection_0.47', 'deflection_1')
+    """
+    return f"deflection_{position:g}"
+
+
+def acceleration_name(position: float) -> str:
+    """The output name of an accelerometer at `position` (a fraction of the
+    beam's length): ``"acceleration_<position>"`` with ``%g``.
+
+    Examples
+    --------
+    >>> acceleration_name(0.832)
+    'acceleration_0.832'
+    """
+    return f"acceleration_{position:g}"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -56,6 +87,28 @@ class Sensors:
         paper experiment fell into a local optimum without the first mode
         (validation fit ~30 % against ~85 % at 0.35, six noise seeds).  This
         is an instrument choice; the rig's physical constants are untouched.
+    deflection_at : tuple of float
+        Positions along the beam of deflection sensors, as fractions of its
+        length from the hub, each in (0, 1]: the beam's deflection ``w(x)``
+        there, relative to the hub frame, as the tip deflection is (1.0 is
+        the tip), from the finite elements' shape functions.  Exact,
+        unfiltered and noise-free like the tip deflection (a strain gauge's
+        or an optical sensor's own dynamics and noise are not modelled).
+        Each adds an output ``deflection_<x>`` (:func:`deflection_name`) to
+        the record.  Default none: the record is then exactly as without
+        this option.  A node of a mode is where that mode's deflection
+        vanishes (:meth:`FlexibleManipulator.mode_nodes`): a sensor there
+        barely sees the mode.
+    acceleration_at : tuple of float
+        Positions along the beam of further accelerometers, fractions of its
+        length from the hub, each in (0, 1]: the acceleration ``x theta'' +
+        w''(x)`` of that point in the plane of motion (1.0 is the end
+        point's, ``end_acceleration``), through the same anti-aliasing filter
+        and with white noise of ``accel_noise`` each, drawn after the other
+        channels' noise.  Each adds an output ``acceleration_<x>``
+        (:func:`acceleration_name`).  A node of a mode for an accelerometer
+        is a node of :meth:`FlexibleManipulator.mode_shape` with
+        ``frame="inertial"``.  Default none.
 
     Examples
     --------
@@ -71,6 +124,8 @@ class Sensors:
     accel_noise: float = 0.0
     antialias_order: int = 4
     antialias_cutoff: float = 0.35
+    deflection_at: tuple[float, ...] = ()
+    acceleration_at: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         if self.encoder_lines is not None:
@@ -93,11 +148,36 @@ class Sensors:
                 f"`antialias_cutoff` must be in (0, 1]; got {self.antialias_cutoff!r}"
             )
         object.__setattr__(self, "antialias_cutoff", c)
+        for name in ("deflection_at", "acceleration_at"):
+            object.__setattr__(self, name, _positions(getattr(self, name), name))
 
     @classmethod
-    def ideal(cls) -> Sensors:
-        """Exact, unfiltered, noise-free sampling of every channel."""
-        return cls(encoder_lines=None, antialias_order=0)
+    def ideal(
+        cls,
+        deflection_at: tuple[float, ...] = (),
+        acceleration_at: tuple[float, ...] = (),
+    ) -> Sensors:
+        """Exact, unfiltered, noise-free sampling of every channel.
+
+        Parameters
+        ----------
+        deflection_at, acceleration_at : tuple of float
+            Sensors along the beam, as the fields of those names.
+        """
+        return cls(
+            encoder_lines=None,
+            antialias_order=0,
+            deflection_at=deflection_at,
+            acceleration_at=acceleration_at,
+        )
+
+    @property
+    def positional_names(self) -> tuple[str, ...]:
+        """The output names of the sensors along the beam, in the record's
+        order: every deflection, then every accelerometer."""
+        return tuple(deflection_name(x) for x in self.deflection_at) + tuple(
+            acceleration_name(x) for x in self.acceleration_at
+        )
 
     @property
     def encoder_resolution(self) -> float | None:
@@ -105,6 +185,29 @@ class Sensors:
         if self.encoder_lines is None:
             return None
         return 2.0 * math.pi / (self.encoder_lines * self.quadrature)
+
+
+def _positions(value, name: str) -> tuple[float, ...]:
+    """`name` as a tuple of distinct fractions in (0, 1]."""
+    values = list(value) if isinstance(value, list | tuple | np.ndarray) else None
+    out = []
+    for v in values if values is not None else [None]:
+        try:
+            x = real(v, name)
+        except ValueError:
+            x = math.nan
+        if values is None or not 0.0 < x <= 1.0:
+            raise ValueError(
+                f"`{name}` must be a tuple of positions along the beam, "
+                f"fractions of its length in (0, 1]; got {value!r}"
+            )
+        out.append(x)
+    names = [f"{x:g}" for x in out]
+    if len(set(names)) != len(names):
+        raise ValueError(
+            f"`{name}` must name distinct positions (to 6 digits); got {value!r}"
+        )
+    return tuple(out)
 
 
 def quantise(angle: np.ndarray, resolution: float | None) -> np.ndarray:
