@@ -241,7 +241,7 @@ def oe_initial_state_study() -> None:
                     own = float(np.sqrt(np.mean(res.fun**2)))
                 else:
                     theta, own = _oe_variant(est, arx, start, initial)
-                model = IdentifiedModel(theta, arx, est.ts, "oe")
+                model = IdentifiedModel(theta, arx, est.ts, method="oe")
                 fit = validate(model, val, warmup=est).fit_percent
                 print(
                     f"  {name} start {sname:<2} initial {initial:<12} paper cost "
@@ -259,7 +259,7 @@ def oe_initial_state_study() -> None:
                 theta, _ = mod.local_polish(
                     arx_least_squares(est, arx), arx, est, "simulation", "measured"
                 )
-                model = IdentifiedModel(theta, arx, est.ts, "oe")
+                model = IdentifiedModel(theta, arx, est.ts, method="oe")
                 fit = validate(model, val, warmup=est).fit_percent
                 print(
                     f"    kmax 1 - {1 - kmax:.0e}: paper cost "

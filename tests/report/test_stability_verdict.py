@@ -56,7 +56,7 @@ def data():
 def test_is_stable_and_validate_agree_with_the_exact_test(data, rho, stable):
     theta = _outside(MARGINAL, rho)
     assert _exactly_stable(theta[:8]) is stable
-    model = IdentifiedModel(theta, ARX8, data.ts, "ebsda")
+    model = IdentifiedModel(theta, ARX8, data.ts, method="ebsda")
     v = validate(model, data)
     assert model.is_stable is v.stable is stable
     assert (model.max_pole_radius < 1) is (v.max_pole_radius < 1) is stable

@@ -346,7 +346,7 @@ def test_rig_rest_criterion_validates_better_than_measured():
     fits = {}
     for initial in ("rest", "measured"):
         theta, _ = local_polish(start, arx, est, "simulation", initial)
-        model = IdentifiedModel(theta, arx, est.ts, "oe", initial=initial)
+        model = IdentifiedModel(theta, arx, est.ts, method="oe", initial=initial)
         fits[initial] = validate(model, val, warmup=est).fit_percent
     # Measured: rest 95.85 %, measured 92.55 %.
     assert fits["rest"] > fits["measured"] + 2.0

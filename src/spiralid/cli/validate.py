@@ -25,7 +25,8 @@ def _read_model(name: str):
     """The model file, whether it records its preprocessing (files
     written before it did only know --detrend from the user) and whether
     it records the names of its input and output."""
-    from spiralid.sysid import IdentifiedModel
+    from spiralid.sysid.models.files import load_model
+    from spiralid.sysid.models.shared import SharedDenominatorModel
 
     path = Path(name)
     if path.is_dir():
@@ -41,17 +42,19 @@ def _read_model(name: str):
             f"{name!r} is not a valid spiralid model file (not JSON: {exc})"
         ) from None
     try:
-        if isinstance(fields, dict) and fields.get("model") == "narx":
-            from spiralid.sysid import NARXModel
-
-            model = NARXModel.from_dict(fields)
-        else:
-            model = IdentifiedModel.from_dict(fields)
+        model = load_model(fields)
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         message = " ".join(str(exc).split()).replace("`", "'")
         raise UsageError(
             f"{name!r} is not a valid spiralid model file ({message})"
         ) from None
+    if isinstance(model, SharedDenominatorModel):
+        raise UsageError(
+            f"{name!r} is a model of several outputs "
+            f"({', '.join(model.output_names)}); validate it from Python with "
+            "spiralid.sysid.validate_outputs, or validate one output's model "
+            "(model.output_model(name))"
+        )
     return model, "u_offset" in fields, "output_name" in fields
 
 

@@ -84,6 +84,9 @@ class ARX:
         """Length of ``theta``: ``na + nb``."""
         return self.na + self.nb
 
+    #: Linear in the signals: poles, modes and the linear residual tests apply.
+    is_linear = True
+
     @property
     def max_lag(self) -> int:
         """Largest lag in the regressors, ``max(na, nk + nb - 1)``."""

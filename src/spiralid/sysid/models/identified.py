@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import KW_ONLY, dataclass
 from typing import Any
 
 import numpy as np
@@ -11,7 +11,8 @@ from scipy import signal
 
 from ..data import IOData
 from . import _fields
-from .arx import ARX, INITIAL_CONDITIONS
+from .arx import ARX
+from .fitted import FittedModel, result_summary
 from .modes import ModeTable, mode_table
 from .polynomials import (
     deflate_integrator,
@@ -39,8 +40,9 @@ def python_control():
 
 
 @dataclass(eq=False)
-class IdentifiedModel:
-    """An estimated ARX model with how it was obtained.
+class IdentifiedModel(FittedModel):
+    """An estimated ARX model with how it was obtained: a
+    :class:`~spiralid.sysid.models.fitted.FittedModel` of an ARX structure.
 
     Attributes
     ----------
@@ -123,29 +125,10 @@ class IdentifiedModel:
     theta: np.ndarray
     arx: ARX
     ts: float
-    method: str
-    predictor: str = "simulation"
+    _: KW_ONLY
     parametrization: str = "coefficients"
-    gain: float = float("nan")
-    penalty: float = 1e6
-    cost: float = float("nan")
-    result: Any = None
     refine_result: Any = None
-    history: np.ndarray | None = None
-    timings: dict = field(default_factory=dict)
     bounds: np.ndarray | None = None
-    input_name: str = "u"
-    output_name: str = "y"
-    # Last, so positional construction keeps its meaning.
-    initial: str = "rest"
-    # How the estimation record was prepared (IOData's units and the offsets
-    # a detrend removed), and which share of the record estimated: what
-    # `spiralid validate` needs to treat new data as the model's was.
-    input_unit: str = ""
-    output_unit: str = ""
-    u_offset: float = 0.0
-    y_offset: float = 0.0
-    fraction: float | None = None
     # Known integrators (poles at z = 1) factored out of the denominator
     # before estimation (`identify(integrator=...)`): the model is then
     # marginally stable by design, not unstable.
@@ -157,10 +140,7 @@ class IdentifiedModel:
     selection: dict | None = None
 
     def __post_init__(self) -> None:
-        if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
-            raise ValueError(
-                f"`initial` must be one of {INITIAL_CONDITIONS}; got {self.initial!r}"
-            )
+        self._check_provenance()
         self.theta = np.asarray(self.theta, dtype=float).copy()
         if self.theta.shape != (self.arx.n_params,):
             raise ValueError(
@@ -215,6 +195,23 @@ class IdentifiedModel:
             )
 
     # -- model behaviour ---------------------------------------------------------
+
+    @property
+    def structure(self) -> ARX:
+        """The structure (:attr:`arx`), under the name every fitted model
+        answers to."""
+        return self.arx
+
+    @property
+    def params(self) -> np.ndarray:
+        """The parameters (:attr:`theta`), under the name every fitted
+        model answers to."""
+        return self.theta
+
+    @property
+    def linear_part(self) -> IdentifiedModel:
+        """The linear model inside this one: the model itself."""
+        return self
 
     def simulate(self, u) -> np.ndarray:
         """Free-run output from zero initial conditions (``IOData`` gives its u)."""
@@ -363,34 +360,15 @@ class IdentifiedModel:
         ``timings=False`` leaves out the wall times, the only part that
         differs between two runs with the same seed (``spiralid identify``
         writes them to ``timings.json`` beside ``model.json``)."""
-        summary = _summary(self.result)
-        if summary is not None and self.refine_result is not None:
-            summary["refine"] = _summary(self.refine_result)
         out = {
             "theta": [float(v) for v in self.theta],
             "na": self.arx.na,
             "nb": self.arx.nb,
             "nk": self.arx.nk,
             "ts": float(self.ts),
-            "method": self.method,
-            "predictor": self.predictor,
             "parametrization": self.parametrization,
-            "initial": self.initial,
-            "gain": float(self.gain),
-            "penalty": float(self.penalty),
-            "cost": float(self.cost),
-            "history": None
-            if self.history is None
-            else [float(v) for v in self.history],
-            "timings": {k: float(v) for k, v in self.timings.items()},
+            **self._provenance_dict(),
             "bounds": None if self.bounds is None else np.asarray(self.bounds).tolist(),
-            "input_name": self.input_name,
-            "output_name": self.output_name,
-            "input_unit": self.input_unit,
-            "output_unit": self.output_unit,
-            "u_offset": float(self.u_offset),
-            "y_offset": float(self.y_offset),
-            "fraction": None if self.fraction is None else float(self.fraction),
             "integrator": self.integrator,
             "covariance": None
             if self.covariance is None
@@ -399,8 +377,9 @@ class IdentifiedModel:
             "cancellations": [dict(c) for c in self.cancellations],
             "selection": self.selection,
             "modes": self.modes.to_dict(),
-            "result": summary,
         }
+        if out["result"] is not None and self.refine_result is not None:
+            out["result"]["refine"] = result_summary(self.refine_result)
         if not timings:
             del out["timings"]
         return out
@@ -428,40 +407,15 @@ class IdentifiedModel:
                         f"field {name!r} must be an integer; got {d[name]!r}"
                     )
             arx = ARX(d["na"], d["nb"], d["nk"])
-            fraction = d.get("fraction")
-            if fraction is not None:
-                fraction = _fields.number(
-                    d, "fraction", "a number in (0, 1) or null", lambda v: 0 < v < 1
-                )
             return cls(
                 theta=np.asarray(d["theta"], dtype=float),
                 arx=arx,
                 ts=_fields.number(d, "ts", "a number > 0", _fields.positive),
-                method=_fields.method(d, _arx_methods()),
-                predictor=d.get("predictor", "simulation"),
                 parametrization=d.get("parametrization", "coefficients"),
                 # Dicts saved before `initial` existed came from the
                 # measured-past rule, which was then the only one.
-                initial=d.get("initial", "measured"),
-                gain=_fields.gain(d),
-                penalty=_fields.number(
-                    d, "penalty", "a finite number >= 0", _fields.nonneg, 1e6
-                ),
-                cost=_fields.number(d, "cost", "a number", _fields.anything, math.nan),
-                history=None if d.get("history") is None else np.asarray(d["history"]),
-                timings=dict(d.get("timings", {})),
+                **cls._provenance_fields(d, _arx_methods(), initial="measured"),
                 bounds=None if d.get("bounds") is None else np.asarray(d["bounds"]),
-                input_name=d.get("input_name", "u"),
-                output_name=d.get("output_name", "y"),
-                input_unit=str(d.get("input_unit", "")),
-                output_unit=str(d.get("output_unit", "")),
-                u_offset=_fields.number(
-                    d, "u_offset", "a finite number", _fields.finite, 0.0
-                ),
-                y_offset=_fields.number(
-                    d, "y_offset", "a finite number", _fields.finite, 0.0
-                ),
-                fraction=fraction,
                 integrator=_integrator_field(d),
                 covariance=_covariance_field(d),
                 noise_variance=_fields.number(
@@ -579,36 +533,3 @@ def _arx_methods() -> tuple[str, ...]:
     from spiralid.choices import PARETO_METHOD_NAMES as PARETO_METHODS
 
     return (*METHODS, *(f"pareto-{name}" for name in PARETO_METHODS))
-
-
-_SUMMARY_KEYS = (
-    "fun",
-    "nit",
-    "nfev",
-    "status",
-    "success",
-    "message",
-    "start",
-    "safe_start",
-    "accepted",
-)
-
-
-def _summary(res) -> dict | None:
-    """The scalars of an optimiser result (a residual vector would bloat a
-    saved model by a record's worth of numbers)."""
-    if res is None:
-        return None
-    return {
-        k: _jsonable(getattr(res, k))
-        for k in _SUMMARY_KEYS
-        if hasattr(res, k) and np.ndim(getattr(res, k)) == 0
-    }
-
-
-def _jsonable(v):
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    if isinstance(v, np.generic):
-        return v.item()
-    return v

@@ -39,14 +39,13 @@ compiled loops in :mod:`._narx_kernels`.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 
 from ..data import IOData, check_signal, single_output_record
 from . import _fields
+from .fitted import FittedModel
 from .narx_lags import Scaling
 from .neural_narx import ACTIVATIONS, NARX
 from .polynomial_narx import PolynomialNARX
@@ -60,9 +59,11 @@ __all__ = [
 ]
 
 
-@dataclass
-class NARXModel:
-    """An estimated NARX model: structure, parameters, scaling and provenance.
+@dataclass(eq=False)
+class NARXModel(FittedModel):
+    """An estimated NARX model: structure, parameters, scaling and provenance
+    (a :class:`~spiralid.sysid.models.fitted.FittedModel` of a NARX
+    structure).
 
     What :func:`spiralid.sysid.identify` returns for a :class:`NARX` or
     :class:`PolynomialNARX` structure.
@@ -96,6 +97,8 @@ class NARXModel:
         Signal names and units.
     u_offset, y_offset : float
         Offsets removed before estimation (the record's, as for ARX).
+    fraction : float or None
+        The share of the record that estimated the model, when known.
     gain, penalty : float
         The cost's gain and stability penalty.
     linear_params : ndarray or None
@@ -111,25 +114,14 @@ class NARXModel:
     structure: NARX | PolynomialNARX
     scaling: Scaling
     ts: float
-    method: str = ""
-    predictor: str = "simulation"
-    initial: str = "rest"
-    cost: float = float("nan")
-    result: Any = None
-    history: np.ndarray | None = None
-    timings: dict = field(default_factory=dict)
-    input_name: str = "u"
-    output_name: str = "y"
-    input_unit: str = ""
-    output_unit: str = ""
-    u_offset: float = 0.0
-    y_offset: float = 0.0
-    gain: float = float("nan")
+    _: KW_ONLY
     penalty: float = 0.0
     linear_params: np.ndarray | None = None
     linear_model: str = ""
 
-    kind = "narx"
+    def __post_init__(self) -> None:
+        self._check_provenance()
+        self.params = np.asarray(self.params, dtype=float)
 
     @property
     def linear_start(self) -> NARXModel | None:
@@ -146,6 +138,12 @@ class NARXModel:
             predictor=self.predictor,
             initial=self.initial,
         )
+
+    @property
+    def linear_part(self) -> NARXModel | None:
+        """The linear model inside this one (:attr:`linear_start`), or None
+        for a structure without a linear bypass."""
+        return self.linear_start
 
     def simulate(self, u, y0=None) -> np.ndarray:
         """Free run over the input `u` from rest, or with ``y0`` (the measured
@@ -225,7 +223,6 @@ class NARXModel:
                 "terms": [list(t) for t in st.terms],
                 "term_names": st.term_names(),
             }
-        res = self.result
         out = {
             "model": "narx",
             "structure": sd,
@@ -235,33 +232,12 @@ class NARXModel:
                 for k in ("u_shift", "u_scale", "y_shift", "y_scale")
             },
             "ts": float(self.ts),
-            "method": self.method,
-            "predictor": self.predictor,
-            "initial": self.initial,
-            "cost": float(self.cost),
-            "gain": float(self.gain),
-            "history": None
-            if self.history is None
-            else [float(v) for v in self.history],
-            "timings": {k: float(v) for k, v in self.timings.items()},
-            "input_name": self.input_name,
-            "output_name": self.output_name,
-            "input_unit": self.input_unit,
-            "output_unit": self.output_unit,
-            "u_offset": float(self.u_offset),
-            "y_offset": float(self.y_offset),
+            **self._provenance_dict(),
             "linear_start": None
             if self.linear_params is None
             else {
                 "model": self.linear_model,
                 "params": [float(v) for v in self.linear_params],
-            },
-            "result": None
-            if res is None
-            else {
-                k: (v if isinstance(v, bool | str) else float(v))
-                for k, v in res.items()
-                if k in ("fun", "nfev", "nit", "status", "success", "message")
             },
         }
         if not timings:
@@ -337,23 +313,7 @@ class NARXModel:
                 structure=st,
                 scaling=sc,
                 ts=_fields.number(d, "ts", "a number > 0", _fields.positive),
-                method=_fields.method(d, _narx_methods()),
-                predictor=d.get("predictor", "simulation"),
-                initial=d.get("initial", "rest"),
-                cost=_fields.number(d, "cost", "a number", _fields.anything, math.nan),
-                gain=_fields.gain(d),
-                history=None if d.get("history") is None else np.asarray(d["history"]),
-                timings=dict(d.get("timings", {})),
-                input_name=d.get("input_name", "u"),
-                output_name=d.get("output_name", "y"),
-                input_unit=str(d.get("input_unit", "")),
-                output_unit=str(d.get("output_unit", "")),
-                u_offset=_fields.number(
-                    d, "u_offset", "a finite number", _fields.finite, 0.0
-                ),
-                y_offset=_fields.number(
-                    d, "y_offset", "a finite number", _fields.finite, 0.0
-                ),
+                **cls._provenance_fields(d, _narx_methods(), penalty=0.0),
                 **_linear_start(d.get("linear_start"), st),
             )
         except KeyError as exc:

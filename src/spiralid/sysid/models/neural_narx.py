@@ -98,6 +98,10 @@ class NARX(_Lags):
         """Hidden units (0 without a network)."""
         return self.hidden[0] if self.hidden else 0
 
+    #: A network is nonlinear (its validation adds the higher-order tests),
+    #: even when training kept its output weights at zero.
+    is_linear = False
+
     @property
     def n_params(self) -> int:
         """Length of the parameter vector."""

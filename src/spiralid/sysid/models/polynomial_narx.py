@@ -88,6 +88,10 @@ class PolynomialNARX(_Lags):
         """Number of candidate terms."""
         return len(self.candidates())
 
+    #: Validated as a nonlinear model (higher-order tests, no poles), even at
+    #: ``degree=1``: its fitted model holds monomials, not polynomials in q.
+    is_linear = False
+
     @property
     def n_params(self) -> int:
         """Number of coefficients (the chosen terms, or the cap)."""

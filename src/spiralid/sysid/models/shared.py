@@ -263,7 +263,7 @@ class SharedDenominatorModel:
     def to_dict(self) -> dict:
         """A JSON-safe form (what ``model.json`` holds)."""
         return {
-            "kind": "shared-denominator",
+            "model": "shared-denominator",
             "structure": {"na": self.arx.na, "nb": self.arx.nb, "nk": self.arx.nk},
             "ts": self.ts,
             "method": self.method,
@@ -286,9 +286,11 @@ class SharedDenominatorModel:
     @classmethod
     def from_dict(cls, d: dict) -> SharedDenominatorModel:
         """The model :meth:`to_dict` wrote."""
-        if d.get("kind") != "shared-denominator":
+        # Files written before the field was called "model" name it "kind".
+        kind = d.get("model", d.get("kind"))
+        if kind != "shared-denominator":
             raise ValueError(
-                f"field 'kind' must be 'shared-denominator'; got {d.get('kind')!r}"
+                f"field 'model' must be 'shared-denominator'; got {kind!r}"
             )
         s = d["structure"]
 

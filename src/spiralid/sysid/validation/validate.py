@@ -181,7 +181,7 @@ def validate(
     """
     if isinstance(residuals, str) and residuals == "auto":
         residuals = _fitted_error(model)
-    if getattr(model, "kind", None) == "narx":
+    if not getattr(model, "is_linear", True):
         # Poles, modes and realisations mean nothing for a nonlinear model:
         # its own report (fits and the Billings-Voon tests), and the options
         # of spectra and modes are refused rather than ignored.

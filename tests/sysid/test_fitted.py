@@ -1,0 +1,128 @@
+"""One fitted-model type: an ARX fit and a NARX fit share their provenance,
+its JSON form and one reader, and validate dispatches on the structure."""
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from spiralid.sysid import (
+    ARX,
+    NARX,
+    FittedModel,
+    IdentifiedModel,
+    IOData,
+    NARXModel,
+    PolynomialNARX,
+    SharedDenominatorModel,
+    identify,
+    load_model,
+    validate,
+)
+from spiralid.sysid.validation.nonlinear import NARXValidation
+from spiralid.sysid.validation.validate import Validation
+
+
+@pytest.fixture(scope="module")
+def record():
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(400)
+    y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    y = y + 0.3 * np.tanh(y) + 0.01 * rng.standard_normal(u.size)
+    return IOData(u, y, ts=0.01, input_name="torque", output_name="angle")
+
+
+@pytest.fixture(scope="module")
+def fits(record):
+    return {
+        "arx": identify(record, ARX(2, 2, 1), method="ls"),
+        "narx": identify(record, NARX(2, 2, 1, hidden=(3,)), method="ls", rng=0),
+        "polynomial": identify(
+            record, PolynomialNARX(2, 2, 1, degree=2, n_terms=5), method="ls"
+        ),
+    }
+
+
+PROVENANCE = [f.name for f in dataclasses.fields(FittedModel)]
+
+
+def test_every_fit_is_one_fitted_model_type(fits):
+    for model in fits.values():
+        assert isinstance(model, FittedModel)
+        assert model.params.shape == (model.structure.n_params,)
+        assert model.input_name == "torque" and model.output_name == "angle"
+    assert isinstance(fits["arx"], IdentifiedModel)
+    assert isinstance(fits["narx"], NARXModel)
+
+
+def test_the_provenance_is_written_alike_by_every_model(fits):
+    """The same provenance keys, with the same values for the same fields,
+    whatever the structure (NARX once lacked `fraction`)."""
+    for model in fits.values():
+        model.fraction = 0.5
+        d = model.to_dict()
+        missing = [k for k in PROVENANCE if k not in d]
+        assert not missing, (type(model).__name__, missing)
+        assert d["fraction"] == 0.5 and d["method"] == "ls"
+        assert d["input_name"] == "torque"
+
+
+@pytest.mark.parametrize("kind", ["arx", "narx", "polynomial"])
+def test_load_model_reads_back_every_kind(fits, record, kind):
+    model = fits[kind]
+    text = json.dumps(model.to_dict(timings=False))
+    back = load_model(json.loads(text))
+    assert type(back) is type(model)
+    np.testing.assert_array_equal(back.params, model.params)
+    np.testing.assert_array_equal(back.simulate(record.u), model.simulate(record.u))
+    for name in PROVENANCE:
+        if name not in ("result", "timings", "history"):
+            assert getattr(back, name) == pytest.approx(getattr(model, name)), name
+
+
+def test_load_model_reads_a_shared_denominator_model():
+    model = SharedDenominatorModel(
+        a=[-1.5, 0.7], b=[[1.0, 0.5], [0.2, 0.1]], arx=ARX(2, 2, 1), ts=0.01,
+        output_names=("a", "b"),
+    )  # fmt: skip
+    back = load_model(json.loads(json.dumps(model.to_dict())))
+    assert isinstance(back, SharedDenominatorModel)
+    np.testing.assert_array_equal(back.b, model.b)
+    # A file written when the field was called "kind".
+    old = model.to_dict()
+    old["kind"] = old.pop("model")
+    assert isinstance(load_model(old), SharedDenominatorModel)
+
+
+@pytest.mark.parametrize(
+    ("d", "named"),
+    [
+        ({"model": "tree"}, "field 'model' must be one of arx, narx"),
+        ([1, 2], "a model must be a JSON object"),
+    ],
+)
+def test_load_model_refuses_what_it_cannot_read(d, named):
+    with pytest.raises(ValueError, match=named):
+        load_model(d)
+
+
+def test_validate_dispatches_on_the_structure(fits, record):
+    assert fits["arx"].is_linear and not fits["narx"].is_linear
+    assert isinstance(validate(fits["arx"], record), Validation)
+    assert isinstance(validate(fits["narx"], record), NARXValidation)
+    assert isinstance(validate(fits["polynomial"], record), NARXValidation)
+
+
+def test_the_linear_part(fits, record):
+    """An ARX fit is its own linear part; a NARX's is its linear start,
+    the ARX with the same lags (network output weights zero)."""
+    assert fits["arx"].linear_part is fits["arx"]
+    lin = fits["narx"].linear_part
+    assert lin is not None and isinstance(lin, NARXModel)
+    # Without an integrator the linear start is ARX(ny, nu, nk) by the
+    # method's own linear estimate (least squares here).
+    two = identify(record, ARX(2, 2, 1), method="ls")
+    y_lin = lin.simulate(record.u)
+    assert np.max(np.abs(y_lin - two.simulate(record.u))) < 1e-6 * np.ptp(record.y)
