@@ -30,8 +30,8 @@ from spiralid.sysid import (
     arx_least_squares,
     identify,
 )
-from spiralid.sysid.estimation.estimators import search_options
 from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
+from spiralid.sysid.estimation.searches import search_options
 from spiralid.sysid.validation.validate import Validation, validate
 
 __all__ = [
@@ -471,7 +471,7 @@ def reproduce(
     max_nfev : int, default 20000
         Budget of cost evaluations of every search run, the same for all so
         that the algorithms compare at equal cost; no iteration cap stops a
-        run first (:func:`spiralid.sysid.estimation.estimators.search_options`).
+        run first (:func:`spiralid.sysid.estimation.searches.search_options`).
     n_points : int, default 50
         Search points ``m``.
     arx : ARX, default ARX(8, 8, 0)

@@ -10,7 +10,12 @@ from scipy import optimize, signal
 from spiralid.cli import build_parser
 from spiralid.datasets import robot_arm
 from spiralid.sysid import ARX, IOData, PaperCost, identify, step_up
-from spiralid.sysid.estimation import estimators, outputerror, parametrizations
+from spiralid.sysid.estimation import (
+    estimators,
+    local_estimators,
+    outputerror,
+    parametrizations,
+)
 from spiralid.sysid.estimation.estimators import (
     METHODS,
     STATUS,
@@ -173,7 +178,9 @@ def test_polish_says_when_it_stopped_at_its_evaluation_cap(record, monkeypatch):
     full = identify(record, ARX4, method="oe")
     assert full.result.status == 0
     monkeypatch.setattr(
-        estimators, "local_polish", partial(outputerror.local_polish, max_nfev=3)
+        local_estimators,
+        "local_polish",
+        partial(outputerror.local_polish, max_nfev=3),
     )
     oe = identify(record, ARX4, method="oe")
     assert oe.result.status == 1 and oe.result.nfev <= 3

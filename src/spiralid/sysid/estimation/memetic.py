@@ -151,7 +151,7 @@ def projected_spiral(
     memetic polish and the restarts are its callback, which then calls
     `callback`.
     The settings have no defaults here: the recommended method's are
-    :func:`~spiralid.sysid.estimation.estimators._estimate_recommended`'s.
+    :func:`~spiralid.sysid.estimation.spiral_method._estimate_recommended`'s.
 
     Parameters
     ----------

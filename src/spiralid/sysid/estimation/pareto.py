@@ -73,7 +73,6 @@ from ..data import IOData, single_output_record
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from .cost import PaperCost
-from .estimators import EstimatorResult
 from .frequency import (
     DEFAULT_MIN_COHERENCE,
     FrequencyError,
@@ -82,6 +81,7 @@ from .frequency import (
 )
 from .outputerror import steiglitz_mcbride
 from .parametrizations import Modal, make_parametrization
+from .problem import EstimatorResult
 
 __all__ = [
     "OBJECTIVES",

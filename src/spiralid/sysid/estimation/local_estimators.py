@@ -1,0 +1,175 @@
+"""The estimators that do not search, and the local polish the searches end
+with: least squares (``"ls"``), output error (``"oe"``: Levenberg-Marquardt
+from the least-squares and Steiglitz-McBride starts), the exact fit of an
+FIR structure, ``refine``'s polish of a search's best and the removal of
+near-cancelling pole-zero pairs."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..models.arx import arx_least_squares
+from .cost import PaperCost
+from .outputerror import local_polish, steiglitz_mcbride
+from .problem import EstimatorResult, Problem
+
+
+def _estimate_ls(problem: Problem) -> EstimatorResult:
+    t0 = time.perf_counter()
+    theta = arx_least_squares(problem.data, problem.arx)
+    return EstimatorResult(
+        x=theta,
+        fun=float(problem.cost(theta)),
+        status=0,
+        success=True,
+        message="Least-squares solution (exact minimiser of the one-step error).",
+        nfev=0,
+        nit=0,
+        n_restarts=0,
+        history=None,
+        elapsed=time.perf_counter() - t0,
+        raw=None,
+    )
+
+
+def _polish(
+    problem: Problem,
+    starts: dict[str, np.ndarray],
+    predictor: str,
+    cost: PaperCost,
+    max_nfev: int | None = None,
+) -> EstimatorResult:
+    """Levenberg-Marquardt from every start; keep the lowest `cost` (ties:
+    the first start). The simulation error is not convex, so each start may
+    stop in a different local minimum; the choice is on the estimation cost,
+    never on validation data. `max_nfev` caps each polish (None:
+    :func:`~spiralid.sysid.estimation.outputerror.local_polish`'s own)."""
+    t0 = time.perf_counter()
+    best = None
+    costs, thetas = {}, {}
+    # Passed only when set, so local_polish's own default stays its own.
+    cap = {} if max_nfev is None else {"max_nfev": max_nfev}
+    for name, start in starts.items():
+        theta, res = local_polish(
+            start,
+            problem.arx,
+            problem.data,
+            predictor,
+            problem.initial,
+            max_radius=problem.max_radius,
+            **cap,
+        )
+        costs[name] = float(cost(theta))
+        thetas[name] = theta
+        if best is None or costs[name] < best[0]:
+            best = (costs[name], name, theta, res)
+    _, name, theta, res = best
+    res.start = name
+    capped = res.capped
+    return EstimatorResult(
+        x=theta,
+        fun=float(problem.cost(theta)),
+        status=1 if capped else 0,
+        success=bool(res.success),
+        message=(
+            f"Stopped at the evaluation cap (max_nfev = {res.max_nfev}) before "
+            "the tolerances were met."
+            if capped
+            else res.message
+        ),
+        nfev=int(res.nfev),
+        optimality=float(res.optimality),
+        at_bound=bool(res.at_bound),
+        nit=int(res.nit),
+        n_restarts=0,
+        history=None,
+        elapsed=time.perf_counter() - t0,
+        start=name,
+        starts=costs,
+        thetas=thetas,
+        raw=res,
+    )
+
+
+def _standard_starts(problem: Problem) -> dict[str, np.ndarray]:
+    theta_ls = problem.parametrization.theta_ls
+    return {
+        "ls": theta_ls,
+        "steiglitz-mcbride": steiglitz_mcbride(problem.data, problem.arx, theta_ls),
+    }
+
+
+def _estimate_oe(problem: Problem) -> EstimatorResult:
+    # With a one-step `predictor` the selection is still on the simulation
+    # error OE minimises, not on the reported cost.
+    cost = problem.simulation_cost()
+    result = _polish(problem, _standard_starts(problem), "simulation", cost)
+    if problem.cancel:
+        _cancel(problem, result, cost)
+    return result
+
+
+def _cancel(problem: Problem, result: EstimatorResult, cost: PaperCost) -> None:
+    """Remove the near-cancelling pole-zero pairs that raise `cost` (the
+    error the method minimises) by at most 1 %
+    (:func:`~spiralid.sysid.estimation.cancellation.reduce_order`); each
+    reduced model is polished by output error, with the same margin, from
+    the deflated model (fresh starts at the reduced order would find other
+    minima: that is choosing an order, not removing a pair)."""
+    from .cancellation import effective, reduce_order
+
+    def polish(start, reduced):
+        theta, _ = local_polish(
+            start,
+            reduced,
+            problem.data,
+            "simulation",
+            problem.initial,
+            max_radius=problem.max_radius,
+        )
+        return theta
+
+    theta, removed = reduce_order(result.x, problem.arx, problem.data.n, cost, polish)
+    if not removed:
+        return
+    result.x_full, result.fun_full = result.x, result.fun
+    result.x, result.fun = theta, float(problem.cost(theta))
+    result.cancelled = removed
+    k = sum(c["order"] for c in removed)
+    result.effective_order = (problem.arx.na - k, problem.arx.nb - k)
+    _, reduced = effective(theta, problem.arx, result.effective_order)
+    result.message = (
+        f"{result.message} Then {len(removed)} near-cancelling pole-zero "
+        f"pair(s) removed: effective order {reduced}."
+    )
+
+
+def _refine(problem: Problem, result: EstimatorResult) -> None:
+    """Polish the search's best locally; keep it only if it lowers the cost."""
+    starts = {"search": result.x}
+    if problem.safe_start:
+        starts.update(_standard_starts(problem))
+    polished = _polish(problem, starts, problem.predictor, problem.cost)
+    polished.accepted = bool(polished.fun <= result.fun)
+    if polished.accepted:
+        result.x, result.fun = polished.x, polished.fun
+    result.refine = polished
+
+
+def _estimate_fir(problem: Problem) -> EstimatorResult:
+    """An FIR model (``na = 0``): the simulation error is linear in the
+    numerator, so its exact minimiser is one least-squares solve (a
+    Levenberg-Marquardt step from least squares); no search can do better."""
+    result = _polish(
+        problem,
+        {"ls": problem.parametrization.theta_ls},
+        problem.predictor,
+        problem.cost,
+    )
+    result.message = (
+        "FIR model (na = 0): the cost is quadratic in the numerator; its exact "
+        "minimiser, no search needed."
+    )
+    return result
