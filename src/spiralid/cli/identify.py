@@ -149,6 +149,7 @@ def _run_narx(args) -> int:
             if steps:
                 options["callback"] = _search_callback(progress, steps, args)
             model = identify(est, structure, method=args.method, **options)
+            model.fraction = args.fraction
             progress.phase("validation", "validating on both parts")
             v_est, v_val = _validated(model, est, val, args.method)
             progress.phase("writing", "writing files and figures")
