@@ -18,6 +18,8 @@ from .estimation.problem import EstimatorResult as EstimatorResult
 from .estimation.subspace import subspace_denominator as subspace_denominator
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
+from .models.files import load_model as load_model
+from .models.fitted import FittedModel as FittedModel
 from .models.identified import IdentifiedModel as IdentifiedModel
 from .models.modes import ModeTable as ModeTable
 from .models.narx import NARX as NARX
@@ -64,6 +66,7 @@ __all__ = [
     "PARAMETRIZATIONS",
     "CorrelationTest",
     "EstimatorResult",
+    "FittedModel",
     "IOData",
     "IdentifiedModel",
     "ModalParametrization",
@@ -95,6 +98,7 @@ __all__ = [
     "is_stable_polynomial",
     "joint_fit",
     "knee_point",
+    "load_model",
     "max_pole_radius",
     "modes_from_poles",
     "projected_spiral",
