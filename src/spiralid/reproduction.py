@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from spiralid._checks import is_default
 from spiralid.study.runner import execute
 from spiralid.study.spec import BASELINES
 from spiralid.study.tasks import reading_tasks
@@ -26,9 +27,12 @@ from spiralid.sysid import (
     ARX,
     IdentifiedModel,
     IOData,
+    OutputsValidation,
     PaperCost,
+    SharedDenominatorModel,
     arx_least_squares,
     identify,
+    validate_outputs,
 )
 from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
 from spiralid.sysid.estimation.searches import search_options
@@ -37,9 +41,13 @@ from spiralid.sysid.validation.validate import Validation, validate
 __all__ = [
     "CONFIGURATIONS",
     "HEADLINE_TEST",
+    "RIG_INTEGRATORS",
+    "RIG_OUTPUTS",
+    "SHARED_ARX",
     "Configuration",
     "Reproduction",
     "Run",
+    "SharedModesFit",
     "default_data",
     "default_data_source",
     "reproduce",
@@ -169,6 +177,102 @@ class Run:
         }
 
 
+# Every sensor of the simulated rig's experiment, each one's known
+# integrators against the hub torque (the hub angle twice, the hub velocity
+# once, outside the shared poles) and the structure that identifies the
+# shared modes from all four: three modes, the anti-aliasing filter's pair
+# and the fourth mode (docs/results/identification.md, "Several sensors").
+RIG_OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
+RIG_INTEGRATORS = (2, 1, 0, 0)
+SHARED_ARX = ARX(10, 10, 1)
+# The FEM modes the shared fit is set against.
+_FEM_MODES = 3
+
+
+@dataclass
+class SharedModesFit:
+    """The rig's modes identified from every sensor of the experiment.
+
+    One denominator for the hub angle, hub velocity, end-point acceleration
+    and tip deflection of the same simulated run as the paper's record
+    (:data:`RIG_OUTPUTS`, :data:`SHARED_ARX`, :data:`RIG_INTEGRATORS`), by
+    :func:`~spiralid.sysid.identify`'s default method, beside the paper's
+    single-output models.
+
+    Attributes
+    ----------
+    model : SharedDenominatorModel
+    estimation, validation : OutputsValidation
+        Each output's fit and the joint fit on the two parts.
+    fem_hz : ndarray, shape (3,)
+        The rig's first three natural frequencies from its finite-element
+        model (``FlexibleManipulator().modes(3)``), Hz.
+    seed : int
+        The search's seed.
+    seconds : float
+        Wall time of the identification.
+    """
+
+    model: SharedDenominatorModel
+    estimation: OutputsValidation
+    validation: OutputsValidation
+    fem_hz: np.ndarray
+    seed: int
+    seconds: float
+
+    def nearest(self, frequencies) -> tuple[np.ndarray, np.ndarray]:
+        """For each FEM mode, the nearest of `frequencies` (Hz; NaN when
+        there is none) and its error in percent of the FEM's."""
+        return _nearest(self.fem_hz, frequencies)
+
+    def to_dict(self) -> dict:
+        hz, err = self.nearest(self.model.modes.table.frequency)
+        return {
+            "outputs": list(self.model.output_names),
+            "structure": {
+                "na": self.model.arx.na,
+                "nb": self.model.arx.nb,
+                "nk": self.model.arx.nk,
+            },
+            "integrators": list(self.model.integrators),
+            "method": self.model.method,
+            "seed": self.seed,
+            "seconds": self.seconds,
+            "fem_modes_hz": self.fem_hz.tolist(),
+            "nearest_modes_hz": _plain_list(hz),
+            "error_percent": _plain_list(err),
+            "modes": self.model.modes.to_dict(),
+            "fit_percent": {
+                part: {
+                    **{n: v.fit_percent for n, v in ov.outputs.items()},
+                    "joint": ov.joint_fit_percent,
+                }
+                for part, ov in (
+                    ("estimation", self.estimation),
+                    ("validation", self.validation),
+                )
+            },
+            "model": self.model.to_dict(),
+        }
+
+
+def _nearest(reference, frequencies) -> tuple[np.ndarray, np.ndarray]:
+    """Each `reference` frequency's nearest in `frequencies` and its error
+    (% of the reference); NaN where `frequencies` is empty."""
+    ref = np.asarray(reference, dtype=float)
+    f = np.asarray(frequencies, dtype=float)
+    f = f[np.isfinite(f)]
+    if f.size == 0:
+        nan = np.full(ref.shape, np.nan)
+        return nan, nan.copy()
+    hz = f[np.argmin(np.abs(f[None, :] - ref[:, None]), axis=1)]
+    return hz, 100.0 * (hz - ref) / ref
+
+
+def _plain_list(values) -> list:
+    return [float(v) if np.isfinite(v) else None for v in values]
+
+
 @dataclass
 class Reproduction:
     """Everything :func:`reproduce` computed.
@@ -194,6 +298,9 @@ class Reproduction:
         How the record was obtained (see :func:`reproduce`).
     elapsed : float
         Wall time of the whole experiment in seconds.
+    shared : SharedModesFit or None
+        The rig's modes from every sensor (``reproduce(all_outputs=True)``);
+        None otherwise.
     """
 
     data: IOData
@@ -208,6 +315,7 @@ class Reproduction:
     validations: dict[str, tuple[Validation, Validation]] = field(repr=False)
     source: dict = field(default_factory=dict)
     elapsed: float = 0.0
+    shared: SharedModesFit | None = None
 
     def best(self, label: str) -> Run:
         """The run of lowest estimation cost (ties: the first seed)."""
@@ -215,6 +323,32 @@ class Reproduction:
             return self.baselines[label]
         runs = self.runs[label]
         return runs[int(np.argmin([r.cost for r in runs]))]
+
+    def modes_comparison(self) -> list[dict]:
+        """The FEM's modes beside those of every sensor's shared fit and of
+        each single-output best model and baseline: for each model, the
+        mode nearest each FEM frequency and its error in percent. Empty
+        without :attr:`shared`."""
+        if self.shared is None:
+            return []
+        rows = []
+        models = [("every sensor", self.shared.model, self.shared.model.arx)]
+        models += [
+            (label, self.best(label).model, self.arx)
+            for label in [*self.runs, *self.baselines]
+        ]
+        for label, model, arx in models:
+            table = getattr(model.modes, "table", model.modes)
+            hz, err = self.shared.nearest(table.frequency)
+            rows.append(
+                {
+                    "model": label,
+                    "structure": str(arx),
+                    "frequency_hz": _plain_list(hz),
+                    "error_percent": _plain_list(err),
+                }
+            )
+        return rows
 
     def statistics(self, label: str) -> dict:
         """Mean, std, median, best and worst over seeds of cost and fit."""
@@ -388,9 +522,14 @@ def default_data(seed: int = 0) -> IOData:
     :func:`spiralid.fms.paper_experiment` on the default
     :class:`~spiralid.fms.FlexibleManipulator`, sensor noise seeded by `seed`.
     """
+    return _rig_recording(seed).iodata("end_acceleration")
+
+
+def _rig_recording(seed: int):
+    """The simulated rig's bang-bang experiment, every sensor recorded."""
     from spiralid.fms import paper_experiment
 
-    return paper_experiment().run(rng=seed).iodata("end_acceleration")
+    return paper_experiment().run(rng=seed)
 
 
 def default_data_source(seed: int = 0) -> dict:
@@ -456,6 +595,7 @@ def reproduce(
     fraction: float = 2 / 3,
     initial: str = "rest",
     configurations: Sequence[Configuration] = CONFIGURATIONS,
+    all_outputs: bool = False,
     source: dict | None = None,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
@@ -488,6 +628,14 @@ def reproduce(
         Default :data:`CONFIGURATIONS`. With ``initial="measured"`` the
         ``"modal"`` ones (the recommended ``"spiral"``) are left out: they
         project the numerator of the simulation from rest only.
+    all_outputs : bool, default False
+        Also identify the rig's modes from all four sensors of the same
+        simulated run (:class:`SharedModesFit`: hub angle, hub velocity,
+        end-point acceleration and tip deflection with one denominator,
+        :data:`SHARED_ARX` with known integrators :data:`RIG_INTEGRATORS`,
+        seeded by the first of `seeds`), beside the paper's single-output
+        model; the paper's runs are unchanged. Only for the simulated rig
+        (`data` None): a record of one sensor has no others.
     source : dict, optional
         How `data` was obtained, recorded in the results (e.g. its path);
         default a description of the simulated rig when `data` is None.
@@ -502,6 +650,7 @@ def reproduce(
     Reproduction
     """
     t0 = time.perf_counter()
+    every_sensor = _all_outputs_record(data, all_outputs)
     if data is None:
         data, source = default_data(), default_data_source()
     source = {"kind": "user data"} if source is None else dict(source)
@@ -549,8 +698,45 @@ def reproduce(
         source=source,
     )
     rep.validations = _validate_best(rep)
+    if every_sensor is not None:
+        rep.shared = _fit_every_sensor(every_sensor, fraction, seed_list[0])
     rep.elapsed = time.perf_counter() - t0
     return rep
+
+
+def _all_outputs_record(data, all_outputs) -> IOData | None:
+    """The rig's record of every sensor when `all_outputs` asks for it
+    (the same run as :func:`default_data`'s), after its checks."""
+    if not isinstance(all_outputs, bool | np.bool_):
+        raise ValueError(f"`all_outputs` must be True or False; got {all_outputs!r}")
+    if is_default(all_outputs, False):
+        return None
+    if data is not None:
+        raise ValueError(
+            "`all_outputs` applies to the simulated rig (data=None) only: a "
+            "record given as `data` has no other sensors; leave it False"
+        )
+    return _rig_recording(0).iodata(list(RIG_OUTPUTS))
+
+
+def _fit_every_sensor(record: IOData, fraction: float, seed: int) -> SharedModesFit:
+    """One denominator for every sensor of `record`, validated on both parts."""
+    from spiralid.fms import FlexibleManipulator
+
+    est, val = record.split(fraction)
+    start = time.perf_counter()
+    model = identify(est, SHARED_ARX, integrator=RIG_INTEGRATORS, rng=seed)
+    seconds = time.perf_counter() - start
+    return SharedModesFit(
+        model=model,
+        estimation=validate_outputs(model, est, label="every sensor (estimation)"),
+        validation=validate_outputs(
+            model, val, warmup=est, label="every sensor (validation)"
+        ),
+        fem_hz=np.asarray(FlexibleManipulator().modes(_FEM_MODES), dtype=float),
+        seed=seed,
+        seconds=seconds,
+    )
 
 
 def _checked_seeds(data, seeds, n_points, max_nfev) -> list[int]:

@@ -35,6 +35,11 @@ def run(args, argv: list[str]) -> int:
         raise UsageError(
             "--input, --output, --ts and the units describe --data; give --data too"
         )
+    if args.all_outputs and args.data is not None:
+        raise UsageError(
+            "--all-outputs identifies the simulated rig's modes from its four "
+            "sensors; it does not apply to --data (a record of one output)"
+        )
     with _progress(args) as progress:
         if args.data is not None:
             progress.phase("load", "loading the data")
@@ -52,6 +57,7 @@ def run(args, argv: list[str]) -> int:
                 max_nfev=args.budget,
                 n_points=args.points,
                 initial=args.initial,
+                all_outputs=args.all_outputs,
                 source=source,
                 workers=args.workers,
                 progress=progress,
@@ -95,6 +101,14 @@ def add_parser(sub) -> None:
     )
     _add_data_options(p)
     _add_initial_option(p)
+    p.add_argument(
+        "--all-outputs",
+        action="store_true",
+        help="also identify the rig's modes from all four sensors of the same "
+        "run (hub angle, hub velocity, end-point acceleration, tip deflection: "
+        "one denominator, ARX(10, 10, 1), integrators 2,1,0,0) beside the "
+        "paper's single-output model; the simulated rig only",
+    )
     p.add_argument("--out", default="spiralid-reproduce", help="output directory")
     p.add_argument("--force", action="store_true", help="write into a non-empty --out")
     _add_quiet_option(p)

@@ -143,6 +143,18 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
         },
         "baselines": {k: r.to_dict() for k, r in rep.baselines.items()},
         "runs": {k: [r.to_dict() for r in runs] for k, runs in rep.runs.items()},
+        # Only with reproduce(all_outputs=True): the paper's run writes the
+        # same keys as before.
+        **(
+            {}
+            if rep.shared is None
+            else {
+                "modes_from_every_sensor": {
+                    **rep.shared.to_dict(),
+                    "comparison": rep.modes_comparison(),
+                }
+            }
+        ),
     }
 
 
@@ -260,9 +272,29 @@ def summary_text(rep: Reproduction) -> str:
             rep.verdict(),
             f"Headline test: {HEADLINE_TEST}.",
             rep.budget_verdict()["sentence"],
+            *_every_sensor_text(rep),
             f"Experiment wall time {rep.elapsed:.1f} s.",
         ]
     )
+
+
+def _every_sensor_text(rep: Reproduction) -> list[str]:
+    """The modes from every sensor beside the FEM's, for the summary (none
+    without ``all_outputs``)."""
+    if rep.shared is None:
+        return []
+    fit = rep.shared.model
+    hz, err = rep.shared.nearest(fit.modes.table.frequency)
+    fem = ", ".join(f"{f:.4g}" for f in rep.shared.fem_hz)
+    found = ", ".join(f"{f:.4g} ({e:+.3f} %)" for f, e in zip(hz, err, strict=True))
+    return [
+        "",
+        f"Modes from every sensor ({', '.join(fit.output_names)}; {fit.arx}, "
+        f"integrators {', '.join(map(str, fit.integrators))}): {found} against "
+        f"the FEM's {fem} Hz; joint validation fit "
+        f"{rep.shared.validation.joint_fit_percent:.2f} %.",
+        str(fit.modes),
+    ]
 
 
 def _tf_block(label: str, tf: str) -> str:
@@ -285,6 +317,7 @@ def _html(rep: Reproduction, images: dict[str, bytes], command: str | None) -> s
         _transfer_functions_section(rep),
         _stability_section(rep),
         _modes_section(rep),
+        _every_sensor_section(rep),
         _READING,
     ]
     return page("spiralid: SDA vs Eb-SDA reproduction", parts)
@@ -526,6 +559,47 @@ def _modes_section(rep: Reproduction) -> str:
             rows,
             "html",
         )
+    )
+
+
+def _every_sensor_section(rep: Reproduction) -> str:
+    """The rig's modes from all four sensors (``all_outputs``): the shared
+    modes' table, each output's fit and the modes beside the FEM's and the
+    single-output models'."""
+    from spiralid.report.shared_output import fits_table, modes_table
+
+    if rep.shared is None:
+        return ""
+    e = html.escape
+    fit = rep.shared.model
+    fem = rep.shared.fem_hz
+    head = ["model", "structure"]
+    for i in range(1, fem.size + 1):
+        head += [f"mode {i} (Hz)", "error (%)"]
+    rows = [["FEM (rig.modes(3))", "-", *(c for f in fem for c in (f"{f:.4f}", "-"))]]
+    for row in rep.modes_comparison():
+        cells = [row["model"], row["structure"]]
+        for f, err in zip(row["frequency_hz"], row["error_percent"], strict=True):
+            cells += ["-", "-"] if f is None else [f"{f:.4f}", f"{err:+.3f}"]
+        rows.append(cells)
+    integrators = ", ".join(
+        f"{n} {k}" for n, k in zip(fit.output_names, fit.integrators, strict=True)
+    )
+    return (
+        "<h2>Modes from every sensor</h2><p>The same simulated run's four "
+        f"sensors ({e(', '.join(fit.output_names))}) identified with one "
+        f"denominator, {e(str(fit.arx))} by {e(fit.method)} (seed "
+        f"{rep.shared.seed}, {rep.shared.seconds:.1f} s), known integrators "
+        f"outside the shared poles: {e(integrators)}. The 95 % intervals come "
+        "from the shared denominator's covariance; a share is the mode's "
+        "resonant peak as a part of that output's.</p>"
+        + table(*modes_table(fit.modes), "html")
+        + table(*fits_table(rep.shared.estimation, rep.shared.validation), "html")
+        + "<p>Each model's mode nearest each of the finite-element model's "
+        "first three natural frequencies, and its error: the shared fit "
+        "beside the paper's single-output models (best run of each "
+        "configuration, end-point acceleration alone) and the baselines.</p>"
+        + table(head, rows, "html")
     )
 
 
