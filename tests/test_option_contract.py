@@ -524,7 +524,7 @@ import spiralid.sysid.estimation.pareto as pareto_module  # noqa: E402
 from spiralid.cli.pareto import _OPTION_FLAGS as _PARETO_FLAGS  # noqa: E402
 from spiralid.cli.pareto import _check_options as _check_pareto  # noqa: E402
 from spiralid.optim.pareto import PARETO_METHODS  # noqa: E402
-from spiralid.sysid.estimation.pareto import (  # noqa: E402
+from spiralid.sysid.estimation.pareto_settings import (  # noqa: E402
     pareto_options,
     refused_pareto_options,
 )

@@ -63,24 +63,24 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from spiralid._checks import generator, integer, is_default, refuse_options
+from spiralid._checks import generator, integer
 from spiralid.choices import OBJECTIVES
-from spiralid.optim._decomposition import Archive
 from spiralid.optim.front import knee_point
-from spiralid.optim.pareto import PARETO_OPTIONS, minimize_pareto, non_dominated
+from spiralid.optim.pareto import non_dominated
 
 from ..data import IOData, single_output_record
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from .cost import PaperCost
-from .frequency import (
-    DEFAULT_MIN_COHERENCE,
-    FrequencyError,
-    FrequencyEstimate,
-    h1_estimate,
+from .frequency import FrequencyError, FrequencyEstimate, h1_estimate
+from .pareto_search import _Progress, _search_structure, _StructureRun
+from .pareto_settings import (
+    _FREQUENCY_DEFAULTS,
+    _SEARCH_DEFAULTS,
+    _pareto_settings,
+    pareto_options,
+    refused_pareto_options,
 )
-from .outputerror import steiglitz_mcbride
-from .parametrizations import Modal, make_parametrization
 from .problem import EstimatorResult
 
 __all__ = [
@@ -90,8 +90,6 @@ __all__ = [
     "pareto_options",
     "refused_pareto_options",
 ]
-
-_SEEDS = ("ls", "steiglitz-mcbride", "oe")
 
 
 @dataclass
@@ -214,175 +212,6 @@ def _names(objectives, several: bool) -> tuple[str, ...]:
     return names
 
 
-def _seed_thetas(data: IOData, arx: ARX, par, initial: str) -> dict[str, np.ndarray]:
-    """The single-objective estimates that seed a search."""
-    from .identify import identify
-
-    theta_ls = par.theta_ls
-    return {
-        "ls": theta_ls,
-        "steiglitz-mcbride": steiglitz_mcbride(data, arx, theta_ls),
-        "oe": identify(data, arx, method="oe", initial=initial).theta,
-    }
-
-
-def _candidates(par, cost: PaperCost):
-    """``x -> (theta, cost)`` for a population of searched points; with the
-    modal parametrisation the projected numerator is computed once."""
-    if isinstance(par, Modal):
-        projected = par.projected(cost)
-        modes = par.modes
-
-        def modal(x):
-            a = modes.to_denominator(x)
-            f, b = projected.evaluate(a)
-            return np.concatenate([a, b], axis=1), f
-
-        return modal
-
-    def plain(x):
-        theta = par.to_theta(x)
-        return theta, cost(theta)
-
-    return plain
-
-
-def _objective_function(par, cost: PaperCost, error: FrequencyError, searched, gain):
-    """``x -> (theta, objectives)`` for a population of searched points, the
-    columns in the order of `searched`; an unstable candidate pays the
-    cost's penalty in every objective."""
-    candidates = _candidates(par, cost)
-    one_step = (
-        PaperCost(cost.arx, cost.data, "one-step", gain=gain, penalty=cost.penalty)
-        if "one-step" in searched
-        else None
-    )
-
-    def evaluate(x):
-        theta, f_cost = candidates(np.atleast_2d(x))
-        extra = np.where(cost.stable(theta), 0.0, cost.penalty)
-        columns = {"cost": f_cost}
-        if "frequency" in searched:
-            columns["frequency"] = error(theta) + extra
-        if one_step is not None:
-            columns["one-step"] = one_step(theta)
-        return theta, np.column_stack([columns[n] for n in searched])
-
-    return evaluate
-
-
-def _polish_extremes(evaluate, archive: Archive, box: np.ndarray, budget: int):
-    """Each objective's best archived point polished on that objective alone
-    by L-BFGS-B in the box (finite-difference gradient, at most `budget`
-    evaluations each); returns the polished points and the evaluations."""
-    from scipy.optimize import minimize
-
-    points, used = [], 0
-    for j in range(archive.f.shape[1]):
-        start = archive.x[int(np.argmin(archive.f[:, j]))]
-        res = minimize(
-            lambda x, j=j: float(evaluate(x)[1][0, j]),
-            start,
-            method="L-BFGS-B",
-            bounds=box,
-            options={"maxfun": budget},
-        )
-        points.append(np.clip(res.x, box[:, 0], box[:, 1]))
-        used += int(res.nfev)
-    return np.array(points), used
-
-
-@dataclass
-class _StructureRun:
-    """One structure's search: its candidates (theta, objectives, origin)."""
-
-    arx: ARX
-    res: object
-    cost: PaperCost
-    box: np.ndarray
-    thetas: list = field(default_factory=list)
-    rows: list = field(default_factory=list)
-    starts: list = field(default_factory=list)
-    nfev: int = 0
-
-
-def _search_structure(
-    data, arx, error, searched, method, gen, *, parametrization, cost,
-    seed_estimates, extremes_nfev, initial, search, gain, count=None,
-) -> _StructureRun:  # fmt: skip
-    """Search one structure's front; collect the seeds, the archive of the
-    search's incumbents and the polished extremes as candidates. `count`,
-    if given, is told the number of points of every evaluation."""
-    par = make_parametrization(parametrization, data, arx)
-    evaluate = _objective_function(par, cost, error, searched, gain)
-    if count is not None:
-        evaluate = _counted(evaluate, count)
-    box = par.default_bounds()
-    seeds = _seed_thetas(data, arx, par, initial) if seed_estimates else {}
-    x0 = np.array([par.from_theta(t) for t in seeds.values()]) if seeds else None
-    # Every incumbent is a candidate model: an unbounded archive of them
-    # (minimize_pareto's own, thinned one is not needed).
-    archive = Archive(np.empty((0, box.shape[0])), np.empty((0, len(searched))))
-    search = dict(search)
-    options = {k: search.pop(k) for k in PARETO_OPTIONS if k in search}
-    res = minimize_pareto(
-        lambda x: evaluate(x)[1],
-        box,
-        method,
-        **search,
-        options=options,
-        rng=gen,
-        vectorized=True,
-        x0=x0,
-        archive=False,
-        # A callback's falsy return lets the search go on.
-        callback=lambda now: archive.add(now.x, now.fun),
-    )
-    archive.add(res.x, res.fun)
-    run = _StructureRun(arx, res, cost, box, nfev=res.nfev)
-    # Seeds first: of exact twins the first is kept, with its origin.
-    points = [] if x0 is None else [(np.clip(x0, box[:, 0], box[:, 1]), list(seeds))]
-    points.append((archive.x, ["search"] * archive.x.shape[0]))
-    if extremes_nfev:
-        polished, used = _polish_extremes(evaluate, archive, box, extremes_nfev)
-        points.append((polished, ["polish"] * polished.shape[0]))
-        run.nfev += used
-    for x, origin in points:
-        # Evaluated again for their theta (counted).
-        theta, f = evaluate(x)
-        run.nfev += x.shape[0]
-        run.thetas.extend(theta)
-        run.rows.extend(f)
-        run.starts.extend(origin)
-    return run
-
-
-def _counted(evaluate, count: Callable[[int], None]):
-    """`evaluate` that tells `count` how many points it evaluated."""
-
-    def counted(x):
-        out = evaluate(x)
-        count(1 if np.ndim(x) == 1 else len(x))
-        return out
-
-    return counted
-
-
-class _Progress:
-    """``progress(done, total)`` of the evaluations of every structure's
-    search, fed one evaluation call at a time; `total` is what the budgets
-    allow (the seeds' and candidates' evaluations pass it: then it says the
-    total)."""
-
-    def __init__(self, progress: Callable[[int, int], None], total: int):
-        self.progress, self.total, self.done = progress, max(int(total), 1), 0
-        progress(0, self.total)
-
-    def __call__(self, n: int) -> None:
-        self.done += n
-        self.progress(min(self.done, self.total), self.total)
-
-
 def _front_model(
     run: _StructureRun, i: int, objectives, names, data, method, parametrization,
     initial,
@@ -418,111 +247,6 @@ def _front_model(
         bounds=run.box,
         **data.provenance(),
     )
-
-
-def pareto_options(objectives) -> dict:
-    """The options :func:`identify_pareto` takes through ``**options`` for
-    these objectives, with their defaults: the search's
-    (:func:`~spiralid.optim.pareto.minimize_pareto`'s keyword options and
-    the keys of its ``options``, flat, less those it sets itself), the
-    models' and, with the ``"frequency"``
-    objective, its H1 estimate's.
-
-    Examples
-    --------
-    >>> sorted(pareto_options(("cost", "one-step")))  # doctest: +NORMALIZE_WHITESPACE
-    ['extremes_nfev', 'max_nfev', 'max_time', 'n_points', 'neighbours',
-     'parametrization', 'seed_estimates']
-    """
-    out = {**_SEARCH_DEFAULTS, **_MODEL_DEFAULTS}
-    if "frequency" in objectives:
-        out.update(_FREQUENCY_DEFAULTS)
-    return out
-
-
-def _search_defaults() -> dict:
-    import inspect
-
-    from .estimators import _keyword_options
-
-    # What each structure's search sets itself (its seeds, its own archive,
-    # the progress callback, the shared generator, the hypervolume's
-    # reference point); `options`' other keys are taken flat, as identify
-    # takes minimize's.
-    own = ("rng", "vectorized", "callback", "x0", "archive", "options", "ref_point")
-    signature = inspect.signature(minimize_pareto).parameters
-    defaults = {
-        name: signature[name].default
-        for name in _keyword_options(minimize_pareto, own=own)
-    }
-    defaults.update((k, v) for k, v in PARETO_OPTIONS.items() if k not in own)
-    # Per order, half minimize_pareto's 100 points and 10,000 evaluations:
-    # the same 100 iterations per search, and every order is a search of its
-    # own (with its seeds' output-error fits and its polishes besides).
-    defaults.update(n_points=50, max_nfev=5_000)
-    return defaults
-
-
-_SEARCH_DEFAULTS = _search_defaults()
-_MODEL_DEFAULTS = dict(parametrization="modal", seed_estimates=True, extremes_nfev=200)
-_FREQUENCY_DEFAULTS = dict(
-    nperseg=None, fmin=None, fmax=None, min_coherence=DEFAULT_MIN_COHERENCE
-)
-# Names this function no longer takes, and what to use instead.
-_RENAMED = {
-    "polish_nfev": (
-        "`polish_nfev` of identify_pareto is now `extremes_nfev` (each "
-        "extreme's polish); `polish_nfev` is the spiral method's budget per "
-        "polish of its centre"
-    ),
-}
-
-
-# Every option of identify_pareto with its default, whatever the objectives:
-# one left at its default is never refused.
-_EVERY_DEFAULT = {**_SEARCH_DEFAULTS, **_MODEL_DEFAULTS, **_FREQUENCY_DEFAULTS}
-
-
-def refused_pareto_options(objectives, options: dict) -> list[str]:
-    """The names in `options` that :func:`identify_pareto` refuses for
-    `objectives`, in their order: those :func:`pareto_options` does not
-    list, unless equal to their default. The command line refuses its flags
-    by this check.
-
-    Examples
-    --------
-    >>> refused_pareto_options(("cost", "one-step"), {"min_coherence": 0.3})
-    ['min_coherence']
-    >>> refused_pareto_options(("cost", "one-step"), {"min_coherence": 0.5})
-    []
-    """
-    applicable = pareto_options(objectives)
-    return [
-        name
-        for name, value in options.items()
-        if name not in applicable
-        and not (name in _EVERY_DEFAULT and is_default(value, _EVERY_DEFAULT[name]))
-    ]
-
-
-def _pareto_settings(method, names, options: dict) -> dict:
-    """`options` checked against :func:`pareto_options` (one line naming an
-    option that does not apply), completed with the defaults."""
-    for name in options:
-        if name in _RENAMED:
-            raise ValueError(_RENAMED[name])
-    refuse_options(
-        options,
-        pareto_options(names),
-        f"identify_pareto with method {method!r} and objectives {names}",
-        defaults=_EVERY_DEFAULT,
-    )
-    settings = {**_EVERY_DEFAULT, **options}
-    seeded = settings["seed_estimates"]
-    if not isinstance(seeded, bool | np.bool_):
-        raise ValueError(f"`seed_estimates` must be True or False; got {seeded!r}")
-    settings["extremes_nfev"] = integer(settings["extremes_nfev"], "extremes_nfev", 0)
-    return settings
 
 
 def identify_pareto(
