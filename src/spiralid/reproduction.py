@@ -41,6 +41,7 @@ from spiralid.sysid.validation.validate import Validation, validate
 __all__ = [
     "CONFIGURATIONS",
     "HEADLINE_TEST",
+    "MODE_WINDOW",
     "RIG_INTEGRATORS",
     "RIG_OUTPUTS",
     "SHARED_ARX",
@@ -221,8 +222,9 @@ class SharedModesFit:
     seconds: float
 
     def nearest(self, frequencies) -> tuple[np.ndarray, np.ndarray]:
-        """For each FEM mode, the nearest of `frequencies` (Hz; NaN when
-        there is none) and its error in percent of the FEM's."""
+        """For each FEM mode, the nearest of `frequencies` (Hz) and its
+        error in percent of the FEM's; NaN when none is within
+        :data:`MODE_WINDOW` of it (the model has not found that mode)."""
         return _nearest(self.fem_hz, frequencies)
 
     def to_dict(self) -> dict:
@@ -256,9 +258,14 @@ class SharedModesFit:
         }
 
 
+# A model's mode stands for a FEM mode when within this share of its
+# frequency: a model that lacks a mode is not credited with a neighbour's.
+MODE_WINDOW = 0.10
+
+
 def _nearest(reference, frequencies) -> tuple[np.ndarray, np.ndarray]:
     """Each `reference` frequency's nearest in `frequencies` and its error
-    (% of the reference); NaN where `frequencies` is empty."""
+    (% of the reference); NaN where none is within :data:`MODE_WINDOW`."""
     ref = np.asarray(reference, dtype=float)
     f = np.asarray(frequencies, dtype=float)
     f = f[np.isfinite(f)]
@@ -266,7 +273,10 @@ def _nearest(reference, frequencies) -> tuple[np.ndarray, np.ndarray]:
         nan = np.full(ref.shape, np.nan)
         return nan, nan.copy()
     hz = f[np.argmin(np.abs(f[None, :] - ref[:, None]), axis=1)]
-    return hz, 100.0 * (hz - ref) / ref
+    err = 100.0 * (hz - ref) / ref
+    far = np.abs(err) > 100.0 * MODE_WINDOW
+    hz[far], err[far] = np.nan, np.nan
+    return hz, err
 
 
 def _plain_list(values) -> list:

@@ -17,7 +17,7 @@ import numpy as np
 
 from spiralid.outputs.atomic import OutputFolder
 from spiralid.report.html import figure, page, png, table
-from spiralid.reproduction import HEADLINE_TEST, Reproduction
+from spiralid.reproduction import HEADLINE_TEST, MODE_WINDOW, Reproduction
 from spiralid.sysid.models.polynomials import format_pole_radius
 
 __all__ = [
@@ -286,7 +286,10 @@ def _every_sensor_text(rep: Reproduction) -> list[str]:
     fit = rep.shared.model
     hz, err = rep.shared.nearest(fit.modes.table.frequency)
     fem = ", ".join(f"{f:.4g}" for f in rep.shared.fem_hz)
-    found = ", ".join(f"{f:.4g} ({e:+.3f} %)" for f, e in zip(hz, err, strict=True))
+    found = ", ".join(
+        f"{f:.4g} ({e:+.4f} %)" if np.isfinite(f) else "none"
+        for f, e in zip(hz, err, strict=True)
+    )
     return [
         "",
         f"Modes from every sensor ({', '.join(fit.output_names)}; {fit.arx}, "
@@ -580,7 +583,7 @@ def _every_sensor_section(rep: Reproduction) -> str:
     for row in rep.modes_comparison():
         cells = [row["model"], row["structure"]]
         for f, err in zip(row["frequency_hz"], row["error_percent"], strict=True):
-            cells += ["-", "-"] if f is None else [f"{f:.4f}", f"{err:+.3f}"]
+            cells += ["-", "-"] if f is None else [f"{f:.4f}", f"{err:+.4f}"]
         rows.append(cells)
     integrators = ", ".join(
         f"{n} {k}" for n, k in zip(fit.output_names, fit.integrators, strict=True)
@@ -598,8 +601,9 @@ def _every_sensor_section(rep: Reproduction) -> str:
         + "<p>Each model's mode nearest each of the finite-element model's "
         "first three natural frequencies, and its error: the shared fit "
         "beside the paper's single-output models (best run of each "
-        "configuration, end-point acceleration alone) and the baselines.</p>"
-        + table(head, rows, "html")
+        "configuration, end-point acceleration alone) and the baselines; - "
+        f"where the model has no mode within {100 * MODE_WINDOW:g} % of the "
+        "FEM's.</p>" + table(head, rows, "html")
     )
 
 
