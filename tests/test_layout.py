@@ -218,8 +218,7 @@ def test_no_module_imports_itself_back_through_others():
 MAX_LINES = 600
 # Still over the limit, each to be split by whoever next reworks it (issue
 # 28); no other file may cross it, and one that drops below leaves the list.
-OVER_THE_LIMIT = {
-}
+OVER_THE_LIMIT: set[str] = set()
 
 
 def _lines(path: Path) -> int:
