@@ -126,3 +126,30 @@ def test_the_linear_part(fits, record):
     two = identify(record, ARX(2, 2, 1), method="ls")
     y_lin = lin.simulate(record.u)
     assert np.max(np.abs(y_lin - two.simulate(record.u))) < 1e-6 * np.ptp(record.y)
+
+
+@pytest.mark.parametrize("tolerance", [0.0, 1.0, 100.0])
+def test_choose_order_among_models_of_any_structure(record, tolerance):
+    """The smallest model (by parameters) whose held-out fit is within
+    `tolerance` of the best, worked out here from each model's own fit."""
+    from spiralid.sysid import choose_order
+
+    est, val = record.split(2 / 3)
+    models = [
+        identify(est, NARX(n, n, 1, hidden=(h,)), method="ls", rng=0)
+        for n in (1, 2)
+        for h in (2, 4)
+    ]
+    fits = [validate(m, val, warmup=est).fit_percent for m in models]
+    ok = [i for i, f in enumerate(fits) if f >= max(fits) - tolerance]
+    want = min(ok, key=lambda i: models[i].params.size)
+    assert choose_order(models, val, warmup=est, tolerance=tolerance) == want
+
+
+def test_choose_order_refuses_what_is_not_a_model(record):
+    from spiralid.sysid import choose_order
+
+    with pytest.raises(ValueError, match="non-empty list of fitted models"):
+        choose_order([], record)
+    with pytest.raises(ValueError, match="non-empty list of fitted models"):
+        choose_order([ARX(2, 2, 1)], record)

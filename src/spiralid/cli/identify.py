@@ -17,8 +17,10 @@ from .options import (
     _HelpFormatter,
     _listing,
     _load_data,
+    _nonneg_float,
     _nonneg_int,
     _open_folder,
+    _orders,
     _positive_int,
     _progress,
     _refuse_unused,
@@ -83,11 +85,26 @@ def _integrator_count(text: str) -> int | tuple[int, ...]:
 
 
 def _narx_structure(args):
-    """--model narx / polynomial: --na past outputs, --nb past inputs."""
+    """--model narx / polynomial: --na past outputs, --nb past inputs
+    (the largest of --by-fit's candidates, which the record must fit)."""
+    return _narx_structures(args)[-1]
+
+
+def _narx_structures(args) -> list:
+    """The structures --by-fit chooses among: every --lags n (past outputs
+    and inputs both n; default --na and --nb) with every --hidden size, by
+    increasing size; one structure without --by-fit."""
+    lags = [(n, n) for n in args.lags] if args.lags else [(args.na, args.nb)]
+    hidden = args.hidden if args.model == "narx" else [None]
+    grid = [_one_narx(args, na, nb, h) for na, nb in lags for h in hidden]
+    return sorted(grid, key=lambda st: st.n_params)
+
+
+def _one_narx(args, na: int, nb: int, hidden: int | None):
     from spiralid.sysid import NARX, PolynomialNARX
 
-    if args.na < 1:
-        raise UsageError(f"--model {args.model} needs --na >= 1; got {args.na}")
+    if na < 1:
+        raise UsageError(f"--model {args.model} needs --na >= 1; got {na}")
     # A NARX's linear start takes up to two known integrators (a hub angle
     # driven by a torque has two); forward regression has one at most.
     most = 2 if args.model == "narx" else 1
@@ -104,16 +121,16 @@ def _narx_structure(args):
         )
     if args.model == "narx":
         return NARX(
-            args.na,
-            args.nb,
+            na,
+            nb,
             args.nk,
-            hidden=(args.hidden,),
+            hidden=(hidden,),
             activation=args.activation,
             integrator=int(args.integrator),
         )
     return PolynomialNARX(
-        args.na,
-        args.nb,
+        na,
+        nb,
         args.nk,
         degree=args.degree,
         n_terms=args.terms,
@@ -148,13 +165,19 @@ def _run_narx(args) -> int:
             progress.phase("estimation", what, **steps)
             if steps:
                 options["callback"] = _search_callback(progress, steps, args)
-            model = identify(est, structure, method=args.method, **options)
+            if args.by_fit is None:
+                model, chosen = (
+                    identify(est, structure, method=args.method, **options),
+                    "",
+                )
+            else:
+                model, chosen = _chosen_by_fit(args, est, val, options, progress)
             model.fraction = args.fraction
             progress.phase("validation", "validating on both parts")
             v_est, v_val = _validated(model, est, val, args.method)
             progress.phase("writing", "writing files and figures")
             staged = folder.path
-            headline = f"{structure} by {args.method} on {args.data}"
+            headline = f"{model.structure} by {args.method} on {args.data}{chosen}"
             summary = _write_model(staged, model, v_est, v_val, headline)
             _save_figures(v_val.plot(), staged, "validation_")
             _write_timings(staged, progress, model)
@@ -163,6 +186,33 @@ def _run_narx(args) -> int:
         print(summary)
         print(f"\nwrote {_listing(written, args.out)}")
     return 0
+
+
+def _chosen_by_fit(args, est, val, options, progress):
+    """--by-fit POINTS: every candidate structure fitted on the estimation
+    part, and the smallest whose validation fit is within POINTS of the best
+    (choose_order, by number of parameters); the model and the lines that
+    say how it was chosen."""
+    from spiralid.sysid import choose_order, fits_by_order, identify
+
+    structures = _narx_structures(args)
+    models = []
+    for k, st in enumerate(structures, 1):
+        progress.phase("estimation", f"candidate {k}/{len(structures)}: {st}")
+        models.append(identify(est, st, method=args.method, **options))
+    fits = fits_by_order(models, val, warmup=est)
+    best = models[choose_order(models, val, warmup=est, tolerance=args.by_fit)]
+    lines = [
+        f"\nchosen by validation fit (--by-fit {args.by_fit:g}): the smallest "
+        f"candidate within {args.by_fit:g} points of the best; its validation fit "
+        "below is optimistic, as it was chosen on that part"
+    ]
+    lines += [
+        f"  {models[i].structure}: {n} parameters, validation fit {fit:.2f} %"
+        + ("  <- chosen" if models[i] is best else "")
+        for n, (i, fit) in fits.items()
+    ]
+    return best, "\n".join(lines)
 
 
 # The budget of the searches that have one of their own (identify's
@@ -379,6 +429,8 @@ _DESTS = {flag: flag.removeprefix("--").replace("-", "_") for flag in _OPTION_FL
 # The structure options of one kind of --model: the models they apply to.
 _MODEL_FLAGS = {
     "--hidden": ("narx",),
+    "--lags": ("narx", "polynomial"),
+    "--by-fit": ("narx", "polynomial"),
     "--activation": ("narx",),
     "--degree": ("polynomial",),
     "--terms": ("polynomial",),
@@ -415,6 +467,29 @@ def _identify_options(args, structure) -> dict:
     }
 
 
+def _check_candidates(args) -> None:
+    """--by-fit, --lags and several --hidden sizes belong together, and to
+    the NARX models."""
+    several = [
+        f
+        for f, v in (("--hidden", args.hidden), ("--lags", args.lags))
+        if v and len(v) > 1
+    ]
+    if args.by_fit is None and several:
+        raise UsageError(
+            f"several values of {' and '.join(several)} need --by-fit POINTS to "
+            "choose among them"
+        )
+    if args.model == "arx" and (args.by_fit is not None or args.lags):
+        raise UsageError(
+            "--by-fit and --lags choose among NARX structures (--model narx or "
+            "polynomial); ARX orders are chosen by `spiralid pareto --orders "
+            "--by-fit`"
+        )
+    if args.lags and _given(args, "--na", "--nb"):
+        raise UsageError("--lags replaces --na and --nb (each lag count n is n, n)")
+
+
 def _check_options(args) -> None:
     """Refuse, before any data is read, what the model and method cannot
     do, and every typed option identify() would refuse from Python for this
@@ -424,6 +499,7 @@ def _check_options(args) -> None:
     from spiralid.sysid.estimation.identify import identify_options, refused_options
 
     model, method = args.model, args.method
+    _check_candidates(args)
     if model != "arx" and METHODS[method].narx is None:
         able = ", ".join(n for n, m in METHODS.items() if m.narx is not None)
         raise UsageError(f"--method {method} does not train NARX models: {able}")
@@ -520,7 +596,28 @@ def add_parser(sub) -> None:
         help="ARX, NARX with a one-hidden-layer perceptron (--na past outputs, "
         "--nb past inputs) or polynomial NARX by forward-regression OLS",
     )
-    p.add_argument("--hidden", type=_positive_int, default=10, help="NARX hidden units")
+    p.add_argument(
+        "--hidden",
+        type=_orders,
+        default=[10],
+        help="NARX hidden units; several (4,8,16 or 4:8) for --by-fit to choose among",
+    )
+    p.add_argument(
+        "--lags",
+        type=_orders,
+        default=None,
+        help="NARX: several lag counts n (e.g. 2,4,8), each --na n --nb n, for "
+        "--by-fit to choose among (default: --na and --nb)",
+    )
+    p.add_argument(
+        "--by-fit",
+        type=_nonneg_float,
+        default=None,
+        metavar="POINTS",
+        help="--model narx or polynomial: fit every --lags and --hidden candidate "
+        "and keep the smallest whose validation fit is within POINTS of the best "
+        "(default: none, one structure)",
+    )
     p.add_argument(
         "--activation",
         choices=["tanh", "logistic", "linear"],

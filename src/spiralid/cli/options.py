@@ -97,6 +97,25 @@ def _ratio(text: str) -> float:
 _fraction = _number(_ratio, "in (0, 1), e.g. 0.5 or 2/3", lambda v: 0 < v < 1)
 
 
+def _orders(text: str) -> list[int]:
+    """``2:12`` (both ends included) or ``2,4,8``: orders, lags or sizes,
+    distinct integers >= 1 (``8`` is one)."""
+    try:
+        if ":" in text:
+            lo, hi = (int(v) for v in text.split(":"))
+            values = list(range(lo, hi + 1))
+        else:
+            values = [int(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if not values or min(values) < 1 or len(set(values)) != len(values):
+        raise argparse.ArgumentTypeError(
+            f"must be integers >= 1 such as 8, 2:12 or 2,4,8 (distinct, increasing "
+            f"ranges); got {text!r}"
+        )
+    return values
+
+
 def _add_initial_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--initial",

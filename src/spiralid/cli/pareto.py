@@ -21,27 +21,10 @@ from .options import (
     _nonneg_float,
     _nonneg_int,
     _open_folder,
+    _orders,
     _positive_int,
     _progress,
 )
-
-
-def _orders(text: str) -> list[int]:
-    """``2:12`` (both ends included) or ``2,4,8``."""
-    try:
-        if ":" in text:
-            lo, hi = (int(v) for v in text.split(":"))
-            values = list(range(lo, hi + 1))
-        else:
-            values = [int(v) for v in text.split(",")]
-    except ValueError:
-        values = []
-    if not values or min(values) < 1 or len(set(values)) != len(values):
-        raise argparse.ArgumentTypeError(
-            f"must be orders such as 2:12 or 2,4,8 (integers >= 1, increasing "
-            f"ranges); got {text!r}"
-        )
-    return values
 
 
 def _objectives(text: str) -> tuple[str, ...]:

@@ -12,7 +12,9 @@ its model:
   the others, e.g. the lowest cost whose frequency-response error is at
   most 3 dB;
 - :func:`choose_order`: the lowest order that validates within a tolerance
-  of the best order on a held-out record.
+  of the best order on a held-out record; it also chooses among fitted
+  models of any structure (NARX lags and hidden sizes), by their number of
+  parameters.
 
 The knee is a property of the front's shape and need not sit at the order
 where a model stops improving on data it was not fitted to
@@ -34,6 +36,7 @@ from spiralid._checks import nonneg
 from spiralid.optim.front import knee_point
 
 from ..estimation.pareto import ParetoIdentification
+from ..models.fitted import FittedModel
 from .validate import validate
 
 __all__ = ["choose", "choose_order", "fits_by_order", "knee_point"]
@@ -86,13 +89,33 @@ def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int
     return int(np.argmin(column))
 
 
+def _candidates(front) -> tuple[list, np.ndarray, list[int]]:
+    """The models, their estimation costs and their sizes: a Pareto front's
+    (size ``na + nb``, cost its first objective), or a sequence of fitted
+    models of any structure (size the number of parameters)."""
+    if isinstance(front, ParetoIdentification):
+        if not front.models:
+            raise ValueError("`front` must be a non-empty ParetoIdentification")
+        sizes = [m.arx.na + m.arx.nb for m in front.models]
+        return list(front.models), front.objectives[:, 0], sizes
+    models = list(front) if isinstance(front, list | tuple) else None
+    if not models or not all(isinstance(m, FittedModel) for m in models):
+        raise ValueError(
+            "`front` must be a ParetoIdentification or a non-empty list of "
+            f"fitted models (identify's results); got {type(front).__name__}"
+        )
+    return models, np.array([m.cost for m in models]), [m.params.size for m in models]
+
+
 def fits_by_order(front, data, *, warmup=None) -> dict[int, tuple[int, float]]:
-    """Each order's lowest-cost model on the front and its validation fit.
+    """Each order's lowest-cost model and its validation fit.
 
     Parameters
     ----------
-    front : ParetoIdentification
-        From :func:`~spiralid.sysid.identify_pareto`.
+    front : ParetoIdentification or list of FittedModel
+        From :func:`~spiralid.sysid.identify_pareto`, or models of any
+        structures (e.g. NARX models of several lags and hidden sizes, each
+        from :func:`~spiralid.sysid.identify`).
     data : IOData
         A record the models were not estimated on (the validation third).
     warmup : IOData, optional
@@ -102,19 +125,18 @@ def fits_by_order(front, data, *, warmup=None) -> dict[int, tuple[int, float]]:
     Returns
     -------
     dict
-        ``{na + nb: (index into front.models, fit %)}``, by increasing order.
-        "Lowest cost" is the front's first objective.
+        ``{order: (index into the models, fit %)}``, by increasing order:
+        ``na + nb`` on a front (where "lowest cost" is its first
+        objective), the number of parameters for a list (lowest
+        estimation cost among models of equal size).
     """
-    if not getattr(front, "models", None):
-        raise ValueError("`front` must be a non-empty ParetoIdentification")
-    cost = front.objectives[:, 0]
+    models, cost, sizes = _candidates(front)
     best: dict[int, int] = {}
-    for i, model in enumerate(front.models):
-        order = model.arx.na + model.arx.nb
+    for i, order in enumerate(sizes):
         if order not in best or cost[i] < cost[best[order]]:
             best[order] = i
     return {
-        order: (i, validate(front.models[i], data, warmup=warmup).fit_percent)
+        order: (i, validate(models[i], data, warmup=warmup).fit_percent)
         for order, i in sorted(best.items())
     }
 
@@ -125,8 +147,10 @@ def choose_order(front, data, *, warmup=None, tolerance: float = 1.0) -> int:
 
     Parameters
     ----------
-    front : ParetoIdentification
-        From :func:`~spiralid.sysid.identify_pareto`.
+    front : ParetoIdentification or list of FittedModel
+        From :func:`~spiralid.sysid.identify_pareto` (orders ``na + nb``),
+        or fitted models of any structures, e.g. NARX models of several
+        lags and hidden sizes (order: the number of parameters).
     data : IOData
         A record the models were not estimated on. The chosen model's fit on
         that same record is then optimistic (it was chosen on it); validate
@@ -139,7 +163,7 @@ def choose_order(front, data, *, warmup=None, tolerance: float = 1.0) -> int:
     Returns
     -------
     int
-        Index into ``front.models``.
+        Index into ``front.models`` (or into the list).
 
     Examples
     --------
@@ -149,6 +173,15 @@ def choose_order(front, data, *, warmup=None, tolerance: float = 1.0) -> int:
     ...                             n_points=12)
     >>> model = front.models[choose_order(front, val, warmup=est)]
     >>> model.arx.na in range(2, 6)
+    True
+
+    NARX lags and hidden sizes, each model fitted on the estimation part:
+
+    >>> models = [sid.identify(est, sid.NARX(n, n, 1, hidden=(h,)), rng=0,
+    ...                        method="ls")
+    ...           for n in (2, 4) for h in (2, 6)]
+    >>> best = models[choose_order(models, val, warmup=est)]
+    >>> best.structure.ny in (2, 4)
     True
     """
     tolerance = nonneg(tolerance, "tolerance")
