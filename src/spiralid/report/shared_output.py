@@ -37,9 +37,25 @@ def _interval(pair, fmt: str) -> str:
     return f"[{lo:{fmt}}, {hi:{fmt}}]"
 
 
+def _fine(pair, kind: str, least: int) -> str:
+    """The format (``".{d}g"`` or ``".{d}f"``) with the fewest digits, at
+    least `least`, that tells the interval's ends apart: a well-determined
+    mode's interval (a few 1e-5 Hz wide on the rig) would print as one
+    number twice at four digits."""
+    lo, hi = pair
+    for d in range(least, least + 7):
+        fmt = f".{d}{kind}"
+        if not (np.isfinite(lo) and np.isfinite(hi)) or (
+            format(lo, fmt) != format(hi, fmt)
+        ):
+            return fmt
+    return fmt
+
+
 def modes_table(modes) -> tuple[list[str], list[list[str]]]:
     """The header and rows of a :class:`~spiralid.sysid.SharedModes`: each
-    mode's frequency (Hz) and damping ratio with their 95 % intervals, its
+    mode's frequency (Hz) and damping ratio with their 95 % intervals (to as
+    many digits as tell the interval's ends apart, four at least), its
     share (%) of each output's resonant peaks and its flags.
 
     Parameters
@@ -64,18 +80,21 @@ def modes_table(modes) -> tuple[list[str], list[list[str]]]:
         "flags",
     ]
     f_int, d_int = t.frequency_interval, t.damping_interval
-    rows = [
-        [
-            str(i + 1),
-            _num(t.frequency[i], ".4g"),
-            _interval(f_int[i], ".4g"),
-            _num(t.damping[i], ".4f"),
-            _interval(d_int[i], ".4f"),
-            *(_num(100 * s, ".1f") for s in modes.share[i]),
-            "; ".join(t.notes(i)),
-        ]
-        for i in range(len(t))
-    ]
+    rows = []
+    for i in range(len(t)):
+        f_fmt = _fine(f_int[i], "g", 4)
+        d_fmt = _fine(d_int[i], "f", 4)
+        rows.append(
+            [
+                str(i + 1),
+                _num(t.frequency[i], f_fmt),
+                _interval(f_int[i], f_fmt),
+                _num(t.damping[i], d_fmt),
+                _interval(d_int[i], d_fmt),
+                *(_num(100 * s, ".1f") for s in modes.share[i]),
+                "; ".join(t.notes(i)),
+            ]
+        )
     return header, rows
 
 
