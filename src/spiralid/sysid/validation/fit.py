@@ -142,3 +142,36 @@ def _gain(gain, model, y: np.ndarray) -> float:
         raise ValueError(
             f"`gain` must be 'auto', 'model' or a finite number > 0; got {gain!r}"
         ) from None
+
+
+def check_sample_time(model, ts: float) -> None:
+    """Refuse a record whose sample time is not the model's (a model
+    without one, a bare structure's, takes any)."""
+    model_ts = getattr(model, "ts", None)
+    if model_ts is not None and not np.isclose(float(model_ts), ts, rtol=1e-9):
+        raise ValueError(
+            f"`data` sample time must match the model's ts = {float(model_ts)!r}; "
+            f"got ts = {ts!r}"
+        )
+
+
+def responses(model, data, warmup):
+    """The model's free run and one-step prediction over ``data`` (after
+    ``warmup`` when given), and the index of ``data``'s first sample in the
+    run: what every model's validation scores, linear or not."""
+    u, y, ts = _signals_of(data)
+    if warmup is None:
+        y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
+        y_pred = np.asarray(model.predict(data), dtype=float).ravel()
+        start = 0
+    else:
+        wu, wy, wts = _signals_of(warmup, "warmup")
+        if not np.isclose(wts, ts, rtol=1e-9):
+            raise ValueError(
+                f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
+            )
+        whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
+        start = wu.size
+        y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[start:]
+        y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[start:]
+    return y_sim, y_pred, start

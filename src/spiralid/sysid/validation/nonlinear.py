@@ -15,7 +15,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from .correlation import check_lags
-from .fit import _bounded_run, _format_fit, _gain, _signals_of, fit_percent, rmse
+from .fit import (
+    _bounded_run,
+    _format_fit,
+    _gain,
+    _signals_of,
+    check_sample_time,
+    fit_percent,
+    responses,
+    rmse,
+)
 from .higher_order import BillingsVoon, billings_voon
 
 __all__ = ["NARXValidation", "validate_narx"]
@@ -198,25 +207,10 @@ def validate_narx(
         raise ValueError(
             f"`residuals` must be 'auto' or one of {_RESIDUALS}; got {residuals!r}"
         )
-    if not np.isclose(float(model.ts), ts, rtol=1e-9):
-        raise ValueError(
-            f"`data` sample time must match the model's ts = {float(model.ts)!r}; "
-            f"got ts = {ts!r}"
-        )
-    start = 0
-    if warmup is not None:
-        wu, wy, wts = _signals_of(warmup, "warmup")
-        if not np.isclose(wts, ts, rtol=1e-9):
-            raise ValueError(
-                f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
-            )
-        start = wu.size
-        whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
-    else:
-        whole = type(data)(u, y, ts=ts)
-    with np.errstate(all="ignore"):
-        y_sim = np.asarray(model.simulate(whole.u), dtype=float)[start:]
-        y_pred = np.asarray(model.predict(whole), dtype=float)[start:]
+    check_sample_time(model, ts)
+    with np.errstate(all="ignore"):  # a diverging free run is reported below
+        y_sim, y_pred, start = responses(model, data, warmup)
+    whole = u if warmup is None else np.r_[_signals_of(warmup, "warmup")[0], u]
     y_sim, diverged = _bounded_run(y_sim, y)
     w = _gain(gain, model, y)
     e_sim, e_pred = y - y_sim, y - y_pred
@@ -224,7 +218,7 @@ def validate_narx(
     lin_model = getattr(model, "linear_start", None)
     if lin_model is not None:
         with np.errstate(all="ignore"):
-            y_lin = np.asarray(lin_model.simulate(whole.u), dtype=float)[start:]
+            y_lin = np.asarray(lin_model.simulate(whole), dtype=float)[start:]
         linear_fit = fit_percent(y, _bounded_run(y_lin, y)[0])
     result = getattr(model, "result", None) or {}
     unit = getattr(model, "output_unit", "")

@@ -38,7 +38,15 @@ from .correlation import (
     independence_test,
     whiteness_test,
 )
-from .fit import _bounded_run, _gain, _signals_of, fit_percent, rmse
+from .fit import (
+    _bounded_run,
+    _gain,
+    _signals_of,
+    check_sample_time,
+    fit_percent,
+    responses,
+    rmse,
+)
 from .linear import Validation
 from .nonlinear import validate_narx
 from .realization import Realization, realization_tests
@@ -218,7 +226,7 @@ def validate(
     )
     stable = bool(is_stable_polynomial(denominator))
     max_radius = float(max_pole_radius(denominator))
-    y_sim, y_pred, start = _responses(model, data, warmup)
+    y_sim, y_pred, start = responses(model, data, warmup)
     y_sim, diverged = _bounded_run(
         y_sim, y, f" (max |pole| = {format_pole_radius(max_radius)})"
     )
@@ -336,37 +344,10 @@ def _valid_inputs(model, data, lags, residuals):
         raise ValueError(
             f"`residuals` must be 'auto' or one of {_RESIDUALS}; got {residuals!r}"
         )
-    model_ts = getattr(model, "ts", None)
-    if model_ts is not None and not np.isclose(float(model_ts), ts, rtol=1e-9):
-        raise ValueError(
-            f"`data` sample time must match the model's ts = {float(model_ts)!r}; "
-            f"got ts = {ts!r}"
-        )
+    check_sample_time(model, ts)
     predictor = getattr(model, "predictor", None) or "simulation"
     if predictor not in _RESIDUALS:
         raise ValueError(
             f"`model.predictor` must be one of {_RESIDUALS}; got {predictor!r}"
         )
     return u, y, ts, lags, predictor
-
-
-def _responses(model, data, warmup):
-    """The model's free run and one-step prediction over ``data`` (after
-    ``warmup`` when given), and the index of ``data``'s first sample in the
-    run."""
-    u, y, ts = _signals_of(data)
-    if warmup is None:
-        y_sim = np.asarray(model.simulate(u), dtype=float).ravel()
-        y_pred = np.asarray(model.predict(data), dtype=float).ravel()
-        start = 0
-    else:
-        wu, wy, wts = _signals_of(warmup, "warmup")
-        if not np.isclose(wts, ts, rtol=1e-9):
-            raise ValueError(
-                f"`warmup` sample time must match `data`'s ts = {ts!r}; got {wts!r}"
-            )
-        whole = type(data)(np.r_[wu, u], np.r_[wy, y], ts=ts)
-        start = wu.size
-        y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[start:]
-        y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[start:]
-    return y_sim, y_pred, start
