@@ -153,4 +153,5 @@ def test_docs_first_examples_run(monkeypatch, tmp_path, capsys):
 @pytest.mark.slow
 def test_docs_narx_example_runs(capsys):
     run_python(DOCS / "guide" / "models.md", "narx-example")
+    run_python(DOCS / "guide" / "models.md", "narx-choice-example")
     assert "Billings-Voon" in capsys.readouterr().out
