@@ -24,11 +24,6 @@ from .readers import (
 )
 from .signals import _check_magnitude, check_outputs, check_signal
 
-# Still importable from here because validation/validate.py (check_pair) and
-# models/arx.py, models/narx.py (check_signal) import them from this module;
-# new code imports the checks from .signals.
-from .signals import check_pair as check_pair
-
 __all__ = ["IOData"]
 
 

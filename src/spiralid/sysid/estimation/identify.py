@@ -61,7 +61,7 @@ from ..models.polynomials import integrator_count, with_integrator
 from . import narx as _narx
 from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
-from .estimators import DEFAULT_METHOD, METHODS, Problem
+from .estimators import DEFAULT_METHOD, METHODS
 from .margin import AUTO, max_radius
 from .options import (
     IDENTIFY_DEFAULTS,
@@ -78,6 +78,7 @@ from .parametrizations import (
     feasible_initial_points,
     make_parametrization,
 )
+from .problem import Problem
 from .uncertainty import parameter_covariance
 
 __all__ = [
@@ -198,9 +199,9 @@ def identify(
         ``restarts``, ``x0``...; for ``"de"`` only ``n_points``,
         ``max_iter``, ``max_nfev``, ``x0`` and ``callback``; for
         ``"spiral"`` those of
-        :func:`~spiralid.sysid.estimation.estimators._estimate_recommended`).
+        :func:`~spiralid.sysid.estimation.spiral_method._estimate_recommended`).
         A budget ``max_nfev`` without ``max_iter`` is the stop
-        (:func:`~spiralid.sysid.estimation.estimators.search_options`).
+        (:func:`~spiralid.sysid.estimation.searches.search_options`).
         For a NARX: ``holdout`` and ``decay``
         (:func:`~spiralid.sysid.estimation.narx.identify_narx`) and its
         estimator's. Any option that does not apply to the method and

@@ -32,7 +32,8 @@ from scipy import signal
 
 from spiralid._checks import integer
 
-from ..data import IOData, check_signal, single_output_record
+from ..data import IOData, single_output_record
+from ..signals import check_signal
 from .polynomials import is_stable_polynomial
 
 __all__ = ["ARX", "INITIAL_CONDITIONS", "arx_least_squares"]

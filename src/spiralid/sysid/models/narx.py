@@ -43,7 +43,8 @@ from dataclasses import KW_ONLY, dataclass
 
 import numpy as np
 
-from ..data import IOData, check_signal, single_output_record
+from ..data import IOData, single_output_record
+from ..signals import check_signal
 from . import _fields
 from .fitted import FittedModel
 from .narx_lags import Scaling

@@ -23,7 +23,6 @@ import numpy as np
 
 from spiralid._checks import refuse_options
 
-from ..data import check_pair
 from ..estimation.cost import cost_of_errors
 from ..estimation.outputerror import error_functions
 from ..models.modes import ModeTable
@@ -32,6 +31,7 @@ from ..models.polynomials import (
     is_stable_polynomial,
     max_pole_radius,
 )
+from ..signals import check_pair
 from ..spectra import find_resonances, modes_from_poles, psd
 from .correlation import (
     check_lags,
