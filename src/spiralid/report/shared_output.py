@@ -136,7 +136,7 @@ _FIGURE_CAPTIONS = {
     "on the validation part, measured peaks labelled, the shared modes as "
     "dotted lines.",
     "residuals": "Whiteness of the residuals and their independence of the "
-    "input, with 99 % bands.",
+    "input, with the 95 % and 99 % bands and each test's verdict.",
     "pole_zero": "The shared poles (and this output's known integrators) with "
     "this output's zeros.",
 }
@@ -151,7 +151,7 @@ def _figures(v_val, diagram, data) -> dict[str, tuple[str, bytes, str]]:
 
         orders = ", ".join(str(n) for n in diagram.orders)
         out["stabilisation"] = (
-            "Stabilisation diagram",
+            "Each order's modes over the record's spectra",
             png(plot_stabilisation(diagram, data)),
             f"Orders na = {orders}.",
         )
