@@ -93,7 +93,9 @@ def _candidates(front) -> tuple[list, np.ndarray, list[int]]:
     """The models, their estimation costs and their sizes: a Pareto front's
     (size ``na + nb``, cost its first objective), or a sequence of fitted
     models of any structure (size the number of parameters)."""
-    if isinstance(front, ParetoIdentification):
+    # A front is anything with models and their objectives (the front's
+    # own type, or one built by hand).
+    if hasattr(front, "models") and hasattr(front, "objectives"):
         if not front.models:
             raise ValueError("`front` must be a non-empty ParetoIdentification")
         sizes = [m.arx.na + m.arx.nb for m in front.models]
