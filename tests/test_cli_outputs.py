@@ -10,6 +10,7 @@ import pytest
 from clitools import run
 
 from spiralid.fms import FlexibleManipulator, paper_experiment
+from spiralid.sysid.models.modes import interval_format
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +50,9 @@ def test_several_outputs_give_one_denominator_and_a_fit_each(made):
     assert "Shared modes" in made.stdout
     for m in model["modes"]["modes"]:
         lo, hi = m["frequency_interval_hz"]
-        assert f"[{lo:.4g}, {hi:.4g}]" in made.stdout
+        fmt = interval_format((lo, hi))
+        assert f"[{lo:{fmt}}, {hi:{fmt}}]" in made.stdout
+        assert format(lo, fmt) != format(hi, fmt)
 
 
 def _cells(page: str) -> list[str]:

@@ -153,3 +153,22 @@ def test_choose_order_refuses_what_is_not_a_model(record):
         choose_order([], record)
     with pytest.raises(ValueError, match="non-empty list of fitted models"):
         choose_order([ARX(2, 2, 1)], record)
+
+
+@pytest.mark.parametrize(
+    ("pair", "kind", "want"),
+    [
+        ((13.31049, 13.31061), "g", ".5g"),  # 13.31 twice at four, 13.311 at five
+        ((13.310504, 13.310506), "g", ".7g"),
+        ((13.2, 13.4), "g", ".4g"),
+        ((0.019995, 0.020004), "f", ".5f"),  # 0.0200 at four, 0.02000 at five
+        ((float("nan"), 1.0), "g", ".4g"),
+    ],
+)
+def test_interval_format_tells_the_ends_apart(pair, kind, want):
+    from spiralid.sysid.models.modes import interval_format
+
+    fmt = interval_format(pair, kind)
+    assert fmt == want
+    if all(np.isfinite(pair)):
+        assert format(pair[0], fmt) != format(pair[1], fmt)

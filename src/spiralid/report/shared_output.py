@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from spiralid.report.html import figure, page, png, table
+from spiralid.sysid.models.modes import interval_format
 
 __all__ = ["fits_table", "modes_table", "shared_report", "write_shared_report"]
 
@@ -35,21 +36,6 @@ def _interval(pair, fmt: str) -> str:
     if not (np.isfinite(lo) and np.isfinite(hi)):
         return "-"
     return f"[{lo:{fmt}}, {hi:{fmt}}]"
-
-
-def _fine(pair, kind: str, least: int) -> str:
-    """The format (``".{d}g"`` or ``".{d}f"``) with the fewest digits, at
-    least `least`, that tells the interval's ends apart: a well-determined
-    mode's interval (a few 1e-5 Hz wide on the rig) would print as one
-    number twice at four digits."""
-    lo, hi = pair
-    for d in range(least, least + 7):
-        fmt = f".{d}{kind}"
-        if not (np.isfinite(lo) and np.isfinite(hi)) or (
-            format(lo, fmt) != format(hi, fmt)
-        ):
-            return fmt
-    return fmt
 
 
 def modes_table(modes) -> tuple[list[str], list[list[str]]]:
@@ -82,8 +68,8 @@ def modes_table(modes) -> tuple[list[str], list[list[str]]]:
     f_int, d_int = t.frequency_interval, t.damping_interval
     rows = []
     for i in range(len(t)):
-        f_fmt = _fine(f_int[i], "g", 4)
-        d_fmt = _fine(d_int[i], "f", 4)
+        f_fmt = interval_format(f_int[i])
+        d_fmt = interval_format(d_int[i], "f")
         rows.append(
             [
                 str(i + 1),

@@ -140,10 +140,12 @@ class ModeTable:
         f_int, d_int = self.frequency_interval, self.damping_interval
         for i in range(len(self)):
             notes = self.notes(i)
+            ff, fd = interval_format(f_int[i]), interval_format(d_int[i], "f")
             lines.append(
-                f"{i + 1:>4}  {self.frequency[i]:9.4g} "
-                f"[{_num(f_int[i, 0])}, {_num(f_int[i, 1])}]  "
-                f"{self.damping[i]:8.4f} [{_num(d_int[i, 0])}, {_num(d_int[i, 1])}]"
+                f"{i + 1:>4}  {self.frequency[i]:9{ff}} "
+                f"[{_num(f_int[i, 0], ff)}, {_num(f_int[i, 1], ff)}]  "
+                f"{self.damping[i]:8{fd}} "
+                f"[{_num(d_int[i, 0], fd)}, {_num(d_int[i, 1], fd)}]"
                 f"  {_pct(self.share[i])}"
                 + (f"  ({'; '.join(notes)})" if notes else "")
             )
@@ -155,8 +157,40 @@ def _plain(value) -> float | None:
     return value if np.isfinite(value) else None
 
 
-def _num(value: float) -> str:
-    return f"{value:.4g}" if np.isfinite(value) else "-"
+def _num(value: float, fmt: str = ".4g") -> str:
+    return format(value, fmt) if np.isfinite(value) else "-"
+
+
+def interval_format(pair, kind: str = "g", least: int = 4) -> str:
+    """The format (``".{d}g"`` or ``".{d}f"``) with the fewest digits, at
+    least `least`, that tells an interval's ends apart.
+
+    A well-determined mode's interval (a few 1e-5 Hz wide on the simulated
+    rig) would print as one number twice at four digits.
+
+    Parameters
+    ----------
+    pair : (float, float)
+        The interval's ends.
+    kind : {"g", "f"}
+        Significant digits or digits after the point.
+    least : int
+        The fewest digits.
+
+    Returns
+    -------
+    str
+        A format specification for :func:`format`.
+    """
+    lo, hi = pair
+    fmt = f".{least}{kind}"
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return fmt
+    for d in range(least, least + 7):
+        fmt = f".{d}{kind}"
+        if format(lo, fmt) != format(hi, fmt):
+            break
+    return fmt
 
 
 def _pct(value: float) -> str:

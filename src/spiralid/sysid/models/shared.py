@@ -23,7 +23,7 @@ from scipy import signal
 
 from .arx import ARX
 from .identified import IdentifiedModel, python_control
-from .modes import ModeTable, mode_table
+from .modes import ModeTable, interval_format, mode_table
 from .polynomials import is_stable_polynomial, max_pole_radius, with_integrator
 
 __all__ = ["SharedDenominatorModel", "SharedModes"]
@@ -75,8 +75,10 @@ class SharedModes:
         )
         lines = [head]
         for i in range(len(t)):
-            freq = f"{t.frequency[i]:.4g} [{lo_f[i]:.4g}, {hi_f[i]:.4g}]"
-            damp = f"{t.damping[i]:.4f} [{lo_z[i]:.4f}, {hi_z[i]:.4f}]"
+            ff = interval_format((lo_f[i], hi_f[i]))
+            fd = interval_format((lo_z[i], hi_z[i]), "f")
+            freq = f"{t.frequency[i]:{ff}} [{lo_f[i]:{ff}}, {hi_f[i]:{ff}}]"
+            damp = f"{t.damping[i]:{fd}} [{lo_z[i]:{fd}}, {hi_z[i]:{fd}}]"
             shares = "  ".join(f"{100 * s:13.1f}%" for s in self.share[i])
             lines.append(f"{i + 1:>4}  {freq:>30}  {damp:>30}  {shares}")
         return "\n".join(lines)
