@@ -116,3 +116,31 @@ def test_an_option_a_shared_model_does_not_take_is_refused(tmp_path):
     assert out.returncode == 2 and len(out.stderr.splitlines()) == 1
     assert "takes one output" in out.stderr
     assert not (tmp_path / "m").exists()
+
+
+def test_validate_reads_a_model_of_several_outputs_back(made):
+    """`spiralid validate` on the shared model's file validates every output
+    and gives the joint fit identify reported on the same validation part;
+    a record without one of the model's outputs is refused by name."""
+    _, folder = made
+    cwd = folder.parent
+    proc = run("validate", "m/model.json", "rig.npz", "--fraction",
+               "0.6666666666666666", "--out", "v", cwd=cwd)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    again = json.loads((cwd / "v" / "validation.json").read_text())
+    saved = json.loads((folder / "validation.json").read_text())["validation"]
+    assert again["joint_fit_percent"] == pytest.approx(
+        saved["joint_fit_percent"], rel=1e-12
+    )
+    for name in ("vel", "acc"):
+        assert again["outputs"][name]["fit_percent"] == pytest.approx(
+            saved["outputs"][name]["fit_percent"], rel=1e-12
+        )
+        assert (cwd / "v" / f"{name}_time.png").is_file()
+    assert "joint fit %" in proc.stdout
+    data = dict(np.load(cwd / "rig.npz"))
+    del data["acc"]
+    np.savez(cwd / "one.npz", **data)
+    proc = run("validate", "m/model.json", "one.npz", cwd=cwd)
+    assert proc.returncode == 2
+    assert "outputs 'vel', 'acc'" in proc.stderr and "no variable 'acc'" in proc.stderr

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 from .errors import UsageError
 from .options import (
     _add_data_options,
@@ -26,7 +28,6 @@ def _read_model(name: str):
     written before it did only know --detrend from the user) and whether
     it records the names of its input and output."""
     from spiralid.sysid.models.files import load_model
-    from spiralid.sysid.models.shared import SharedDenominatorModel
 
     path = Path(name)
     if path.is_dir():
@@ -48,14 +49,19 @@ def _read_model(name: str):
         raise UsageError(
             f"{name!r} is not a valid spiralid model file ({message})"
         ) from None
-    if isinstance(model, SharedDenominatorModel):
-        raise UsageError(
-            f"{name!r} is a model of several outputs "
-            f"({', '.join(model.output_names)}); validate it from Python with "
-            "spiralid.sysid.validate_outputs, or validate one output's model "
-            "(model.output_model(name))"
-        )
-    return model, "u_offset" in fields, "output_name" in fields
+    named = "output_name" in fields or "output_names" in fields
+    return model, "u_offset" in fields, named
+
+
+def _outputs_of(model) -> list[str]:
+    """The outputs a model was estimated on: one, or several of a shared
+    denominator."""
+    return list(getattr(model, "output_names", None) or [model.output_name])
+
+
+def _offsets_of(model) -> tuple[float, ...]:
+    """The output offsets the model file records, one per output."""
+    return tuple(getattr(model, "y_offsets", None) or (model.y_offset,))
 
 
 def _names_in(name: str) -> set[str] | None:
@@ -104,20 +110,23 @@ def _columns_of_the_model(args, model) -> None:
     names = _names_in(args.data)
     if names is None:
         return
+    outputs = _outputs_of(model)
     wanted = {
-        "input": model.input_name if args.input is None else None,
-        "output": model.output_name if args.output is None else None,
+        "input": [model.input_name] if args.input is None else [],
+        "output": outputs if args.output is None else [],
     }
-    missing = [v for v in wanted.values() if v is not None and v not in names]
+    missing = [v for vs in wanted.values() for v in vs if v not in names]
     if missing:
         kind = "column" if Path(args.data).suffix.lower() == ".csv" else "variable"
+        plural = "s" if len(outputs) > 1 else ""
         raise UsageError(
-            f"the model was estimated on input {model.input_name!r} and output "
-            f"{model.output_name!r}, but {args.data!r} has no {kind} "
-            f"{' or '.join(map(repr, missing))}; give --input and --output"
+            f"the model was estimated on input {model.input_name!r} and "
+            f"output{plural} {', '.join(map(repr, outputs))}, but {args.data!r} has "
+            f"no {kind} {' or '.join(map(repr, missing))}; give --input and --output"
         )
-    args.input = args.input if wanted["input"] is None else wanted["input"]
-    args.output = args.output if wanted["output"] is None else wanted["output"]
+    args.input = args.input if not wanted["input"] else model.input_name
+    if wanted["output"]:
+        args.output = outputs if len(outputs) > 1 else outputs[0]
 
 
 def _prepared_as_the_model(data, model, recorded: bool, args):
@@ -126,7 +135,8 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
     nothing, `--detrend` removes the means of the part before `--fraction`."""
     if not recorded:
         return _detrended(data, args.fraction) if args.detrend else data
-    if (model.u_offset, model.y_offset) == (0.0, 0.0):
+    offsets = _offsets_of(model)
+    if model.u_offset == 0.0 and not any(offsets):
         if args.detrend:
             raise UsageError(
                 "--detrend does not apply: the model was estimated without it"
@@ -134,18 +144,49 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
         return data
     from dataclasses import replace
 
+    if len(offsets) != data.n_outputs:
+        raise UsageError(
+            f"the model has {len(offsets)} output(s) and the data "
+            f"{data.n_outputs}; give --output with the model's outputs"
+        )
+    y_offset = tuple(a + b for a, b in zip(data.y_offsets, offsets, strict=True))
     return replace(
         data,
         u=data.u - model.u_offset,
-        y=data.y - model.y_offset,
+        y=data.y - (offsets[0] if data.y.ndim == 1 else np.asarray(offsets)),
         u_offset=data.u_offset + model.u_offset,
-        y_offset=data.y_offset + model.y_offset,
+        y_offset=y_offset[0] if data.y.ndim == 1 else y_offset,
     )
 
 
-def run(args, argv: list[str]) -> int:
-    from spiralid.sysid import validate
+def _validation(model, data, warm):
+    """The model's validation on `data` (after `warm`): one output's, or
+    each output's and the joint fit of a shared denominator."""
+    from spiralid.sysid import SharedDenominatorModel, validate, validate_outputs
 
+    if isinstance(model, SharedDenominatorModel):
+        return validate_outputs(model, data, warmup=warm, label=model.method)
+    return validate(model, data, warmup=warm, label=model.method)
+
+
+def _figures(v) -> dict:
+    """The validation's figures by file stem (each output's, prefixed by
+    its name, for several outputs)."""
+    if not hasattr(v, "outputs"):
+        return v.plot()
+    return {
+        f"{_stem(name)}_{kind}": fig
+        for name, one in v.outputs.items()
+        for kind, fig in one.plot().items()
+    }
+
+
+def _stem(name: str) -> str:
+    """An output's name as a file-name part (letters, digits, _ and -)."""
+    return "".join(c if c.isalnum() or c in "_-" else "_" for c in name) or "output"
+
+
+def run(args, argv: list[str]) -> int:
     with _progress(args) as progress:
         progress.phase("load", "loading the model and the data")
         model, recorded, named = _read_model(args.model)
@@ -162,18 +203,18 @@ def run(args, argv: list[str]) -> int:
             warm = None
         if args.out is None:
             progress.phase("validation", "validating")
-            v = validate(model, data, warmup=warm, label=model.method)
+            v = _validation(model, data, warm)
             written = None
         else:
             with _open_folder(args.out, args.force) as folder:
                 progress.phase("validation", "validating")
-                v = validate(model, data, warmup=warm, label=model.method)
+                v = _validation(model, data, warm)
                 progress.phase("writing", "writing files and figures")
                 (folder.path / "validation.json").write_text(
                     json.dumps(v.to_dict(), indent=2)
                 )
                 (folder.path / "summary.txt").write_text(v.summary() + "\n")
-                _save_figures(v.plot(), folder.path)
+                _save_figures(_figures(v), folder.path)
                 written = folder.commit(last="validation.json")
     if not args.quiet:
         print(v.summary())
