@@ -103,7 +103,7 @@ def test_the_command_refuses_all_outputs_with_data_in_one_line(tmp_path):
 
 
 def test_a_model_is_not_credited_with_a_neighbour_s_mode():
-    from spiralid.reproduction import _nearest
+    from spiralid.study.modes import _nearest
 
     hz, err = _nearest([10.0, 20.0, 30.0], [10.1, 29.0, 80.0])
     np.testing.assert_allclose(hz, [10.1, np.nan, 29.0])

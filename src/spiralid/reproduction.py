@@ -20,6 +20,16 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from spiralid._checks import is_default
+from spiralid.study.modes import (
+    MODE_WINDOW,
+    RIG_INTEGRATORS,
+    RIG_OUTPUTS,
+    SHARED_ARX,
+    SharedModesFit,
+    fit_every_sensor,
+    modes_comparison,
+    rig_record,
+)
 from spiralid.study.runner import execute
 from spiralid.study.spec import BASELINES
 from spiralid.study.tasks import reading_tasks
@@ -27,12 +37,9 @@ from spiralid.sysid import (
     ARX,
     IdentifiedModel,
     IOData,
-    OutputsValidation,
     PaperCost,
-    SharedDenominatorModel,
     arx_least_squares,
     identify,
-    validate_outputs,
 )
 from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
 from spiralid.sysid.estimation.searches import search_options
@@ -178,111 +185,6 @@ class Run:
         }
 
 
-# Every sensor of the simulated rig's experiment, each one's known
-# integrators against the hub torque (the hub angle twice, the hub velocity
-# once, outside the shared poles) and the structure that identifies the
-# shared modes from all four: three modes, the anti-aliasing filter's pair
-# and the fourth mode (docs/results/identification.md, "Several sensors").
-RIG_OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
-RIG_INTEGRATORS = (2, 1, 0, 0)
-SHARED_ARX = ARX(10, 10, 1)
-# The FEM modes the shared fit is set against.
-_FEM_MODES = 3
-
-
-@dataclass
-class SharedModesFit:
-    """The rig's modes identified from every sensor of the experiment.
-
-    One denominator for the hub angle, hub velocity, end-point acceleration
-    and tip deflection of the same simulated run as the paper's record
-    (:data:`RIG_OUTPUTS`, :data:`SHARED_ARX`, :data:`RIG_INTEGRATORS`), by
-    :func:`~spiralid.sysid.identify`'s default method, beside the paper's
-    single-output models.
-
-    Attributes
-    ----------
-    model : SharedDenominatorModel
-    estimation, validation : OutputsValidation
-        Each output's fit and the joint fit on the two parts.
-    fem_hz : ndarray, shape (3,)
-        The rig's first three natural frequencies from its finite-element
-        model (``FlexibleManipulator().modes(3)``), Hz.
-    seed : int
-        The search's seed.
-    seconds : float
-        Wall time of the identification.
-    """
-
-    model: SharedDenominatorModel
-    estimation: OutputsValidation
-    validation: OutputsValidation
-    fem_hz: np.ndarray
-    seed: int
-    seconds: float
-
-    def nearest(self, frequencies) -> tuple[np.ndarray, np.ndarray]:
-        """For each FEM mode, the nearest of `frequencies` (Hz) and its
-        error in percent of the FEM's; NaN when none is within
-        :data:`MODE_WINDOW` of it (the model has not found that mode)."""
-        return _nearest(self.fem_hz, frequencies)
-
-    def to_dict(self) -> dict:
-        hz, err = self.nearest(self.model.modes.table.frequency)
-        return {
-            "outputs": list(self.model.output_names),
-            "structure": {
-                "na": self.model.arx.na,
-                "nb": self.model.arx.nb,
-                "nk": self.model.arx.nk,
-            },
-            "integrators": list(self.model.integrators),
-            "method": self.model.method,
-            "seed": self.seed,
-            "seconds": self.seconds,
-            "fem_modes_hz": self.fem_hz.tolist(),
-            "nearest_modes_hz": _plain_list(hz),
-            "error_percent": _plain_list(err),
-            "modes": self.model.modes.to_dict(),
-            "fit_percent": {
-                part: {
-                    **{n: v.fit_percent for n, v in ov.outputs.items()},
-                    "joint": ov.joint_fit_percent,
-                }
-                for part, ov in (
-                    ("estimation", self.estimation),
-                    ("validation", self.validation),
-                )
-            },
-            "model": self.model.to_dict(),
-        }
-
-
-# A model's mode stands for a FEM mode when within this share of its
-# frequency: a model that lacks a mode is not credited with a neighbour's.
-MODE_WINDOW = 0.10
-
-
-def _nearest(reference, frequencies) -> tuple[np.ndarray, np.ndarray]:
-    """Each `reference` frequency's nearest in `frequencies` and its error
-    (% of the reference); NaN where none is within :data:`MODE_WINDOW`."""
-    ref = np.asarray(reference, dtype=float)
-    f = np.asarray(frequencies, dtype=float)
-    f = f[np.isfinite(f)]
-    if f.size == 0:
-        nan = np.full(ref.shape, np.nan)
-        return nan, nan.copy()
-    hz = f[np.argmin(np.abs(f[None, :] - ref[:, None]), axis=1)]
-    err = 100.0 * (hz - ref) / ref
-    far = np.abs(err) > 100.0 * MODE_WINDOW
-    hz[far], err[far] = np.nan, np.nan
-    return hz, err
-
-
-def _plain_list(values) -> list:
-    return [float(v) if np.isfinite(v) else None for v in values]
-
-
 @dataclass
 class Reproduction:
     """Everything :func:`reproduce` computed.
@@ -337,28 +239,18 @@ class Reproduction:
     def modes_comparison(self) -> list[dict]:
         """The FEM's modes beside those of every sensor's shared fit and of
         each single-output best model and baseline: for each model, the
-        mode nearest each FEM frequency and its error in percent. Empty
-        without :attr:`shared`."""
+        mode nearest each FEM frequency and its error in percent
+        (:func:`spiralid.study.modes.modes_comparison`). Empty without
+        :attr:`shared`."""
         if self.shared is None:
             return []
-        rows = []
-        models = [("every sensor", self.shared.model, self.shared.model.arx)]
-        models += [
-            (label, self.best(label).model, self.arx)
-            for label in [*self.runs, *self.baselines]
-        ]
-        for label, model, arx in models:
-            table = getattr(model.modes, "table", model.modes)
-            hz, err = self.shared.nearest(table.frequency)
-            rows.append(
-                {
-                    "model": label,
-                    "structure": str(arx),
-                    "frequency_hz": _plain_list(hz),
-                    "error_percent": _plain_list(err),
-                }
-            )
-        return rows
+        return modes_comparison(
+            self.shared,
+            [
+                (label, self.best(label).model, self.arx)
+                for label in [*self.runs, *self.baselines]
+            ],
+        )
 
     def statistics(self, label: str) -> dict:
         """Mean, std, median, best and worst over seeds of cost and fit."""
@@ -709,7 +601,7 @@ def reproduce(
     )
     rep.validations = _validate_best(rep)
     if every_sensor is not None:
-        rep.shared = _fit_every_sensor(every_sensor, fraction, seed_list[0])
+        rep.shared = fit_every_sensor(every_sensor, fraction, seed_list[0])
     rep.elapsed = time.perf_counter() - t0
     return rep
 
@@ -726,27 +618,7 @@ def _all_outputs_record(data, all_outputs) -> IOData | None:
             "`all_outputs` applies to the simulated rig (data=None) only: a "
             "record given as `data` has no other sensors; leave it False"
         )
-    return _rig_recording(0).iodata(list(RIG_OUTPUTS))
-
-
-def _fit_every_sensor(record: IOData, fraction: float, seed: int) -> SharedModesFit:
-    """One denominator for every sensor of `record`, validated on both parts."""
-    from spiralid.fms import FlexibleManipulator
-
-    est, val = record.split(fraction)
-    start = time.perf_counter()
-    model = identify(est, SHARED_ARX, integrator=RIG_INTEGRATORS, rng=seed)
-    seconds = time.perf_counter() - start
-    return SharedModesFit(
-        model=model,
-        estimation=validate_outputs(model, est, label="every sensor (estimation)"),
-        validation=validate_outputs(
-            model, val, warmup=est, label="every sensor (validation)"
-        ),
-        fem_hz=np.asarray(FlexibleManipulator().modes(_FEM_MODES), dtype=float),
-        seed=seed,
-        seconds=seconds,
-    )
+    return rig_record(noise_seed=0)
 
 
 def _checked_seeds(data, seeds, n_points, max_nfev) -> list[int]:

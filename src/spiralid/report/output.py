@@ -17,7 +17,7 @@ import numpy as np
 
 from spiralid.outputs.atomic import OutputFolder
 from spiralid.report.html import figure, page, png, table
-from spiralid.reproduction import HEADLINE_TEST, MODE_WINDOW, Reproduction
+from spiralid.reproduction import HEADLINE_TEST, Reproduction
 from spiralid.sysid.models.polynomials import format_pole_radius
 
 __all__ = [
@@ -281,23 +281,9 @@ def summary_text(rep: Reproduction) -> str:
 def _every_sensor_text(rep: Reproduction) -> list[str]:
     """The modes from every sensor beside the FEM's, for the summary (none
     without ``all_outputs``)."""
-    if rep.shared is None:
-        return []
-    fit = rep.shared.model
-    hz, err = rep.shared.nearest(fit.modes.table.frequency)
-    fem = ", ".join(f"{f:.4g}" for f in rep.shared.fem_hz)
-    found = ", ".join(
-        f"{f:.4g} ({e:+.4f} %)" if np.isfinite(f) else "none"
-        for f, e in zip(hz, err, strict=True)
-    )
-    return [
-        "",
-        f"Modes from every sensor ({', '.join(fit.output_names)}; {fit.arx}, "
-        f"integrators {', '.join(map(str, fit.integrators))}): {found} against "
-        f"the FEM's {fem} Hz; joint validation fit "
-        f"{rep.shared.validation.joint_fit_percent:.2f} %.",
-        str(fit.modes),
-    ]
+    from spiralid.report.shared_output import every_sensor_lines
+
+    return [] if rep.shared is None else ["", *every_sensor_lines(rep.shared)]
 
 
 def _tf_block(label: str, tf: str) -> str:
@@ -569,41 +555,15 @@ def _every_sensor_section(rep: Reproduction) -> str:
     """The rig's modes from all four sensors (``all_outputs``): the shared
     modes' table, each output's fit and the modes beside the FEM's and the
     single-output models'."""
-    from spiralid.report.shared_output import fits_table, modes_table
+    from spiralid.report.shared_output import every_sensor_section
 
     if rep.shared is None:
         return ""
-    e = html.escape
-    fit = rep.shared.model
-    fem = rep.shared.fem_hz
-    head = ["model", "structure"]
-    for i in range(1, fem.size + 1):
-        head += [f"mode {i} (Hz)", "error (%)"]
-    rows = [["FEM (rig.modes(3))", "-", *(c for f in fem for c in (f"{f:.4f}", "-"))]]
-    for row in rep.modes_comparison():
-        cells = [row["model"], row["structure"]]
-        for f, err in zip(row["frequency_hz"], row["error_percent"], strict=True):
-            cells += ["-", "-"] if f is None else [f"{f:.4f}", f"{err:+.4f}"]
-        rows.append(cells)
-    integrators = ", ".join(
-        f"{n} {k}" for n, k in zip(fit.output_names, fit.integrators, strict=True)
-    )
-    return (
-        "<h2>Modes from every sensor</h2><p>The same simulated run's four "
-        f"sensors ({e(', '.join(fit.output_names))}) identified with one "
-        f"denominator, {e(str(fit.arx))} by {e(fit.method)} (seed "
-        f"{rep.shared.seed}, {rep.shared.seconds:.1f} s), known integrators "
-        f"outside the shared poles: {e(integrators)}. The 95 % intervals come "
-        "from the shared denominator's covariance; a share is the mode's "
-        "resonant peak as a part of that output's.</p>"
-        + table(*modes_table(fit.modes), "html")
-        + table(*fits_table(rep.shared.estimation, rep.shared.validation), "html")
-        + "<p>Each model's mode nearest each of the finite-element model's "
-        "first three natural frequencies, and its error: the shared fit "
-        "beside the paper's single-output models (best run of each "
-        "configuration, end-point acceleration alone) and the baselines; - "
-        f"where the model has no mode within {100 * MODE_WINDOW:g} % of the "
-        "FEM's.</p>" + table(head, rows, "html")
+    return every_sensor_section(
+        rep.shared,
+        rep.modes_comparison(),
+        "the paper's single-output models (best run of each configuration, "
+        "end-point acceleration alone) and the baselines",
     )
 
 

@@ -6,8 +6,10 @@ each one's share in each output, every output's fit on both parts and the
 joint fit, each output's validation figures, and a stabilisation diagram
 over a range of orders. The numbers are computed in :mod:`spiralid.sysid`
 (the model's ``modes``, ``validate_outputs``, ``stabilisation``); this
-module only lays them out. The reproduction's "modes from every sensor"
-section uses the same tables (:func:`modes_table`, :func:`fits_table`).
+module only lays them out. The "modes from every sensor" section of the
+reproduction's and the study's reports (:func:`every_sensor_section`,
+:func:`every_sensor_lines`) uses the same tables (:func:`modes_table`,
+:func:`fit_percents_table`).
 
 Matplotlib is imported only when a figure is drawn.
 """
@@ -22,7 +24,15 @@ import numpy as np
 from spiralid.report.html import figure, page, png, table
 from spiralid.sysid.models.modes import interval_format
 
-__all__ = ["fits_table", "modes_table", "shared_report", "write_shared_report"]
+__all__ = [
+    "every_sensor_lines",
+    "every_sensor_section",
+    "fit_percents_table",
+    "fits_table",
+    "modes_table",
+    "shared_report",
+    "write_shared_report",
+]
 
 
 def _num(value: float, fmt: str) -> str:
@@ -99,20 +109,135 @@ def fits_table(v_est, v_val) -> tuple[list[str], list[list[str]]]:
     rows : list of list of str
     """
 
-    def fit(v) -> str:
-        return f"{v.fit_percent:.2f}" + (" (diverged)" if v.diverged else "")
+    def numbers(v) -> dict:
+        return {
+            "outputs": {name: o.fit_percent for name, o in v.outputs.items()},
+            "joint": v.joint_fit_percent,
+            "diverged": [name for name, o in v.outputs.items() if o.diverged],
+        }
 
-    rows = [
-        [name, fit(v_est.outputs[name]), fit(v)] for name, v in v_val.outputs.items()
-    ]
-    rows.append(
-        [
-            "joint",
-            f"{v_est.joint_fit_percent:.2f}",
-            f"{v_val.joint_fit_percent:.2f}",
-        ]
+    return fit_percents_table(
+        {"estimation": numbers(v_est), "validation": numbers(v_val)}
     )
+
+
+def fit_percents_table(fits: dict) -> tuple[list[str], list[list[str]]]:
+    """:func:`fits_table` from the numbers alone (what a study's store
+    keeps of the validations).
+
+    Parameters
+    ----------
+    fits : dict
+        :func:`spiralid.study.modes.fit_percents`: per part
+        (``"estimation"``, ``"validation"``) the ``"outputs"``' fits (%),
+        the ``"joint"`` fit and the outputs whose free run ``"diverged"``.
+
+    Returns
+    -------
+    header : list of str
+    rows : list of list of str
+    """
+    est, val = fits["estimation"], fits["validation"]
+
+    def fit(part: dict, name: str) -> str:
+        flag = " (diverged)" if name in part["diverged"] else ""
+        return f"{part['outputs'][name]:.2f}{flag}"
+
+    rows = [[name, fit(est, name), fit(val, name)] for name in val["outputs"]]
+    rows.append(["joint", f"{est['joint']:.2f}", f"{val['joint']:.2f}"])
     return ["output", "fit % (estimation)", "fit % (validation)"], rows
+
+
+def every_sensor_section(
+    fit, comparison: list[dict], models: str, title: str = "Modes from every sensor"
+) -> str:
+    """The HTML section of the rig's modes from every sensor: the shared
+    modes' table, each output's fit, and the modes beside the FEM's and the
+    single-output models'.
+
+    Parameters
+    ----------
+    fit : SharedModesFit
+        :class:`spiralid.study.modes.SharedModesFit`.
+    comparison : list of dict
+        :func:`spiralid.study.modes.modes_comparison` of `fit` (its rows
+        after the FEM's).
+    models : str
+        What the single-output models of `comparison` are, in words.
+    title : str
+        The section's heading.
+
+    Returns
+    -------
+    str
+    """
+    from spiralid.study.modes import MODE_WINDOW
+
+    e = html.escape
+    model = fit.model
+    head = ["model", "structure"]
+    for i in range(1, fit.fem_hz.size + 1):
+        head += [f"mode {i} (Hz)", "error (%)"]
+    rows = [
+        [
+            f"FEM (rig.modes({fit.fem_hz.size}))",
+            "-",
+            *(c for f in fit.fem_hz for c in (f"{f:.4f}", "-")),
+        ]
+    ]
+    for row in comparison:
+        cells = [row["model"], row["structure"]]
+        for f, err in zip(row["frequency_hz"], row["error_percent"], strict=True):
+            cells += ["-", "-"] if f is None else [f"{f:.4f}", f"{err:+.4f}"]
+        rows.append(cells)
+    integrators = ", ".join(
+        f"{n} {k}" for n, k in zip(model.output_names, model.integrators, strict=True)
+    )
+    return (
+        f"<h2>{e(title)}</h2><p>The same simulated run's four sensors "
+        f"({e(', '.join(model.output_names))}) identified with one "
+        f"denominator, {e(str(model.arx))} by {e(model.method)} (seed "
+        f"{fit.seed}, {fit.seconds:.1f} s), known integrators outside the "
+        f"shared poles: {e(integrators)}. The 95 % intervals come from the "
+        "shared denominator's covariance; a share is the mode's resonant peak "
+        "as a part of that output's.</p>"
+        + table(*modes_table(model.modes), "html")
+        + table(*fit_percents_table(fit.fits), "html")
+        + "<p>Each model's mode nearest each of the finite-element model's "
+        f"first {fit.fem_hz.size} natural frequencies, and its error: the shared "
+        f"fit beside {e(models)}; - where the model has no mode within "
+        f"{100 * MODE_WINDOW:g} % of the FEM's.</p>" + table(head, rows, "html")
+    )
+
+
+def every_sensor_lines(fit, title: str = "Modes from every sensor") -> list[str]:
+    """The modes from every sensor beside the FEM's, as lines of text (a
+    summary's paragraph, the modes' table last).
+
+    Parameters
+    ----------
+    fit : SharedModesFit
+        :class:`spiralid.study.modes.SharedModesFit`.
+    title : str
+        The paragraph's first words.
+
+    Returns
+    -------
+    list of str
+    """
+    model = fit.model
+    hz, err = fit.nearest(model.modes.table.frequency)
+    fem = ", ".join(f"{f:.4g}" for f in fit.fem_hz)
+    found = ", ".join(
+        f"{f:.4g} ({e:+.4f} %)" if np.isfinite(f) else "none"
+        for f, e in zip(hz, err, strict=True)
+    )
+    return [
+        f"{title} ({', '.join(model.output_names)}; {model.arx}, integrators "
+        f"{', '.join(map(str, model.integrators))}): {found} against the FEM's "
+        f"{fem} Hz; joint validation fit {fit.fits['validation']['joint']:.2f} %.",
+        str(model.modes),
+    ]
 
 
 _FIGURE_CAPTIONS = {
