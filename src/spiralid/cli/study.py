@@ -69,6 +69,11 @@ def _cmd_study(args, argv: list[str]) -> int:
             f"{run.total} runs: {run.reused} already in {store}, "
             f"{run.computed} computed now, {len(run.failures)} failed"
         )
+        if run.modes_reused or run.modes_computed:
+            print(
+                f"modes from every sensor: {run.modes_reused} records already "
+                f"in the store, {run.modes_computed} identified now"
+            )
         if report is not None:
             print(report)
     if run.failures:
@@ -126,7 +131,7 @@ def _study_report(
 
     progress.phase("analysis", "analysing the store")
     with ResultStore.open(store, readonly=True) as db:
-        rows, spec_text = db.rows(), db.meta().get("spec", "")
+        rows, spec_text, modes = db.rows(), db.meta().get("spec", ""), db.modes()
     try:
         spec = parse_spec(spec_text, where=f"the specification in {store}")
     except ValueError as exc:
@@ -137,7 +142,7 @@ def _study_report(
             f"before the first of its {spec.n_runs} runs finished; rerun the "
             "study to compute them"
         )
-    res = analyse(rows, spec)
+    res = analyse(rows, spec, modes=modes)
     # Before anything is written, so that a failure here writes nothing.
     summary = study_summary(res)
     if warn and res.missing_runs:

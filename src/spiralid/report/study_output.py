@@ -1,7 +1,9 @@
 """Write a study's report: PNG figures, ``results.json``, ``report.html``.
 
 The same three kinds of file as a reproduction (:mod:`spiralid.report.output`),
-computed from a study's store by :func:`spiralid.study.analyse`.
+computed from a study's store by :func:`spiralid.study.analyse`; a rig record
+with ``all_outputs`` adds its modes from every sensor, laid out as the
+reproduction's (:func:`spiralid.report.shared_output.every_sensor_section`).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from pathlib import Path
 from spiralid.outputs.atomic import OutputFolder
 from spiralid.report.html import figure, page, png, table
 from spiralid.report.output import versions
+from spiralid.report.shared_output import every_sensor_lines, every_sensor_section
 from spiralid.study import StudyResults
 from spiralid.study.spec import BASELINES
 
@@ -224,7 +227,30 @@ def study_summary(res: StudyResults) -> str:
     anytime = anytime_summary(res)
     if anytime:
         lines += ["", anytime]
+    for record, fit in res.modes.items():
+        lines += ["", *every_sensor_lines(fit, f"Modes from every sensor: {record}")]
     return "\n".join(lines)
+
+
+# What the single-output models beside a record's shared fit are.
+_MODELS = (
+    "the single-output models identified on the record's one sensor (the best "
+    "run of each configuration on each reading) and the baselines of each "
+    "predictor"
+)
+
+
+def _every_sensor_sections(res: StudyResults) -> list[str]:
+    """Each rig record's modes from every sensor (``all_outputs``)."""
+    return [
+        every_sensor_section(
+            fit,
+            res.modes_comparison(record),
+            _MODELS,
+            title=f"Modes from every sensor: {record}",
+        )
+        for record, fit in res.modes.items()
+    ]
 
 
 def study_results_dict(res: StudyResults, spec_text: str, command=None) -> dict:
@@ -285,6 +311,21 @@ def study_results_dict(res: StudyResults, spec_text: str, command=None) -> dict:
             for (d, p), rows in res.baselines.items()
             for label, row in rows.items()
         ],
+        # Only for rig records with all_outputs: a study without them writes
+        # the same keys as before.
+        **(
+            {
+                "modes_from_every_sensor": {
+                    record: {
+                        **fit.to_dict(),
+                        "comparison": res.modes_comparison(record),
+                    }
+                    for record, fit in res.modes.items()
+                }
+            }
+            if res.modes
+            else {}
+        ),
     }
 
 
@@ -328,6 +369,7 @@ def _html(res: StudyResults, images: dict, spec_text: str, command) -> str:
         ]
     for stem, data in images.items():
         parts.append(figure(stem, data))
+    parts += _every_sensor_sections(res)
     parts.append("<h2>Every reading</h2>")
     for rd in res.readings:
         parts.append(f"<h3>{e(', '.join(map(str, rd)))}</h3>")

@@ -5,18 +5,24 @@ reading (record, predictor, parametrisation) and configuration the costs,
 fits and wall times over seeds; the baselines of each record and predictor;
 and, per reading, the claim's test (Eb-SDA against SDA by default): the
 rank-sum p-value, the Vargha-Delaney A12 effect size and the Holm-adjusted
-p-value over all readings tested together, with a verdict.
+p-value over all readings tested together, with a verdict; and, for a rig
+record with ``all_outputs``, its modes from every sensor beside the FEM's
+and the single-output models' (:mod:`~spiralid.study.modes`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .anytime import budget_verdicts, verdict
 from .spec import StudySpec
 from .statistics import holm, rank_sum
+
+if TYPE_CHECKING:  # the modes module loads the identification (SciPy, Numba)
+    from .modes import SharedModesFit
 
 __all__ = ["CLAIM", "StudyResults", "analyse"]
 
@@ -37,7 +43,8 @@ class StudyResults:
         Search configurations.
     cells : dict of (reading, label) to dict
         ``cost``, ``fit_val``, ``seconds``, ``seeds`` arrays over seeds (seed
-        order) and ``history``, the runs' convergence histories.
+        order), ``history``, the runs' convergence histories, and
+        ``best_model``, the model dict of the run of lowest cost.
     baselines : dict of (data, predictor) to dict of label to row
     claims : list of dict
         Per reading where both labels of `claim` ran: the medians, ``n``,
@@ -53,6 +60,9 @@ class StudyResults:
     expected_runs : int or None
         Runs of the specification (None without it); more than
         `stored_runs` when the study stopped early or runs failed.
+    modes : dict of str to SharedModesFit
+        Per rig record with ``all_outputs``, its modes from every sensor
+        (empty without).
     """
 
     readings: list[Reading]
@@ -65,6 +75,7 @@ class StudyResults:
     anytime: dict = field(default_factory=dict)
     stored_runs: int = 0
     expected_runs: int | None = None
+    modes: dict[str, SharedModesFit] = field(default_factory=dict)
 
     @property
     def missing_runs(self) -> int:
@@ -72,6 +83,40 @@ class StudyResults:
         if self.expected_runs is None:
             return 0
         return max(self.expected_runs - self.stored_runs, 0)
+
+    def modes_comparison(self, record: str) -> list[dict]:
+        """The FEM's modes beside those of `record`'s fit from every sensor
+        and of each single-output model identified on it: the best run of
+        each configuration on each reading of the record, then each
+        baseline per predictor (:func:`~spiralid.study.modes.modes_comparison`).
+
+        Parameters
+        ----------
+        record : str
+            A key of :attr:`modes`.
+        """
+        from spiralid.sysid import IdentifiedModel
+
+        from .modes import modes_comparison
+
+        models = []
+        for rd in self.readings:
+            if rd[0] != record:
+                continue
+            for label in self.labels:
+                cell = self.cells.get((rd, label))
+                if cell is not None:
+                    models.append((f"{label} ({rd[1]}, {rd[2]})", cell["best_model"]))
+        for (data, predictor), rows in self.baselines.items():
+            if data == record:
+                models += [
+                    (f"{label} ({predictor})", row["model"])
+                    for label, row in rows.items()
+                ]
+        built = [(label, IdentifiedModel.from_dict(d)) for label, d in models]
+        return modes_comparison(
+            self.modes[record], [(label, m, m.arx) for label, m in built]
+        )
 
     def statistics(self, reading: Reading, label: str) -> dict:
         """Median, best, worst and quartiles of cost; median fit and time."""
@@ -110,6 +155,7 @@ def analyse(
     spec: StudySpec | None = None,
     claim=CLAIM,
     alpha: float = 0.05,
+    modes: dict | None = None,
 ) -> StudyResults:
     """Group a store's rows and test the claim per reading.
 
@@ -124,6 +170,10 @@ def analyse(
         Labels of the configuration claimed better and its reference.
     alpha : float
         Family-wise significance level of the Holm-adjusted tests.
+    modes : dict of str to dict, optional
+        The store's modes from every sensor
+        (:meth:`~spiralid.study.ResultStore.modes`), read into
+        :attr:`StudyResults.modes`.
     """
     if not 0 < alpha < 1:
         raise ValueError(f"`alpha` must be in (0, 1); got {alpha!r}")
@@ -139,6 +189,7 @@ def analyse(
         alpha=alpha,
         stored_runs=len(rows),
         expected_runs=None if spec is None else spec.n_runs,
+        modes=_shared_modes(modes),
     )
     tested = [
         rd for rd in readings if (rd, claim[0]) in cells and (rd, claim[1]) in cells
@@ -149,6 +200,16 @@ def analyse(
             cells, tested, tuple(claim), spec.budget, spec.points, alpha=alpha
         )
     return res
+
+
+def _shared_modes(modes: dict | None) -> dict:
+    """The store's modes from every sensor, each read back as a
+    SharedModesFit (the identification is loaded only when there are any)."""
+    if not modes:
+        return {}
+    from .modes import SharedModesFit
+
+    return {record: SharedModesFit.from_dict(d) for record, d in modes.items()}
 
 
 def _group(rows: list[dict]) -> dict:
@@ -185,6 +246,7 @@ def _cell(group: list[dict]) -> dict:
         "seconds": np.array([r["seconds"] for r in group]),
         "history": [r["model"]["history"] for r in group],
         "nfev": [r["nfev"] for r in group],
+        "best_model": min(group, key=lambda r: r["cost"])["model"],
     }
 
 

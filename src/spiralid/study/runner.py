@@ -9,7 +9,9 @@ on the engine or the order (each run draws from its own seeded generator).
 
 :func:`run_study` opens the store, skips the runs it already holds, and
 commits every new row as it arrives, so an interrupted study resumes where
-it stopped.
+it stopped. A rig record with ``all_outputs`` also has its modes identified
+from every sensor of the same run (:func:`~spiralid.study.modes.fit_every_sensor`),
+once per record, after the runs, and stored beside them.
 """
 
 from __future__ import annotations
@@ -48,6 +50,9 @@ class StudyRun:
         Runs computed and stored now.
     failures : list of (Task, str)
         Runs that raised, with the message; not stored, so a rerun retries.
+    modes_reused, modes_computed : int
+        Records whose modes from every sensor (``all_outputs``) the store
+        already held, and those identified now.
     """
 
     store: Path
@@ -55,6 +60,8 @@ class StudyRun:
     reused: int
     computed: int
     failures: list[tuple[Task, str]] = field(default_factory=list)
+    modes_reused: int = 0
+    modes_computed: int = 0
 
 
 @contextmanager
@@ -358,4 +365,30 @@ def run_study(
             done += 1
             if progress is not None:
                 progress(done, len(tasks))
+        _store_modes(spec, db, outcome)
     return outcome
+
+
+def _store_modes(spec: StudySpec, db: ResultStore, outcome: StudyRun) -> None:
+    """Identify and store the modes from every sensor of each rig record
+    with ``all_outputs`` that the store does not hold yet.
+
+    Once per record, not per seed: the shared fit reaches the same modes
+    whatever its search's seed (docs/guide/studies.md), so it is seeded by
+    the first of the study's seeds, as ``spiralid reproduce --all-outputs``
+    seeds it.
+    """
+    from .modes import fit_every_sensor, rig_record
+
+    stored = db.modes()
+    for d in spec.data:
+        if not d.all_outputs:
+            continue
+        if d.name in stored:
+            outcome.modes_reused += 1
+            continue
+        rig = d.rig()
+        record = rig_record(rig, d.settings.get("noise_seed", 0))
+        fit = fit_every_sensor(record, spec.fraction, spec.seeds[0], rig)
+        db.add_modes(d.name, fit.to_dict())
+        outcome.modes_computed += 1

@@ -44,7 +44,7 @@ _DATA_KINDS = ("rig", "arm", "csv")
 _STUDY_KEYS = ("seeds", "budget", "points", "na", "nb", "nk", "fraction", "baselines")
 _GRID_KEYS = ("predictors", "parametrizations")
 _DATA_KEYS = {
-    "rig": ("name", "kind", "output", "noise_seed", "rig"),
+    "rig": ("name", "kind", "output", "noise_seed", "rig", "all_outputs"),
     "arm": ("name", "kind", "ts"),
     "csv": ("name", "kind", "path", "input", "output", "ts", "detrend"),
 }
@@ -57,11 +57,32 @@ _BASELINES = tuple(BASELINES)
 
 @dataclass(frozen=True)
 class DataSpec:
-    """One record of the study: its name, kind and how to obtain it."""
+    """One record of the study: its name, kind and how to obtain it.
+
+    Attributes
+    ----------
+    name, kind : str
+    settings : dict
+        The record's other keys in the specification; ``all_outputs`` only
+        when true.
+    """
 
     name: str
     kind: str
     settings: dict = field(default_factory=dict)
+
+    @property
+    def all_outputs(self) -> bool:
+        """A rig record whose modes the study also identifies from every
+        sensor of the same run (:mod:`spiralid.study.modes`)."""
+        return bool(self.settings.get("all_outputs", False))
+
+    def rig(self):
+        """The :class:`~spiralid.fms.FlexibleManipulator` a rig record
+        simulates."""
+        from spiralid.fms import FlexibleManipulator
+
+        return FlexibleManipulator(**self.settings.get("rig", {}))
 
     def load(self):
         """The record as an :class:`~spiralid.sysid.IOData`."""
@@ -69,10 +90,9 @@ class DataSpec:
 
         s = self.settings
         if self.kind == "rig":
-            from spiralid.fms import FlexibleManipulator, paper_experiment
+            from spiralid.fms import paper_experiment
 
-            rig = FlexibleManipulator(**s.get("rig", {}))
-            rec = paper_experiment().run(rig, rng=s.get("noise_seed", 0))
+            rec = paper_experiment().run(self.rig(), rng=s.get("noise_seed", 0))
             return rec.iodata(s.get("output", "end_acceleration"))
         if self.kind == "arm":
             from spiralid.datasets import robot_arm
@@ -237,6 +257,13 @@ def _data(entry: Any, base: Path | None, where: str) -> DataSpec:
         _fail(
             where, f"[[data]] `kind` must be one of {list(_DATA_KINDS)}; got {kind!r}"
         )
+    if "all_outputs" in entry and kind != "rig":
+        # Before the unknown-key check, to say why rather than only "unknown".
+        _fail(
+            where,
+            f"[[data]] of kind {kind!r}: `all_outputs` applies to kind 'rig' "
+            "only (the simulated rig's four sensors of one run)",
+        )
     _check_keys(entry, _DATA_KEYS[kind], where, f"[[data]] of kind {kind!r}")
     name = entry.get("name", kind)
     if not isinstance(name, str) or not name:
@@ -255,6 +282,15 @@ def _data(entry: Any, base: Path | None, where: str) -> DataSpec:
         settings["path"] = str(path.resolve())
     if kind == "rig" and not isinstance(settings.get("rig", {}), dict):
         _fail(where, f"[[data]] {name!r}: `rig` must be a table of rig settings")
+    if not isinstance(settings.get("all_outputs", False), bool):
+        _fail(
+            where,
+            f"[[data]] {name!r}: `all_outputs` must be true or false; "
+            f"got {settings['all_outputs']!r}",
+        )
+    if not settings.get("all_outputs", True):
+        # Off is the default: a spec that says so hashes as one that does not.
+        del settings["all_outputs"]
     return DataSpec(name, kind, settings)
 
 

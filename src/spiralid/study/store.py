@@ -6,6 +6,11 @@ finished, and a rerun of the same command computes only the rest. A store
 belongs to one specification: opening it with another is refused, since its
 rows would answer a different question.
 
+A rig record with ``all_outputs`` adds its modes from every sensor, one row
+per record in a table of its own (``modes``), created with the first of
+them: a store without it (a study without the option, or written before it
+existed) reads as one without modes.
+
 Two processes never write one store: :meth:`ResultStore.open` takes an
 exclusive ``flock`` on ``STORE.lock`` beside it (released by the kernel when
 the holder exits, however it exits) and refuses with a clear error while
@@ -137,7 +142,7 @@ class ResultStore:
 
     def _init(self, digest: str, spec_text: str) -> None:
         tables = self._tables()
-        if tables - {"meta", "runs"}:
+        if tables - {"meta", "runs", "modes"}:
             # Someone else's database: adding our tables to it would be
             # writing into their file.
             raise ValueError(
@@ -183,6 +188,34 @@ class ResultStore:
         marks = ", ".join("?" for _ in _COLUMNS)
         with self._db:
             self._db.execute(f"INSERT OR REPLACE INTO runs VALUES ({marks})", values)
+
+    def add_modes(self, record: str, result: dict) -> None:
+        """Store the modes of `record` from every sensor, committed at once.
+
+        Parameters
+        ----------
+        record : str
+            The record's name in the specification.
+        result : dict
+            :meth:`spiralid.study.modes.SharedModesFit.to_dict`.
+        """
+        with self._db:
+            self._db.execute(
+                "CREATE TABLE IF NOT EXISTS modes "
+                "(record TEXT PRIMARY KEY, result TEXT)"
+            )
+            self._db.execute(
+                "INSERT OR REPLACE INTO modes VALUES (?, ?)",
+                (record, json.dumps(result)),
+            )
+
+    def modes(self) -> dict[str, dict]:
+        """The stored modes from every sensor, by record name (empty for a
+        store without them)."""
+        if "modes" not in self._tables():
+            return {}
+        query = "SELECT record, result FROM modes ORDER BY record"
+        return {record: json.loads(text) for record, text in self._db.execute(query)}
 
     def rows(self) -> list[dict]:
         """Every stored run as a dict, in key order."""
