@@ -25,6 +25,9 @@ _POLL_STEP = 0.25
 _POLL_TOL = 1e-3
 # The archive is thinned to twice the population when it grows past four.
 _ARCHIVE_SLACK = 4
+# The objectives of points the thinning dropped are kept up to this many
+# times the population (see Archive._remember).
+_GHOSTS = 10
 
 
 def tchebycheff(f: np.ndarray, w: np.ndarray, z: np.ndarray, s: np.ndarray):
@@ -85,6 +88,12 @@ class Subproblems:
                 self.x[j], self.f[j] = y[q], fy[q]
 
 
+def _dominated_by(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Mask of the rows of `b` that some row of `a` dominates."""
+    a, b = a[:, None, :], b[None, :, :]
+    return np.any(np.all(a <= b, axis=2) & np.any(a < b, axis=2), axis=0)
+
+
 class Archive:
     """The non-dominated points of every evaluation offered to it.
 
@@ -109,6 +118,7 @@ class Archive:
         x, f = np.asarray(x, float), np.asarray(f, float)
         keep = non_dominated(f)
         self.x, self.f = x[keep], f[keep]
+        self._ghosts = np.empty((0, f.shape[1]))
 
     def add(self, y, fy) -> None:
         """Offer the points `y` of objectives `fy`."""
@@ -118,16 +128,39 @@ class Archive:
         y, fy = np.asarray(y, float), np.asarray(fy, float)
         fresh = non_dominated(fy)
         y, fy = y[fresh], fy[fresh]
+        taken = ~np.any(np.all(self.f[:, None, :] <= fy[None, :, :], axis=2), axis=0)
+        if self._ghosts.shape[0] and taken.any():
+            taken[taken] = ~_dominated_by(self._ghosts, fy[taken])
+        y, fy = y[taken], fy[taken]
         old, new_f = self.f[:, None, :], fy[None, :, :]
-        beaten = np.any(np.all(old <= new_f, axis=2), axis=0)
         dominated = np.all(old >= new_f, axis=2) & np.any(old > new_f, axis=2)
         dropped = np.any(dominated, axis=1)
-        x = np.concatenate([self.x[~dropped], y[~beaten]])
-        f = np.concatenate([self.f[~dropped], fy[~beaten]])
+        x = np.concatenate([self.x[~dropped], y])
+        f = np.concatenate([self.f[~dropped], fy])
         if self.m is not None and f.shape[0] > _ARCHIVE_SLACK * self.m:
             keep = thin_front(f, 2 * self.m)
+            dropped = np.ones(f.shape[0], bool)
+            dropped[keep] = False
+            self._remember(f[dropped])
             x, f = x[keep], f[keep]
         self.x, self.f = x, f
+
+    def _remember(self, dropped: np.ndarray) -> None:
+        """Keep the objectives of the points the thinning dropped, so that
+        a later point one of them dominates is refused. Without them the
+        learned-metric poll's crossover pairs left up to a third of a small
+        front dominated by points the search had seen. They are bounded
+        too, more loosely than the archive (thinned to ``_GHOSTS / 2`` times
+        the population past ``_GHOSTS`` times)."""
+        # No remembered point dominates a dropped one (each was checked when
+        # it came in, and the archive holds no dominated pair), so only the
+        # remembered ones can fall.
+        ghosts = np.concatenate(
+            [self._ghosts[~_dominated_by(dropped, self._ghosts)], dropped]
+        )
+        if ghosts.shape[0] > _GHOSTS * self.m:
+            ghosts = ghosts[thin_front(ghosts, _GHOSTS // 2 * self.m)]
+        self._ghosts = ghosts
 
     def final(self) -> tuple[np.ndarray, np.ndarray]:
         """At most ``m`` points, evenly spread (every point without ``m``)."""
@@ -185,6 +218,19 @@ class PollMoves:
     its steps again. With the rule's ``basis`` the directions are a basis
     learned by Adaptive Encoding from every successful step of the
     population; without, the box's axes.
+
+    With the rule's ``crossover`` share ``p``, each subproblem polls instead,
+    with probability ``p`` per iteration, the pair ``x*_i +- M (x_r - x*_i)``:
+    ``x_r`` the incumbent of a random subproblem of the whole population and
+    ``M`` a random half of the coordinates (one at least). A poll moves one
+    direction at a time and keeps only improvements, so it cannot cross a
+    ridge that no single direction descends, nor the gap between two pieces
+    of a disconnected front: on WFG2 the outermost subproblems stop at an
+    inner piece, and its non-separable distance stays unconverged. The
+    crossover point carries coordinates that another part of the front has
+    already made good; its mirror steps past the centre away from ``x_r``,
+    which at an end of the front is outwards. Such a pair leaves the
+    direction's step and the turn of directions as they were.
     """
 
     def __init__(self, rule: LearnedMetricSpiral, sub: Subproblems, lo, hi, gen):
@@ -198,6 +244,7 @@ class PollMoves:
         self.batch = 2 * m
         self.n_restarts = 0
         self._centre = None
+        self._crossed = np.zeros(m, bool)
 
     def propose(self, sub: Subproblems, gen) -> np.ndarray:
         m = sub.size
@@ -206,12 +253,26 @@ class PollMoves:
         step = step * gen.uniform(0.5, 1.5, size=m)
         offset = (self.basis[:, self.direction] * step).T * (self.hi - self.lo)
         centre = sub.x[self._centre]
+        if self.rule.crossover > 0.0:
+            # Drawn only when on, so that crossover=0 is the poll as it was,
+            # number for number.
+            self._crossed = gen.uniform(size=m) < self.rule.crossover
+            offset[self._crossed] = self._crossover(sub, centre, gen)
         return np.vstack(
             [
                 np.clip(centre + offset, self.lo, self.hi),
                 np.clip(centre - offset, self.lo, self.hi),
             ]
         )
+
+    def _crossover(self, sub: Subproblems, centre, gen) -> np.ndarray:
+        """The offsets ``M (x_r - x*)`` of the crossing subproblems."""
+        rows = np.flatnonzero(self._crossed)
+        q, n = rows.size, self.lo.size
+        partner = sub.x[gen.integers(sub.size, size=q)]
+        mask = gen.uniform(size=(q, n)) < 0.5
+        mask[np.arange(q), gen.integers(n, size=q)] = True
+        return mask * (partner - centre[rows])
 
     def learn(self, sub: Subproblems, y, fy) -> None:
         m = sub.size
@@ -220,16 +281,21 @@ class PollMoves:
         g_pair = np.column_stack([sub.g(fy[:m]), sub.g(fy[m:])])
         better = np.argmin(g_pair, axis=1)
         success = g_pair[rows, better] < g_centre
+        polled = ~self._crossed
         j = self.direction
         self.steps[rows, j] = np.where(
-            success,
-            np.minimum(self.steps[rows, j] * self.rule.grow, 1.0),
-            self.steps[rows, j] * self.rule.shrink,
+            polled,
+            np.where(
+                success,
+                np.minimum(self.steps[rows, j] * self.rule.grow, 1.0),
+                self.steps[rows, j] * self.rule.shrink,
+            ),
+            self.steps[rows, j],
         )
         if self.encoding is not None and success.any():
             moved = (y[rows + m * better] - sub.x[self._centre])[success]
             self._learn_basis(moved / (self.hi - self.lo))
-        self.direction = (j + 1) % self.lo.size
+        self.direction = np.where(polled, (j + 1) % self.lo.size, j)
         stuck = self.steps.max(axis=1) < _POLL_TOL
         if stuck.any():
             self.steps[stuck] = _POLL_STEP

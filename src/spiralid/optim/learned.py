@@ -105,6 +105,16 @@ class LearnedMetricSpiral:
         default 2 and 1/2, Adaptive Coordinate Descent's.
     delta : float
         Contraction over the run's budget when ``success_steps=False``.
+    crossover : float
+        :func:`~spiralid.optim.minimize_pareto` only: the share of
+        subproblems that poll a crossover pair instead of a basis direction
+        at each iteration (default 0.5; 0 polls the basis directions
+        only). The pair is ``x* +- M (x_r - x*)`` with ``x_r`` the incumbent
+        of a random subproblem and ``M`` a random half of the coordinates:
+        a uniform crossover of the centre with ``x_r`` and its mirror, which
+        carries a coordinate found good elsewhere on the front and steps
+        past the front's ends (WFG2's outer pieces). The single-objective
+        search refuses any other value than the default.
 
     Examples
     --------
@@ -124,6 +134,7 @@ class LearnedMetricSpiral:
     grow: float = 2.0
     shrink: float = 0.5
     delta: float = 1e-3
+    crossover: float = 0.5
 
     def __post_init__(self):
         for name in ("basis", "success_steps", "model_step", "populations"):
@@ -138,6 +149,13 @@ class LearnedMetricSpiral:
                 raise ValueError(f"`{name}` must be in (0, 1); got {value!r}")
             object.__setattr__(self, name, value)
         object.__setattr__(self, "grow", grow)
+        try:
+            crossover = float(self.crossover)
+        except (TypeError, ValueError):
+            crossover = math.nan
+        if isinstance(self.crossover, bool) or not 0.0 <= crossover <= 1.0:
+            raise ValueError(f"`crossover` must be in [0, 1]; got {self.crossover!r}")
+        object.__setattr__(self, "crossover", crossover)
 
     def poll_cost(self, n: int) -> int:
         """Evaluations of a poll period in dimension ``n``: ``2n`` polls and
@@ -196,6 +214,12 @@ class LearnedMetricSearch(SearchBase):
         )
         if not isinstance(method, LearnedMetricSpiral):
             raise ValueError(f"`method` must be a LearnedMetricSpiral; got {method!r}")
+        if method.crossover != LearnedMetricSpiral.crossover:
+            raise ValueError(
+                "`crossover` of LearnedMetricSpiral applies to minimize_pareto "
+                "only (it crosses subproblems' incumbents); got "
+                f"crossover={method.crossover!r}"
+            )
         self.rule = method
         self._width = self._hi - self._lo
         if not method.success_steps and self._k_max is None:
