@@ -13,7 +13,9 @@ from spiralid.optim.front import knee_point
 from spiralid.optim.learned import LearnedMetricSearch, LearnedMetricSpiral
 from spiralid.optim.pareto import (
     PARETO_OPTIONS,
+    HypervolumeEstimate,
     hypervolume,
+    hypervolume_mc,
     minimize_pareto,
     non_dominated,
     thin_front,
@@ -44,6 +46,7 @@ __all__ = [
     "ConstantSpiral",
     "ConvergentSpiral",
     "ExponentialSpiral",
+    "HypervolumeEstimate",
     "LearnedMetricSearch",
     "LearnedMetricSpiral",
     "LinearSpiral",
@@ -57,6 +60,7 @@ __all__ = [
     "differential_evolution",
     "exponential_rule",
     "hypervolume",
+    "hypervolume_mc",
     "knee_point",
     "minimize",
     "minimize_pareto",
