@@ -109,3 +109,13 @@ def test_a_model_is_not_credited_with_a_neighbour_s_mode():
     np.testing.assert_allclose(hz, [10.1, np.nan, 29.0])
     np.testing.assert_allclose(err, [1.0, np.nan, -100.0 / 30.0])
     assert np.isnan(_nearest([10.0], [])[0]).all()
+
+
+def test_the_every_sensor_names_stay_importable_from_the_reproduction():
+    import spiralid.reproduction as reproduction
+    import spiralid.study.modes as modes
+
+    for name in ("MODE_WINDOW", "RIG_INTEGRATORS", "RIG_OUTPUTS", "SHARED_ARX",
+                 "SharedModesFit"):  # fmt: skip
+        assert name in reproduction.__all__
+        assert getattr(reproduction, name) is getattr(modes, name)

@@ -20,11 +20,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from spiralid._checks import is_default
+from spiralid.study import modes as _modes
 from spiralid.study.modes import (
-    MODE_WINDOW,
-    RIG_INTEGRATORS,
-    RIG_OUTPUTS,
-    SHARED_ARX,
     SharedModesFit,
     fit_every_sensor,
     modes_comparison,
@@ -61,6 +58,22 @@ __all__ = [
     "reproduce",
 ]
 
+
+# The fit of every sensor is spiralid.study.modes' (the study runs it too);
+# its constants are named here too, where all_outputs documents them.
+
+# Every sensor of the simulated rig's experiment (the outputs of
+# all_outputs' shared fit).
+RIG_OUTPUTS = _modes.RIG_OUTPUTS
+# Each sensor's known integrators against the hub torque: the hub angle
+# twice, the hub velocity once, outside the shared poles.
+RIG_INTEGRATORS = _modes.RIG_INTEGRATORS
+# The structure that identifies the shared modes from all four sensors: three
+# modes, the anti-aliasing filter's pair and the fourth mode.
+SHARED_ARX = _modes.SHARED_ARX
+# A model's mode stands for a FEM mode when within this share of its
+# frequency: a model that lacks a mode is not credited with a neighbour's.
+MODE_WINDOW = _modes.MODE_WINDOW
 
 # The one test behind the headline verdict, everywhere it is stated (the
 # report, its summary, results.json): the same two-sided test the budget
