@@ -5,8 +5,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
-
 from .errors import UsageError
 from .options import (
     _add_data_options,
@@ -143,6 +141,8 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
             )
         return data
     from dataclasses import replace
+
+    import numpy as np
 
     if len(offsets) != data.n_outputs:
         raise UsageError(
