@@ -292,8 +292,13 @@ class PollMoves:
             ),
             self.steps[rows, j],
         )
-        if self.encoding is not None and success.any():
-            moved = (y[rows + m * better] - sub.x[self._centre])[success]
+        # The basis learns from the poll's own successes only: fed the
+        # crossover's, long steps between distant incumbents, it turned the
+        # poll off ZDT4's front (hypervolume 0 on 4 seeds of 4, against
+        # 0.64-0.74 without them).
+        learnt = success & polled
+        if self.encoding is not None and learnt.any():
+            moved = (y[rows + m * better] - sub.x[self._centre])[learnt]
             self._learn_basis(moved / (self.hi - self.lo))
         self.direction = np.where(polled, (j + 1) % self.lo.size, j)
         stuck = self.steps.max(axis=1) < _POLL_TOL
