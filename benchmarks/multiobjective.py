@@ -1,14 +1,20 @@
-"""The multi-objective spiral search against pymoo on ZDT and DTLZ.
+"""The multi-objective spiral search against pymoo on ZDT, DTLZ and WFG.
 
 Problems (pymoo's definitions and reference fronts): ZDT1-4 and ZDT6 (2
-objectives, 30 or 10 variables) and DTLZ1-7 (3 objectives, pymoo's default
-sizes). Optimisers at the same budget of evaluations: ``MO-Eb-SDA`` and
-``MO-SDA`` (``spiralid.optim.minimize_pareto``, 100 points), pymoo's
-NSGA-II and SMS-EMOA (population 100) and MOEA/D (Das-Dennis weights, 99 or
-91 of them, 10 neighbours), and random search (the non-dominated set of
-uniform draws). Hypervolume (moocore) from the reference point 1.1 x the
-reference front's nadir (DTLZ5-7's fronts, which pymoo would download, are
-computed here), and IGD+ to pymoo's reference front; median and
+objectives, 30 or 10 variables), DTLZ1-7 (3 objectives, pymoo's default
+sizes), ``dtlz2-4`` (DTLZ2 with 4 objectives and pymoo's 10 variables) and
+``wfg2`` (2 objectives, 24 variables: 4 position and 20 distance ones; its
+front, in 5 disconnected pieces, computed here, and its objectives divided
+by the front's nadir (2, 4) so that it spans the unit square).
+Optimisers at the same budget of evaluations: ``MO-learned-metric``,
+``MO-Eb-SDA`` and ``MO-SDA`` (``spiralid.optim.minimize_pareto``, 100
+points), ``MO-learned-metric-no-crossover`` (the poll without its crossover
+pairs), pymoo's NSGA-II and SMS-EMOA (population 100) and MOEA/D (Das-Dennis
+weights, 99, 91 or 84 of them, 10 neighbours), and random search (the
+non-dominated set of uniform draws). Hypervolume (moocore) from the
+reference point 1.1 x the reference front's nadir (DTLZ5-7's fronts, which
+pymoo would download, are computed here), and IGD+ to pymoo's reference
+front (WFG2's and DTLZ2's with 4 objectives computed here); median and
 interquartile range over seeds, and the two-sided rank-sum p-value against
 NSGA-II per problem (``spiralid.study.statistics.rank_sum``); median wall
 time per run and the optimiser's own time per evaluation (wall time minus
@@ -34,7 +40,36 @@ import numpy as np
 from spiralid.optim import LearnedMetricSpiral, minimize_pareto
 from spiralid.study.statistics import rank_sum
 
-PROBLEMS = ("zdt1", "zdt2", "zdt3", "zdt4", "zdt6", *(f"dtlz{i}" for i in range(1, 8)))
+PROBLEMS = (
+    *("zdt1", "zdt2", "zdt3", "zdt4", "zdt6"),
+    *(f"dtlz{i}" for i in range(1, 8)),
+    "dtlz2-4",
+    "wfg2",
+)
+# pymoo's name and arguments where the benchmark's name is not pymoo's.
+_PYMOO = {
+    "dtlz2-4": ("dtlz2", {"n_obj": 4}),
+    "wfg2": ("wfg2", {"n_var": 24, "n_obj": 2}),
+}
+# Objectives divided by these (the true front's nadir) before the
+# indicators: WFG's objective j spans [0, 2j].
+_SCALE = {"wfg2": np.array([2.0, 4.0])}
+
+
+def _wfg2_front():
+    """WFG2's front for 2 objectives: the position y in [0, 1] gives
+    (2 (1 - cos(pi y / 2)), 4 (1 - y cos^2(5 pi y))) with the distance
+    variables at their optimum; its non-dominated part, 5 pieces."""
+    y = np.linspace(0.0, 1.0, 200_001)
+    f = np.column_stack(
+        [
+            2.0 * (1.0 - np.cos(np.pi * y / 2)),
+            4.0 * (1.0 - y * np.cos(5 * np.pi * y) ** 2),
+        ]
+    )
+    f = f[np.lexsort((f[:, 1], f[:, 0]))]
+    keep = f[:, 1] < np.minimum.accumulate(np.r_[np.inf, f[:-1, 1]])
+    return f[keep][::10]
 
 
 def _offline_front(name):
@@ -45,6 +80,13 @@ def _offline_front(name):
         t = np.linspace(0.0, np.pi / 2, 1000)
         c = np.cos(t) / np.sqrt(2.0)
         return np.column_stack([c, c, np.sin(t)])
+    if name == "wfg2":
+        return _wfg2_front()
+    if name == "dtlz2-4":
+        from pymoo.util.ref_dirs import get_reference_directions
+
+        d = get_reference_directions("das-dennis", 4, n_partitions=12)
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
     if name == "dtlz7":
         import moocore
 
@@ -61,7 +103,8 @@ def _problem(name):
     reference front, computed once per process."""
     from pymoo.problems import get_problem
 
-    return get_problem(name), _reference_front(name)
+    pymoo_name, kwargs = _PYMOO.get(name, (name, {}))
+    return get_problem(pymoo_name, **kwargs), _reference_front(name)
 
 
 @functools.cache
@@ -124,7 +167,7 @@ def _pymoo(kind):
         elif kind == "SMS-EMOA":
             algorithm = SMSEMOA(pop_size=100)
         else:
-            parts = 99 if problem.n_obj == 2 else 12
+            parts = {2: 99, 3: 12, 4: 6}[problem.n_obj]
             dirs = get_reference_directions(
                 "das-dennis", problem.n_obj, n_partitions=parts
             )
@@ -156,6 +199,8 @@ METHODS = {
     "NSGA-II": _pymoo("NSGA-II"),
     "MO-learned-metric": _spiral("learned-metric"),
     "MO-learned-metric-axes": _spiral(LearnedMetricSpiral(basis=False)),
+    # Ablation: the poll without its crossover pairs.
+    "MO-learned-metric-no-crossover": _spiral(LearnedMetricSpiral(crossover=0.0)),
     "MO-Eb-SDA": _spiral("ebsda"),
     "MO-SDA": _spiral("sda"),
     # Ablations: the non-dominated incumbents instead of the thinned archive.
@@ -170,9 +215,11 @@ METHODS = {
 }
 
 
-def _indicators(f, front):
+def _indicators(f, front, scale=None):
     import moocore
 
+    if scale is not None:
+        f, front = f / scale, front / scale
     ref = 1.1 * front.max(axis=0)
     hv = float(moocore.hypervolume(f, ref=ref))
     gap = np.maximum(f[None, :, :] - front[:, None, :], 0.0)
@@ -188,7 +235,7 @@ def run_one(task):
     t0 = time.perf_counter()
     f = METHODS[method](problem, seed, budget)
     wall = time.perf_counter() - t0
-    hv, igd_plus = _indicators(f, front)
+    hv, igd_plus = _indicators(f, front, _SCALE.get(name))
     own_us = 1e6 * (wall - timer.seconds) / budget
     return name, method, seed, budget, hv, igd_plus, wall, own_us
 
