@@ -63,8 +63,10 @@ from rest over the whole record, scored on the last third), median wall
 time per identification, and the machine load.
 
 Scaling with the order (``--scaling``): ``spiral`` (default budget, seeds
-0..``--seeds``-1, ``stop`` from ``--stop``: ``converged``, its default, or
-``budget``, the whole budget as before), OE and LS at ARX(n, n, 0) for n in
+0..``--seeds``-1, ``stop`` from ``--stop``: ``work``, its default,
+``converged``, the default before it, or ``budget``, the whole budget),
+each identification run ``--repeats`` times (the median time), OE and LS at
+ARX(n, n, 0) for n in
 ``--orders`` (default 2, 4, 8, 12, 16, 24, 32) on ``rig`` and ``rig-8000``;
 median time, cost as a ratio to OE's (after the pole-zero cancellation,
 which both apply), spiral's time as a ratio to OE's, and the growth
@@ -98,6 +100,7 @@ from spiralid.sysid import ARX, IOData, PaperCost, identify
 from spiralid.sysid.estimation.identify import default_bounds
 from spiralid.sysid.estimation.memetic import projected_spiral
 from spiralid.sysid.estimation.modal import ModalParametrization
+from spiralid.sysid.estimation.spiral_method import SPIRAL_STOPS
 from spiralid.sysid.estimation.varpro import ProjectedCost
 from spiralid.sysid.models.polynomials import fold_reflection, step_up
 from spiralid.sysid.validation.validate import fit_percent
@@ -392,17 +395,24 @@ def summarise(rows, records, methods):
 
 
 def scaling_one(task):
-    record, order, method, seed, stop = task
+    record, order, method, seed, stop, *rest = task
+    repeats = rest[0] if rest else 1
     est, _ = load_record(record).split(2 / 3)
     arx = ARX(order, order, 0)
     kw = {"rng": seed, "stop": stop} if method == "spiral" else {}
-    t0, c0 = time.perf_counter(), time.process_time()
-    fit = identify(est, arx, method=method.lower(), **kw)
-    # Processor time of this one process (BLAS on one thread): on a shared
-    # machine the wall time also counts the other jobs' share of the cores.
+    times, walls = [], []
+    for _ in range(repeats):
+        t0, c0 = time.perf_counter(), time.process_time()
+        fit = identify(est, arx, method=method.lower(), **kw)
+        # Processor time of this one process (BLAS on one thread): on a
+        # shared machine the wall time also counts the other jobs' share of
+        # the cores. Each repeat gives the same fit (it is deterministic);
+        # the median of the repeats' times damps the other jobs' cache traffic.
+        times.append(time.process_time() - c0)
+        walls.append(time.perf_counter() - t0)
     return dict(record=record, order=order, method=method, seed=seed,
-                cost=float(fit.cost), time=time.process_time() - c0,
-                wall=time.perf_counter() - t0)  # fmt: skip
+                cost=float(fit.cost), time=float(np.median(times)),
+                wall=float(np.median(walls)))  # fmt: skip
 
 
 def growth_exponent(orders, times) -> float:
@@ -456,7 +466,7 @@ def scaling(args) -> None:
         for method, seeds in (("LS", 1), ("OE", 1), ("spiral", args.seeds))
         for seed in range(seeds)
     ]
-    tasks = [(*task, args.stop) for task in tasks]
+    tasks = [(*task, args.stop, args.repeats) for task in tasks]
     scaling_one(("rig", 8, "spiral", 0, args.stop))  # warm the compiled kernels
     load0 = os.getloadavg()
     t0 = time.perf_counter()
@@ -464,7 +474,7 @@ def scaling(args) -> None:
     rows = [scaling_one(task) for task in tasks]
     print(summarise_scaling(rows, records, orders))
     print(
-        f"\nspiral with stop={args.stop!r}; "
+        f"\nspiral with stop={args.stop!r}; median of {args.repeats} repeat(s); "
         f"{len(tasks)} identifications in {time.perf_counter() - t0:.0f} s; "
         f"load average at start {load0[0]:.2f}, at end {os.getloadavg()[0]:.2f}"
     )
@@ -498,10 +508,16 @@ def main(argv=None):
                     help="orders of the scaling table")  # fmt: skip
     ap.add_argument(
         "--stop",
-        default="converged",
-        choices=("converged", "budget"),
-        help="the scaling table's spiral stop (its default 'converged', or the "
-        "whole budget)",
+        default=SPIRAL_STOPS[0],
+        choices=SPIRAL_STOPS,
+        help="the scaling table's spiral stop (its default 'work', 'converged' "
+        "as before it, or the whole budget)",
+    )
+    ap.add_argument(
+        "--repeats",
+        type=int,
+        default=1,
+        help="the scaling table's runs of each identification (median time)",
     )
     args = ap.parse_args(argv)
     if args.scaling:

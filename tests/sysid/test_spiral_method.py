@@ -91,11 +91,11 @@ def test_bad_search_options_are_named(two_modes, kwargs, match):
 
 
 def test_the_search_stops_when_a_restart_finds_no_lower_basin(two_modes):
-    # stop="converged" (the default) ends the search once a fresh population
-    # falls back into a basin already found; stop="budget" spends it all,
-    # as before. Output error's cost holds either way.
+    # stop="converged" ends the search once a fresh population falls back
+    # into a basin already found; stop="budget" spends it all, as before.
+    # Output error's cost holds either way.
     oe = identify(two_modes, ARX4, method="oe")
-    default = identify(two_modes, ARX4, rng=1, max_nfev=8000)
+    default = identify(two_modes, ARX4, rng=1, max_nfev=8000, stop="converged")
     budget = identify(two_modes, ARX4, rng=1, max_nfev=8000, stop="budget")
     assert default.result.raw.converged and default.result.status == 0
     assert "Converged" in default.result.message
@@ -103,3 +103,43 @@ def test_the_search_stops_when_a_restart_finds_no_lower_basin(two_modes):
     assert default.result.nfev < budget.result.nfev
     for fit in (default, budget):
         assert fit.result.get("fun_full", fit.cost) <= oe.cost * (1 + 1e-12)
+
+
+def _output_error_work(data, arx):
+    """Residual evaluations of output error's two polishes, counted here
+    from the same starts (least squares and Steiglitz-McBride)."""
+    from spiralid.sysid.estimation.margin import max_radius
+    from spiralid.sysid.estimation.outputerror import local_polish, steiglitz_mcbride
+    from spiralid.sysid.models.arx import arx_least_squares
+
+    ls = arx_least_squares(data, arx)
+    radius = max_radius(data.ts, data.n * data.ts)
+    return sum(
+        local_polish(start, arx, data, "simulation", max_radius=radius)[1].nfev
+        for start in (ls, steiglitz_mcbride(data, arx, ls))
+    )
+
+
+def test_the_default_stop_ties_the_search_to_output_errors_work(two_modes):
+    # stop="work" (the default): output error first, then a search whose
+    # budget is WORK.search evaluations per evaluation output error needed
+    # (at least two populations), never above max_nfev; the cost stays at or
+    # below output error's, whose minimum is among those kept.
+    from spiralid.sysid.estimation.spiral_method import WORK
+
+    oe = identify(two_modes, ARX4, method="oe")
+    work = _output_error_work(two_modes, ARX4)
+    fit = identify(two_modes, ARX4, rng=1)
+    res = fit.result
+    assert res.oe_work == work
+    assert res.caps["search"] == max(100, round(WORK.search * work))
+    assert res.raw.nfev <= res.caps["search"]
+    assert res.caps["polish"] == max(WORK.least, round(WORK.polish * work))
+    assert res.refine.runs["search"][1].nfev <= res.caps["polish"]
+    assert fit.result.get("fun_full", fit.cost) <= oe.cost * (1 + 1e-12)
+    # A smaller max_nfev still caps the search.
+    small = identify(two_modes, ARX4, rng=1, max_nfev=60)
+    assert small.result.caps["search"] == 60 and small.result.raw.nfev <= 60
+    # The other stops leave the budget alone and measure nothing first.
+    converged = identify(two_modes, ARX4, rng=1, stop="converged")
+    assert converged.result.oe_work is None and converged.result.caps == {}

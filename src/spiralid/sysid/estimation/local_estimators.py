@@ -36,7 +36,7 @@ def _estimate_ls(problem: Problem) -> EstimatorResult:
 
 def _polish(
     problem: Problem,
-    starts: dict[str, np.ndarray],
+    starts: dict[str, np.ndarray | tuple],
     predictor: str,
     cost: PaperCost,
     max_nfev: int | None = None,
@@ -45,24 +45,34 @@ def _polish(
     the first start). The simulation error is not convex, so each start may
     stop in a different local minimum; the choice is on the estimation cost,
     never on validation data. `max_nfev` caps each polish (None:
-    :func:`~spiralid.sysid.estimation.outputerror.local_polish`'s own)."""
+    :func:`~spiralid.sysid.estimation.outputerror.local_polish`'s own).
+
+    A start given as ``(theta, res)`` was polished already (an earlier
+    result's ``runs``): it takes part in the choice without a second run.
+    The result's ``runs`` holds every start's ``(theta, res)`` and ``work``
+    their residual evaluations together (what the polishes cost, in the
+    unit their caps are set in)."""
     t0 = time.perf_counter()
     best = None
-    costs, thetas = {}, {}
+    costs, thetas, runs = {}, {}, {}
     # Passed only when set, so local_polish's own default stays its own.
     cap = {} if max_nfev is None else {"max_nfev": max_nfev}
     for name, start in starts.items():
-        theta, res = local_polish(
-            start,
-            problem.arx,
-            problem.data,
-            predictor,
-            problem.initial,
-            max_radius=problem.max_radius,
-            **cap,
-        )
+        if isinstance(start, tuple):
+            theta, res = start
+        else:
+            theta, res = local_polish(
+                start,
+                problem.arx,
+                problem.data,
+                predictor,
+                problem.initial,
+                max_radius=problem.max_radius,
+                **cap,
+            )
         costs[name] = float(cost(theta))
         thetas[name] = theta
+        runs[name] = (theta, res)
         if best is None or costs[name] < best[0]:
             best = (costs[name], name, theta, res)
     _, name, theta, res = best
@@ -89,11 +99,14 @@ def _polish(
         start=name,
         starts=costs,
         thetas=thetas,
+        runs=runs,
+        work=sum(int(r.nfev) for _, r in runs.values()),
         raw=res,
     )
 
 
 def _standard_starts(problem: Problem) -> dict[str, np.ndarray]:
+    """Output error's starts: least squares and Steiglitz-McBride from it."""
     theta_ls = problem.parametrization.theta_ls
     return {
         "ls": theta_ls,
@@ -111,14 +124,22 @@ def _estimate_oe(problem: Problem) -> EstimatorResult:
     return result
 
 
-def _cancel(problem: Problem, result: EstimatorResult, cost: PaperCost) -> None:
+def _cancel(
+    problem: Problem,
+    result: EstimatorResult,
+    cost: PaperCost,
+    max_nfev: int | None = None,
+) -> None:
     """Remove the near-cancelling pole-zero pairs that raise `cost` (the
     error the method minimises) by at most 1 %
     (:func:`~spiralid.sysid.estimation.cancellation.reduce_order`); each
     reduced model is polished by output error, with the same margin, from
     the deflated model (fresh starts at the reduced order would find other
-    minima: that is choosing an order, not removing a pair)."""
+    minima: that is choosing an order, not removing a pair). `max_nfev`
+    caps each of those polishes (None: the polish's own default)."""
     from .cancellation import effective, reduce_order
+
+    cap = {} if max_nfev is None else {"max_nfev": max_nfev}
 
     def polish(start, reduced):
         theta, _ = local_polish(
@@ -128,6 +149,7 @@ def _cancel(problem: Problem, result: EstimatorResult, cost: PaperCost) -> None:
             "simulation",
             problem.initial,
             max_radius=problem.max_radius,
+            **cap,
         )
         return theta
 
@@ -146,12 +168,37 @@ def _cancel(problem: Problem, result: EstimatorResult, cost: PaperCost) -> None:
     )
 
 
-def _refine(problem: Problem, result: EstimatorResult) -> None:
-    """Polish the search's best locally; keep it only if it lowers the cost."""
-    starts = {"search": result.x}
+def _refine(
+    problem: Problem,
+    result: EstimatorResult,
+    standard: EstimatorResult | None = None,
+    max_nfev: int | None = None,
+) -> None:
+    """Polish the search's best locally; keep it only if it lowers the cost.
+
+    With the safe start the polish also runs from the least-squares and
+    Steiglitz-McBride starts, or takes `standard`, their polish made
+    already (:func:`_polish`'s result), without running it again.
+    `max_nfev` caps the polish from the search's best (None: the
+    polish's own default)."""
+    polished = _polish(
+        problem, {"search": result.x}, problem.predictor, problem.cost, max_nfev
+    )
     if problem.safe_start:
-        starts.update(_standard_starts(problem))
-    polished = _polish(problem, starts, problem.predictor, problem.cost)
+        if standard is None:
+            standard = _polish(
+                problem, _standard_starts(problem), problem.predictor, problem.cost
+            )
+        # One choice over all three, the search's first (it wins ties), as
+        # one polish of the three starts makes it.
+        elapsed = polished.elapsed + standard.elapsed
+        polished = _polish(
+            problem,
+            {"search": polished.runs["search"], **standard.runs},
+            problem.predictor,
+            problem.cost,
+        )
+        polished.elapsed = elapsed
     polished.accepted = bool(polished.fun <= result.fun)
     if polished.accepted:
         result.x, result.fun = polished.x, polished.fun

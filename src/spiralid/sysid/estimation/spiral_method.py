@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,21 +16,30 @@ from spiralid.optim import RULES, Restarts
 
 from . import heldback
 from .heldback import HOLDBACK
-from .local_estimators import _cancel, _estimate_fir, _polish, _refine
-from .outputerror import steiglitz_mcbride
+from .local_estimators import (
+    _cancel,
+    _estimate_fir,
+    _polish,
+    _refine,
+    _standard_starts,
+)
 from .problem import EstimatorResult, Problem
 
-__all__ = ["SPIRAL_RESTARTS", "SPIRAL_STOPS"]
+__all__ = ["SPIRAL_RESTARTS", "SPIRAL_STOPS", "WORK", "WorkShares"]
 
 
-def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
+def _modal_starts(
+    problem: Problem, modes, n_points: int, n_peaks: int, x0, standard: dict | None
+):
     """First points of the modal search and the safe denominators.
 
-    With the safe start: the stabilised least-squares, Steiglitz-McBride
-    and zero models (modal coordinates, clipped to the box), and the exact
-    denominators of the first two for the final check (the modal map can
-    only approximate poles it cannot represent). Then `n_peaks` points at
-    the frequency response's peaks, then the caller's `x0`.
+    With the safe start (`standard`: output error's least-squares and
+    Steiglitz-McBride starts): the stabilised least-squares,
+    Steiglitz-McBride and zero models (modal coordinates, clipped to the
+    box), and the exact denominators of the first two for the final check
+    (the modal map can only approximate poles it cannot represent). Then
+    `n_peaks` points at the frequency response's peaks, then the caller's
+    `x0`.
     """
     from ..models.polynomials import step_up
     from .memetic import frequency_seeds
@@ -37,9 +47,8 @@ def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
 
     par, arx = problem.parametrization, problem.arx
     rows, safe = [], None
-    if problem.safe_start:
-        theta_ls = par.theta_ls
-        theta_sm = steiglitz_mcbride(problem.data, arx, theta_ls)
+    if standard is not None:
+        theta_ls, theta_sm = standard["ls"], standard["steiglitz-mcbride"]
         rows = [par.from_theta(th) for th in (theta_ls, theta_sm, 0 * theta_ls)]
         a_ls = step_up(stabilise(theta_ls, arx)[: arx.na])
         safe = np.array([a_ls, theta_sm[: arx.na]])
@@ -71,7 +80,78 @@ def _modal_starts(problem: Problem, modes, n_points: int, n_peaks: int, x0):
 SPIRAL_RESTARTS = Restarts(growth=1.0, stall=20)
 
 # The spiral method's stops (`stop`): the first is the default.
-SPIRAL_STOPS = ("converged", "budget")
+SPIRAL_STOPS = ("work", "converged", "budget")
+
+
+@dataclass(frozen=True)
+class WorkShares:
+    """What ``stop="work"`` lets the steps after output error spend, each a
+    multiple of output error's own work ``W``: the residual evaluations of
+    its two Levenberg-Marquardt polishes (from least squares and
+    Steiglitz-McBride), which the method runs first.
+
+    Output error's minimum is always among the minima the method keeps the
+    lowest of, so its cost stays at or below output error's whatever these
+    caps cut; they bound the time the rest adds to output error's.
+
+    Parameters
+    ----------
+    search : float
+        The search's evaluations (population and polish steps) per unit of
+        ``W``. One evaluation of output error (with its share of the
+        Jacobians) took the processor time of 10-35 projected-cost
+        evaluations of one candidate at orders 2-32 on 2,000 and 8,000
+        samples, so 2.5 is a sixth of output error's time or less.
+    polish : float
+        The cap of the polish from the search's best, in
+        Levenberg-Marquardt evaluations per unit of ``W``.
+    refit : float
+        The held-back refits' evaluations together, per unit of ``W``
+        (shared among the distinct minima, each still at most
+        :data:`~spiralid.sysid.estimation.heldback.REFIT_NFEV` per
+        parameter and one).
+    cancel : float
+        The cap of each polish of a reduced model in the pole-zero
+        cancellation (``cancel``), per unit of ``W``: from the deflated
+        model it can crawl for longer than output error took (1,390
+        evaluations at ARX(24, 24, 0) on the rig, against 1,595 for output
+        error's two polishes), and capped at 100 it removed the same two
+        pairs, the cost 3e-4 higher.
+    least : int
+        The fewest evaluations any of these caps leaves: a few
+        Levenberg-Marquardt steps (a search has at least two populations'
+        worth).
+    """
+
+    search: float = 2.5
+    polish: float = 0.1
+    refit: float = 0.1
+    cancel: float = 0.15
+    least: int = 5
+
+    def cap(self, share: float, work: int, least: int | None = None) -> int:
+        """A cap of evaluations tied to output error's work.
+
+        Parameters
+        ----------
+        share : float
+            One of the shares above.
+        work : int
+            Output error's work ``W`` (residual evaluations).
+        least : int, optional
+            The floor; default :attr:`least`.
+
+        Returns
+        -------
+        int
+            ``round(share * work)``, at least `least`.
+        """
+        floor = self.least if least is None else least
+        return max(int(floor), round(share * work))
+
+
+#: The shares of ``stop="work"``, the default (:class:`WorkShares`).
+WORK = WorkShares()
 
 
 def _estimate_recommended(
@@ -85,7 +165,7 @@ def _estimate_recommended(
     restarts: bool | Restarts = SPIRAL_RESTARTS,
     frequency_seeds: int = 0,
     holdback: float | None = HOLDBACK,
-    stop: str = "converged",
+    stop: str = "work",
     x0=None,
     max_iter: int | None = None,
     callback=None,
@@ -126,15 +206,24 @@ def _estimate_recommended(
     10_000`` evaluations of the search, its polish steps included
     (``benchmarks/identification.py`` measures what each ingredient does).
 
-    `stop` says when the search ends: ``"converged"`` (the default) as soon
-    as a fresh population (a restart) stalls without lowering the best cost
-    by more than 1e-6 of it, i.e. it fell back into a basin already found
-    or a worse one, or at the budget if that comes first
+    `stop` says when the search ends: ``"converged"`` as soon as a fresh
+    population (a restart) stalls without lowering the best cost by more
+    than 1e-6 of it, i.e. it fell back into a basin already found or a
+    worse one, or at the budget if that comes first
     (:class:`~spiralid.sysid.estimation.memetic.PatientRestarts` with
-    ``patience=1``; ``result.raw.converged`` says which); ``"budget"``
-    spends the whole budget, as before (restarts drawn uniformly in the
-    box rarely beat the first population, which holds the safe starts:
-    ``benchmarks/identification.py --scaling`` measures both).
+    ``patience=1``; ``result.raw.converged`` says which); ``"work"`` (the
+    default) as ``"converged"``, with output error's two polishes run
+    first and the search's budget, the cap of the polish from its best and
+    the held-back refits' evaluations each tied to their work
+    (:class:`WorkShares`, :data:`WORK`; ``result.oe_work`` is that work and
+    ``result.caps`` the caps), so the method adds a bounded share of output
+    error's time to it; without the safe start or with
+    ``polish_every=None`` there is no output error to measure and it is
+    ``"converged"``. ``"budget"`` spends the whole budget, as before
+    (restarts drawn uniformly in the box rarely beat the first population,
+    which holds the safe starts: ``benchmarks/identification.py
+    --scaling`` measures all three). Every stop is deterministic: the same
+    `rng` gives the same result.
     An FIR structure (``na = 0``) has no modes: its cost is quadratic in the
     numerator and the exact minimiser is returned without a search.
     """
@@ -173,8 +262,9 @@ def _estimate_recommended(
         max_nfev=10_000 if max_nfev is None else max_nfev,
         polish_every=polish_every,
         polish_nfev=polish_nfev,
-        restarts=_patient(restarts) if stop == "converged" else restarts,
+        restarts=restarts if stop == "budget" else _patient(restarts),
         frequency_seeds=frequency_seeds,
+        work=WORK if stop == "work" else None,
         x0=x0,
         max_iter=max_iter,
         callback=callback,
@@ -195,7 +285,7 @@ def _estimate_recommended(
     else:
         result = _choose_held_back(problem, start, holdback, settings)
     if problem.cancel:
-        _cancel(problem, result, problem.cost)
+        _cancel(problem, result, problem.cost, result.caps.get("cancel"))
     return result
 
 
@@ -268,6 +358,12 @@ def _choose_held_back(
     if len(candidates) > 1:
         part = problem.restricted(problem.data[:start])
         nfev = heldback.refit_nfev(problem.arx.n_params)
+        work = settings["work"]
+        if work is not None and result.get("oe_work") is not None:
+            # The refits share a budget tied to output error's work.
+            share = work.cap(work.refit, result.oe_work) // len(candidates)
+            nfev = min(nfev, max(share, work.least))
+            result.caps["refit"] = nfev
         for c in candidates:
             # A local refit without the held-back end stays in the minimum's
             # basin: the held-back error then judges the basin, not the data
@@ -300,9 +396,12 @@ def _spiral_search(
     x0,
     max_iter,
     callback,
+    work: WorkShares | None = None,
 ) -> EstimatorResult:
     """The search with its safe starts and the final polish beside output
-    error (:func:`_estimate_recommended`), on `problem`'s record."""
+    error (:func:`_estimate_recommended`), on `problem`'s record; with
+    `work` output error's polish first and the search's budget and the
+    polish from its best tied to its work (``stop="work"``)."""
     from .memetic import projected_spiral
 
     t0 = time.perf_counter()
@@ -311,7 +410,23 @@ def _spiral_search(
     box = par.default_bounds() if problem.bounds is None else problem.bounds
     modes = copy.copy(par.modes)
     modes.bounds = box
-    start, safe = _modal_starts(problem, modes, n_points, frequency_seeds, x0)
+    polishes = problem.refine or (problem.safe_start and polish_every is not None)
+    # Output error's starts once: the search's first population and the
+    # final polish share them.
+    standard = _standard_starts(problem) if problem.safe_start else None
+    oe, caps = None, {}
+    if work is not None and polishes and standard is not None:
+        # Output error first: its work sets what the rest may spend.
+        oe = _polish(problem, standard, problem.predictor, problem.cost)
+        max_nfev = min(max_nfev, work.cap(work.search, oe.work, 2 * n_points))
+        # The polish's own default cap, which the shares never exceed.
+        largest = 100 * (problem.arx.n_params + 1)
+        caps = {
+            "search": max_nfev,
+            "polish": min(work.cap(work.polish, oe.work), largest),
+            "cancel": min(work.cap(work.cancel, oe.work), largest),
+        }
+    start, safe = _modal_starts(problem, modes, n_points, frequency_seeds, x0, standard)
     raw = projected_spiral(
         cost,
         modes,
@@ -342,7 +457,8 @@ def _spiral_search(
         nfev=int(raw.nfev),
         nit=int(raw.nit),
         history=raw.history,
-        elapsed=time.perf_counter() - t0,
+        # The search's own time; output error's polish is the refine's.
+        elapsed=time.perf_counter() - t0 - (0.0 if oe is None else oe.elapsed),
         x_search=raw.z,
         bounds=box,
         safe_start=problem.safe_start,
@@ -351,12 +467,16 @@ def _spiral_search(
         n_restarts=raw.n_restarts,
         refine=None,
         raw=raw,
+        oe_work=None if oe is None else oe.work,
+        caps=caps,
     )
-    if problem.refine or (problem.safe_start and polish_every is not None):
+    if polishes:
         # The safe start's promise, kept to the end: the result is never
         # above output error from the same stabilised least-squares and
         # Steiglitz-McBride starts, nor above a local polish of the search's
         # own best (the search's LM steps are capped, OE's run to its
         # tolerances). `polish_every=None` asks for no gradient step at all.
-        _refine(problem, result)
+        if oe is None and standard is not None:
+            oe = _polish(problem, standard, problem.predictor, problem.cost)
+        _refine(problem, result, oe, caps.get("polish"))
     return result
