@@ -255,12 +255,17 @@ def main(argv=None) -> None:
             se = (got[:, k, 3] - got[:, k, 2]) / (2 * stats.norm.ppf(0.975))
             with np.errstate(all="ignore"):
                 z = (got[:, k, 0] - f) / se
-            if np.all(np.isfinite(z)):
-                zs = f"{z.mean():+.2f}, {z.std(ddof=1):.2f}"
+            if np.all(np.isnan(se)):
+                zs = fcov = dcov = "no interval"
+            else:
+                # A zero-width interval (se 0) covers nothing: it counts as a
+                # miss, and its infinite error in se is left out of the mean.
+                ok = np.isfinite(z)
+                zs = f"{z[ok].mean():+.2f}, {z[ok].std(ddof=1):.2f}"
+                if not np.all(ok):
+                    zs += f" ({np.count_nonzero(~ok)} with se 0)"
                 fcov = _coverage((got[:, k, 2] <= f) & (f <= got[:, k, 3]))
                 dcov = _coverage((got[:, k, 4] <= ZETA) & (ZETA <= got[:, k, 5]))
-            else:
-                zs = fcov = dcov = "no interval"
             print(
                 f"| {fit} | {k + 1} | {err.mean():.4f} | {err.max():.4f} | "
                 f"{derr.mean():.1f} | {zs} | {fcov} | {dcov} |"

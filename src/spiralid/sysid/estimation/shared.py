@@ -24,9 +24,17 @@ weighting for independent Gaussian sensor noise, so a noisy sensor does not
 pull the modes off a clean one's. ``weights=`` gives them explicitly.
 
 Intervals. At the optimum, ``s^2 (J_a' J_a)^-1`` with ``J_a`` the weighted
-variable-projection Jacobian (Golub-Pereyra) is the covariance of ``a``
-(the numerators' uncertainty is already projected out), and ``s^2`` the
-weighted residual variance per degree of freedom.
+variable-projection Jacobian (Golub-Pereyra) of every output, stacked, is
+the covariance of ``a`` (the numerators' uncertainty is already projected
+out), and ``s^2`` the weighted residual variance per degree of freedom.
+It comes from the singular values of ``J_a`` with a square-root factor
+``R = s S^-1 V^T`` (``C = R^T R``), which the modes' intervals use: the
+normal equations ``J_a' J_a`` square the condition of ``J_a`` (about 1e8
+on the rig's four outputs at ARX(14, 16, 1)), and from the inverted normal
+equations the first mode's delta-method standard error ``sqrt(g' C g)``
+came out anywhere between 0 and 1.8 times the factor's ``|R g|`` over 100
+noise realisations (one interval of zero width; the factor's varied by
+4 %).
 """
 
 from __future__ import annotations
@@ -402,7 +410,9 @@ def _weighted_polish(first, par, z, data, arx, reweight: bool):
 
 
 def _model(data, arx, method, cost, a, b, covariance, result, t0):
+    """The model; `covariance` is ``(C, R)`` or None."""
     result = dict(result, elapsed=time.perf_counter() - t0)
+    covariance, root = (None, None) if covariance is None else covariance
     # Least squares' poles may be unstable: no simulation cost then.
     stable = is_stable_polynomial(a)
     return SharedDenominatorModel(
@@ -421,6 +431,7 @@ def _model(data, arx, method, cost, a, b, covariance, result, t0):
         weights=cost.weights,
         costs=cost.per_output(a) if stable else None,
         covariance=covariance,
+        covariance_factor=root,
         integrators=cost.integrators,
         result=result,
     )
@@ -470,15 +481,28 @@ def joint_least_squares(data, arx: ARX, weights=None) -> np.ndarray:
 
 
 def _covariance(cost: SharedProjectedCost, a, data: IOData, arx: ARX):
-    """``s^2 (J_a' J_a)^-1`` of the weighted projected residual at `a`, or
-    None where ``J_a' J_a`` is singular or `a` unstable."""
+    """``(C, R)``: ``C = s^2 (J_a' J_a)^-1`` of the weighted projected
+    residual at `a`, every output's stacked, and its factor ``R = s S^-1
+    V^T`` from the SVD ``J_a = U S V^T`` (module docstring); None where
+    `a` is unstable, the record too short or ``J_a`` singular (a singular
+    value below ``1e-12`` of the largest)."""
     if not is_stable_polynomial(a):
         return None
-    sse, _, hess = cost.normal_equations(a)
     dof = data.n * data.n_outputs - arx.na - data.n_outputs * arx.nb
     if dof <= 0:
         return None
+    rows, residual = [], []
+    for w, part in zip(np.sqrt(cost.weights), cost.parts, strict=True):
+        r, jac = part.residual(a)
+        residual.append(w * r)
+        rows.append(w * np.asarray(jac, dtype=float))
+    r = np.concatenate(residual)
+    s2 = float(r @ r) / dof
     try:
-        return (sse / dof) * np.linalg.inv(hess)
+        _, sv, vt = np.linalg.svd(np.vstack(rows), full_matrices=False)
     except np.linalg.LinAlgError:
         return None
+    if not sv[-1] > 1e-12 * sv[0]:
+        return None
+    root = np.sqrt(s2) * vt / sv[:, None]
+    return root.T @ root, root

@@ -120,6 +120,10 @@ class SharedDenominatorModel:
     covariance : ndarray, shape (na, na), or None
         The covariance of ``a`` (variable projection: the numerators
         projected out), for the modes' intervals.
+    covariance_factor : ndarray or None, shape (na, na)
+        A square-root factor ``R`` of :attr:`covariance` (``C = R^T R``),
+        which the mode intervals use for precision; not saved in model.json
+        (a model read back uses the covariance itself).
     integrators : tuple of int
         Each output's known integrators, poles at ``z = 1`` outside the
         shared ``A``: output ``i`` is ``B_i / (A (1 - z^-1)^k_i)``.
@@ -142,6 +146,7 @@ class SharedDenominatorModel:
     weights: np.ndarray | None = None
     costs: np.ndarray | None = None
     covariance: np.ndarray | None = None
+    covariance_factor: np.ndarray | None = None
     integrators: tuple[int, ...] = ()
     result: dict = field(default_factory=dict)
 
@@ -231,7 +236,14 @@ class SharedDenominatorModel:
         output."""
         b_full = [np.r_[np.zeros(self.arx.nk), bi] for bi in self.b]
         tables = [
-            mode_table(self.a, bi, self.ts, covariance=self.covariance) for bi in b_full
+            mode_table(
+                self.a,
+                bi,
+                self.ts,
+                covariance=self.covariance,
+                factor=self.covariance_factor,
+            )
+            for bi in b_full
         ]
         share = (
             np.column_stack([t.share for t in tables]) if tables else np.zeros((0, 0))
