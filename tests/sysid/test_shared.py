@@ -307,3 +307,41 @@ def test_an_accelerometer_at_a_node_of_the_rig_gets_that_mode_from_the_other():
     k = np.argmin(np.abs(shared.modes.table.frequency - mode2))
     share = shared.modes.share[k]
     assert share[1] < share[0] / 10  # the node accelerometer barely sees it
+
+
+def test_the_covariance_is_s2_over_the_stacked_jacobian_with_its_factor():
+    # By hand: finite differences of every output's weighted projected
+    # residual, stacked, and s^2 = the weighted squared error per degree of
+    # freedom; the factor R (C = R^T R) gives the same standard errors.
+    from spiralid.sysid.models.modes import mode_table
+
+    data = _record(12)
+    arx = ARX(4, 4, 1)
+    fit = identify(data, arx, method="oe")
+    cost = SharedProjectedCost(arx, data, fit.weights)
+
+    def residual(a):
+        return np.concatenate(
+            [
+                np.sqrt(w) * part.residual(a)[0]
+                for w, part in zip(fit.weights, cost.parts, strict=True)
+            ]
+        )
+
+    r = residual(fit.a)
+    h = 1e-7
+    jac = np.column_stack(
+        [
+            (residual(fit.a + h * e) - residual(fit.a - h * e)) / (2 * h)
+            for e in np.eye(4)
+        ]
+    )
+    s2 = r @ r / (2 * data.n - 4 - 2 * 4)
+    expected = s2 * np.linalg.inv(jac.T @ jac)
+    np.testing.assert_allclose(fit.covariance, expected, rtol=1e-4)
+    root = fit.covariance_factor
+    np.testing.assert_allclose(root.T @ root, fit.covariance, rtol=1e-10)
+    plain = mode_table(fit.a, [0.0, *fit.b[0]], TS, covariance=expected)
+    np.testing.assert_allclose(
+        fit.modes.table.frequency_se, plain.frequency_se, rtol=1e-3
+    )
