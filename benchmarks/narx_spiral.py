@@ -31,10 +31,15 @@ scored on the validation third, which neither the training nor any choice
 saw. A diverging free run counts as -999.
 
 Printed: median validation fit % over the seeds with quartiles, median
-seconds per fit (per whole choice in (b)), and the load average.
+seconds per fit (per whole choice in (b)), every seed's fit, and the load
+average. The defaults (10 seeds for (a), 6 for (b)) are what
+docs/results/narx.md shows: 4.1 and 13.6 min of CPU, 7.5 and 22.5 min of
+wall time on 2 workers at load averages of 2.5-9 and 6-8 on 2 cores (each
+worker got about a third of a core); ``--seeds-b 3``
+halves (b).
 
-Usage: ``python benchmarks/narx_spiral.py [--seeds 3] [--workers 2]
-[--part a|b|ab] [--budget 3000] [--trainings 12]``
+Usage: ``python benchmarks/narx_spiral.py [--seeds 10] [--seeds-b 6]
+[--workers 2] [--part a|b|ab] [--budget 3000] [--trainings 12]``
 """
 
 from __future__ import annotations
@@ -321,7 +326,8 @@ def table_b(rows) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--seeds", type=int, default=10, help="seeds of (a)")
+    ap.add_argument("--seeds-b", type=int, default=6, help="seeds of (b)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--part", default="ab")
     ap.add_argument("--records", default=",".join(RECORDS))
@@ -348,9 +354,9 @@ def main() -> None:
         table_a(rows)
     if "b" in args.part:
         t0 = time.perf_counter()
-        jobs = [(n, s, args.trainings) for n in names for s in range(args.seeds)]
+        jobs = [(n, s, args.trainings) for n in names for s in range(args.seeds_b)]
         rows = run(run_b, jobs)
-        print(f"\n# (b): {args.seeds} seeds, {time.perf_counter() - t0:.0f} s wall")
+        print(f"\n# (b): {args.seeds_b} seeds, {time.perf_counter() - t0:.0f} s wall")
         table_b(rows)
     print(
         f"\n# total {time.perf_counter() - t_all:.0f} s wall, "

@@ -13,6 +13,12 @@ best point is then trained again on the whole estimation record.
 Points that round to a structure already trained are not trained again:
 ``budget`` counts trainings, not the search's evaluations, so the search
 is compared with a grid of the same number of trainings.
+
+Measured (docs/results/narx.md, ``benchmarks/narx_spiral.py``): on the
+nonlinear rig the search gains 14-16 points of validation fit over the
+default ``NARX(4, 4, 1)``, mostly by choosing more lags, but a random search
+of the same budget does as well: with a dozen trainings in three
+coordinates the spiral rule has little to learn from.
 """
 
 from __future__ import annotations
