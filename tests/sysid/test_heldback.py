@@ -46,6 +46,21 @@ def test_the_lowest_cost_stays_unless_another_minimum_is_clearly_better_held_bac
     assert sel.to_dict()["note"] == sel.sentence()
 
 
+def test_a_refit_cut_short_may_not_override_the_lowest_cost_when_told():
+    lowest, clearly = _c("search", 1.0, 2.0), _c("ls", 0.9, 2.5)
+    clearly.capped = True
+    # Trusted (the default, as stop="converged" chooses): the held-back
+    # error decides; untrusted (stop="work"): the capped score cannot.
+    assert heldback.select([lowest, clearly]) == ("ls", "search")
+    assert heldback.select([lowest, clearly], trust_capped=False) == (
+        "search",
+        "search",
+    )
+    # The lowest cost's own refit being capped does not matter.
+    lowest.capped, clearly.capped = True, False
+    assert heldback.select([lowest, clearly], trust_capped=False) == ("ls", "search")
+
+
 def test_one_minimum_found_three_times_is_one_candidate():
     data = _record()
     cost = PaperCost(ARX(2, 2, 1), data)

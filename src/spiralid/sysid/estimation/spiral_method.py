@@ -355,11 +355,13 @@ def _choose_held_back(
         for name, theta in minima.items()
     ]
     candidates = heldback.distinct(found, problem.cost)
+    paced = False
     if len(candidates) > 1:
         part = problem.restricted(problem.data[:start])
         nfev = heldback.refit_nfev(problem.arx.n_params)
         work = settings["work"]
-        if work is not None and result.get("oe_work") is not None:
+        paced = work is not None and result.get("oe_work") is not None
+        if paced:
             # The refits share a budget tied to output error's work.
             share = work.cap(work.refit, result.oe_work) // len(candidates)
             nfev = min(nfev, max(share, work.least))
@@ -371,7 +373,10 @@ def _choose_held_back(
             refit = _polish(part, {c.name: c.theta}, part.predictor, part.cost, nfev)
             c.theta_part = refit.x
             c.held_rms = heldback.held_back_rms(refit.x, problem.cost, start)
-    chosen, lowest = heldback.select(candidates)
+            c.capped = refit.status == 1
+    # A refit cut short by output error's pace stays near the whole-record
+    # fit, which saw the held-back end: its score is too kind to decide.
+    chosen, lowest = heldback.select(candidates, trust_capped=not paced)
     selection = heldback.Selection(
         holdback, problem.data.n - start, candidates, chosen, lowest
     )
