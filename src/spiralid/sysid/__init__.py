@@ -9,6 +9,7 @@ from .data import IOData as IOData
 from .estimation.cost import PaperCost as PaperCost
 from .estimation.estimators import METHODS as METHODS
 from .estimation.identify import identify as identify
+from .estimation.narx_choice import choose_narx as choose_narx
 from .estimation.outputerror import steiglitz_mcbride as steiglitz_mcbride
 from .estimation.parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
 from .estimation.parametrizations import default_bounds as default_bounds
@@ -85,6 +86,7 @@ __all__ = [
     "arx_least_squares",
     "billings_voon",
     "choose",
+    "choose_narx",
     "choose_order",
     "default_bounds",
     "find_resonances",
