@@ -47,8 +47,8 @@ single-output fits). The range of counts a calibrated 95 % interval gives
 (the binomial's 2.5-97.5 % quantiles) is printed once. Asserts nothing.
 
 ``--realisations N`` is the calibration run: N noise realisations (seeds
-0..N-1) of the shared spiral fit alone (unless ``--methods`` or
-``--singles`` say otherwise).
+0..N-1, or from ``--first-seed``) of the shared spiral fit alone (unless
+``--methods`` or ``--singles`` say otherwise).
 
 Run: ``python benchmarks/shared_modes.py [--seeds 20] [--workers 2]
 [--outputs end_acceleration,tip_deflection] [--order 12,12,1]
@@ -172,6 +172,12 @@ def main(argv=None) -> None:
         default=None,
         help="the calibration run: this many seeds, the shared spiral fit only",
     )
+    ap.add_argument(
+        "--first-seed",
+        type=int,
+        default=0,
+        help="the first noise seed (a second calibration run takes others)",
+    )
     ap.add_argument("--workers", type=int, default=1)
     ap.add_argument("--outputs", default="end_acceleration,tip_deflection")
     ap.add_argument("--order", default="12,12,1")
@@ -209,7 +215,7 @@ def main(argv=None) -> None:
     singles = (not calibration) if args.singles is None else args.singles
     tasks = [
         (s, outputs, order, integrators, args.tip_noise, methods, singles)
-        for s in range(seeds)
+        for s in range(args.first_seed, args.first_seed + seeds)
     ]
     t0 = time.perf_counter()
     rig = FlexibleManipulator()
