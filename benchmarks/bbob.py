@@ -27,6 +27,12 @@ Full size (dimensions 2, 5, 10, 20; 24 functions; 15 instances; budget
 
     python benchmarks/bbob.py --output bbob-output --jobs 2
 
+D = 40 for the three leading methods, instances 1-3 (21 minutes on one
+loaded core)::
+
+    python benchmarks/bbob.py --dims 40 --instances 1 2 3 \
+        --methods learned-metric+restarts cma bipop-cma --output bbob-40
+
 Reduced size, as the test suite runs it::
 
     python benchmarks/bbob.py --dims 2 --functions 1 8 15 --instances 1 \\
