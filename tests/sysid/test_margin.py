@@ -138,8 +138,11 @@ def test_identify_keeps_every_pole_inside_the_record_length(method, seed):
     fit = identify(data, ARX(3, 3, 1), method=method, **kw)
     assert fit.max_pole_radius <= np.exp(-data.ts / (data.n * data.ts))
     # Without the margin, choosing by the cost alone (the held-back choice of
-    # "spiral" may itself avoid the drift's pole) fits the drift.
-    alone = {"holdback": None} if method == "spiral" else {}
+    # "spiral" may itself avoid the drift's pole) fits the drift. The whole
+    # budget finds the cost's lowest minimum: the default's search, paced by
+    # output error's work, may stop short of it (seed 5: 2.505 against the
+    # drift's 2.435, both below output error's 2.525).
+    alone = {"holdback": None, "stop": "budget"} if method == "spiral" else {}
     free = identify(
         data,
         ARX(3, 3, 1),
