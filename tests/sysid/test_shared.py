@@ -212,6 +212,9 @@ def test_the_stabilisation_figure_draws_every_mode():
     drawn = sum(len(line.get_xdata()) for line in ax.lines)
     assert drawn == diagram.frequency.size
     assert ax.get_xlabel() == "frequency (Hz)" and ax.get_title()
+    # The markers and their legend are drawn above the spectra's twin axes.
+    spectra = fig.axes[1]
+    assert ax.get_zorder() > spectra.get_zorder() and not ax.patch.get_visible()
 
 
 def test_the_search_never_ends_above_output_error():

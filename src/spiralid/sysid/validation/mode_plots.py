@@ -68,6 +68,10 @@ def plot_stabilisation(
             spec_ax.plot(spectrum.f, level - level.max(), lw=0.8, alpha=0.5,
                          label=f"PSD of {name}")  # fmt: skip
         spec_ax.set_ylabel("PSD (dB, each output's peak at 0)")
+        # The twin is drawn over its host: put the spectra behind the mode
+        # markers and their legend instead.
+        ax.set_zorder(spec_ax.get_zorder() + 1)
+        ax.patch.set_visible(False)
     ax.legend(loc="upper left", fontsize="small")
     ax.set_xlim(left=0.0)
     return fig
