@@ -174,16 +174,13 @@ def _figures(v) -> dict:
     its name, for several outputs)."""
     if not hasattr(v, "outputs"):
         return v.plot()
+    from spiralid.report.shared_output import output_stem
+
     return {
-        f"{_stem(name)}_{kind}": fig
+        f"{output_stem(name)}_{kind}": fig
         for name, one in v.outputs.items()
         for kind, fig in one.plot().items()
     }
-
-
-def _stem(name: str) -> str:
-    """An output's name as a file-name part (letters, digits, _ and -)."""
-    return "".join(c if c.isalnum() or c in "_-" else "_" for c in name) or "output"
 
 
 def run(args, argv: list[str]) -> int:

@@ -30,6 +30,7 @@ __all__ = [
     "fit_percents_table",
     "fits_table",
     "modes_table",
+    "output_stem",
     "shared_report",
     "write_shared_report",
 ]
@@ -268,14 +269,25 @@ def _figures(v_val, diagram, data) -> dict[str, tuple[str, bytes, str]]:
         )
     for name, v in v_val.outputs.items():
         for kind, fig in v.plot().items():
-            stem = f"validation_{_stem(name)}_{kind}"
+            stem = f"validation_{output_stem(name)}_{kind}"
             title = f"{name}: {kind.replace('_', '-')}"
             out[stem] = (title, png(fig), _FIGURE_CAPTIONS.get(kind, ""))
     return out
 
 
-def _stem(name: str) -> str:
-    """An output's name as a file-name part (letters, digits, _ and -)."""
+def output_stem(name: str) -> str:
+    """An output's name as a file-name part (letters, digits, _ and -): how
+    its figures are named, by ``identify --output`` and ``validate``.
+
+    Parameters
+    ----------
+    name : str
+        The output's name.
+
+    Returns
+    -------
+    str
+    """
     kept = "".join(c if c.isalnum() or c in "_-" else "_" for c in name)
     return kept or "output"
 
@@ -360,7 +372,7 @@ def shared_report(
         )
     for name in v_val.outputs:
         parts.append(f"<h2>Validation of {e(name)}</h2>")
-        prefix = f"validation_{_stem(name)}_"
+        prefix = f"validation_{output_stem(name)}_"
         for stem, (title, data_png, caption) in figures.items():
             if stem.startswith(prefix):
                 parts.append(figure(title, data_png, caption))
