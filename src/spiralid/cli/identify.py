@@ -191,17 +191,20 @@ def _run_narx(args) -> int:
 def _chosen_by_fit(args, est, val, options, progress):
     """--by-fit POINTS: every candidate structure fitted on the estimation
     part, and the smallest whose validation fit is within POINTS of the best
-    (choose_order, by number of parameters); the model and the lines that
+    (choose_order's rule, by number of parameters); the model and the lines that
     say how it was chosen."""
-    from spiralid.sysid import choose_order, fits_by_order, identify
+    from spiralid.sysid import fits_by_order, identify
+    from spiralid.sysid.validation.selection import lowest_within
 
     structures = _narx_structures(args)
     models = []
     for k, st in enumerate(structures, 1):
         progress.phase("estimation", f"candidate {k}/{len(structures)}: {st}")
         models.append(identify(est, st, method=args.method, **options))
+    # Each candidate validated once: the table below and the choice read
+    # the same fits.
     fits = fits_by_order(models, val, warmup=est)
-    best = models[choose_order(models, val, warmup=est, tolerance=args.by_fit)]
+    best = models[lowest_within(fits, args.by_fit)]
     lines = [
         f"\nchosen by validation fit (--by-fit {args.by_fit:g}): the smallest "
         f"candidate within {args.by_fit:g} points of the best; its validation fit "

@@ -39,7 +39,7 @@ from ..estimation.pareto import ParetoIdentification
 from ..models.fitted import FittedModel
 from .validate import validate
 
-__all__ = ["choose", "choose_order", "fits_by_order", "knee_point"]
+__all__ = ["choose", "choose_order", "fits_by_order", "knee_point", "lowest_within"]
 
 
 def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int:
@@ -187,6 +187,26 @@ def choose_order(front, data, *, warmup=None, tolerance: float = 1.0) -> int:
     True
     """
     tolerance = nonneg(tolerance, "tolerance")
-    fits = fits_by_order(front, data, warmup=warmup)
+    return lowest_within(fits_by_order(front, data, warmup=warmup), tolerance)
+
+
+def lowest_within(fits: dict[int, tuple[int, float]], tolerance: float) -> int:
+    """:func:`choose_order`'s rule on fits already computed: the index of
+    the lowest order whose fit is within `tolerance` points of the best.
+
+    Parameters
+    ----------
+    fits : dict
+        :func:`fits_by_order`'s ``{order: (index, fit %)}``, by increasing
+        order.
+    tolerance : float
+        Percentage points of fit a lower order may lose to the best.
+
+    Returns
+    -------
+    int
+        The chosen model's index.
+    """
+    tolerance = nonneg(tolerance, "tolerance")
     top = np.nanmax([fit for _, fit in fits.values()])
     return next(i for i, fit in fits.values() if fit >= top - tolerance)
