@@ -1,7 +1,8 @@
-"""The fit %, the RMSE, and the checks both validations share (the record's
-signals, the gain of eq. (2), a free run that ran away): the linear
-:func:`~.validate.validate` and the nonlinear :func:`~.nonlinear.validate_narx`
-import them from here, so neither imports the other's module."""
+"""The fit %, the RMSE, and what every structure's validation shares (the
+record's signals, the gain of eq. (2), the free run and one-step
+prediction, a free run that ran away, the run from measured samples):
+:func:`~.validate.validate` computes them once for any model, and the
+nonlinear part (:mod:`.nonlinear`) reuses them without importing it."""
 
 from __future__ import annotations
 
@@ -12,9 +13,10 @@ import numpy as np
 from spiralid._checks import positive
 
 from ..estimation.cost import auto_gain
+from ..estimation.outputerror import error_functions
 from ..signals import check_pair
 
-__all__ = ["fit_percent", "rmse"]
+__all__ = ["fit_from_measured", "fit_percent", "rmse"]
 
 # Below this fit % (an error a million percent of the output's spread) the
 # digits only tell how long an unstable run grew: a table says it diverged.
@@ -175,3 +177,33 @@ def responses(model, data, warmup):
         y_sim = np.asarray(model.simulate(whole.u), dtype=float).ravel()[start:]
         y_pred = np.asarray(model.predict(whole), dtype=float).ravel()[start:]
     return y_sim, y_pred, start
+
+
+def fit_from_measured(model, data) -> float:
+    """The free run's fit started from the record's first ``max_lag``
+    measured samples (its initial state), on the samples after them; NaN
+    for a model that cannot start from measured samples, ``-inf`` for a run
+    that diverged.
+
+    An ARX model runs through the output-error residual that
+    ``PaperCost(initial="measured")`` sums; any other model through its own
+    ``simulate(u, y0=y)``, which returns the measured samples unchanged and
+    continues from them.
+    """
+    y = np.asarray(data.y, dtype=float).ravel()
+    arx = getattr(model, "arx", None)
+    structure = getattr(model, "structure", None)
+    with np.errstate(all="ignore"):
+        if arx is not None:
+            residual, _ = error_functions(arx, data, "simulation", "measured")
+            e = residual(np.asarray(model.theta, dtype=float))
+            t0 = arx.max_lag
+        elif hasattr(structure, "max_lag"):
+            t0 = structure.max_lag
+            y_run = np.asarray(model.simulate(data.u, y0=y), dtype=float).ravel()
+            e = y_run[t0:] - y[t0:]
+        else:
+            return float("nan")
+        tail = y[t0:]
+        fit = 100.0 * (1.0 - np.linalg.norm(e) / np.linalg.norm(tail - tail.mean()))
+    return float(fit) if np.isfinite(fit) else -np.inf

@@ -1,7 +1,7 @@
 """Model validation the way the paper and MATLAB's toolbox judge a model.
 
-:func:`validate` applies the measured input of a validation record to an
-identified model and reports, in one :class:`Validation`:
+:func:`validate` applies the measured input of a validation record to any
+fitted model, linear or not, and reports, in one :class:`Validation`:
 
 * time domain: fit % as MATLAB's ``compare`` defines it, RMSE, the paper's
   cost (eq. (2)-(3)) and the range of the error (the paper's Table-2), for
@@ -10,11 +10,16 @@ identified model and reports, in one :class:`Validation`:
 * residual analysis: whiteness of the residual and its independence from the
   input, with 95 % and 99 % bands (:mod:`spiralid.sysid.validation.correlation`);
 * frequency domain: Welch spectra of measured and modelled output and their
-  resonance peaks, and the model's own modes from its poles
-  (:mod:`spiralid.sysid.spectra`; the paper's Figure-7c);
-* structure: stability from the poles, and controllability / observability of
-  the model's state-space realisation (the paper's MATLAB ``ctrb``/``obsv``
-  check after eq. (10)).
+  resonance peaks (:mod:`spiralid.sysid.spectra`; the paper's Figure-7c);
+* for a linear model (:mod:`.linear`): the model's own modes from its poles,
+  stability from the poles, and controllability / observability of its
+  state-space realisation (the paper's MATLAB ``ctrb``/``obsv`` check after
+  eq. (10));
+* for a nonlinear model (:mod:`.nonlinear`): the Billings-Voon higher-order
+  correlation tests and what the network added over its linear start.
+
+The shared part is computed once, by one code path, for every structure;
+then the linear or the nonlinear extras.
 """
 
 from __future__ import annotations
@@ -24,15 +29,8 @@ import numpy as np
 from spiralid._checks import refuse_options
 
 from ..estimation.cost import cost_of_errors
-from ..estimation.outputerror import error_functions
-from ..models.modes import ModeTable
-from ..models.polynomials import (
-    format_pole_radius,
-    is_stable_polynomial,
-    max_pole_radius,
-)
 from ..signals import check_pair
-from ..spectra import find_resonances, modes_from_poles, psd
+from ..spectra import find_resonances, psd
 from .correlation import (
     check_lags,
     independence_test,
@@ -43,13 +41,15 @@ from .fit import (
     _gain,
     _signals_of,
     check_sample_time,
+    fit_from_measured,
     fit_percent,
     responses,
     rmse,
 )
-from .linear import Validation
-from .nonlinear import validate_narx
+from .linear import absent, linear_checks, runaway_note
+from .nonlinear import nonlinear_checks
 from .realization import Realization, realization_tests
+from .result import Validation
 
 __all__ = [
     "Realization",
@@ -61,11 +61,6 @@ __all__ = [
 ]
 
 _RESIDUALS = ("one-step", "simulation")
-
-
-def _attr(obj, name):
-    val = getattr(obj, name)
-    return val() if callable(val) else val
 
 
 def validate(
@@ -87,13 +82,16 @@ def validate(
     Parameters
     ----------
     model : IdentifiedModel or NARXModel
-        From :func:`~spiralid.sysid.identify`. A NARX model gets a
-        :class:`~spiralid.sysid.validation.nonlinear.NARXValidation` (fits
-        and the Billings-Voon tests); an ARX model (anything with ``theta``,
-        ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
-        ``predict(data)``, ``poles``, ``zeros``). For a NARX model
-        `n_peaks`, `nperseg` and `max_damping` (spectra and modes) do not
-        apply: one of them other than its default is refused in one line.
+        From :func:`~spiralid.sysid.identify` or
+        :func:`~spiralid.sysid.load_model`: an ARX model (anything with
+        ``theta``, ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
+        ``predict(data)``, ``poles``, ``zeros``) or a nonlinear one (its
+        ``structure.is_linear`` false: NARX, polynomial NARX). Both get the
+        same :class:`Validation`; a linear model's has its poles, modes and
+        realisation tests, a nonlinear model's its ``nonlinear`` part (the
+        Billings-Voon tests, the network's gain over its linear start).
+        `max_damping` (modes from poles) does not apply to a nonlinear
+        model: a value other than its default is refused in one line.
     data : IOData
         The validation record, usually the last third (the paper's split).
         The model is run from zero initial conditions over it.
@@ -138,6 +136,7 @@ def validate(
     Returns
     -------
     Validation
+        One type for every structure (see :class:`Validation`).
 
     Raises
     ------
@@ -187,65 +186,51 @@ def validate(
     hardly decays. Pass ``warmup`` to validate such a model from the state
     it has reached.
     """
+    linear = bool(getattr(model, "is_linear", True))
+    if not linear:
+        # Modes are read from poles, which a nonlinear model does not have:
+        # the option is refused rather than ignored.
+        refuse_options(
+            dict(max_damping=max_damping),
+            (
+                "lags", "n_peaks", "levels", "residuals", "nperseg", "gain",
+                "warmup", "label",
+            ),
+            "validate for a nonlinear model",
+            defaults=dict(max_damping=0.3),
+        )  # fmt: skip
     if isinstance(residuals, str) and residuals == "auto":
         residuals = _fitted_error(model)
-    if not getattr(model, "is_linear", True):
-        # Poles, modes and realisations mean nothing for a nonlinear model:
-        # its own report (fits and the Billings-Voon tests), and the options
-        # of spectra and modes are refused rather than ignored.
-        refuse_options(
-            dict(n_peaks=n_peaks, nperseg=nperseg, max_damping=max_damping),
-            ("lags", "levels", "residuals", "gain", "warmup", "label"),
-            "validate for a NARX model",
-            defaults=dict(n_peaks=3, nperseg=None, max_damping=0.3),
-        )
+    u, y, ts, lags, predictor = _valid_inputs(model, data, lags, residuals, linear)
+    extras = linear_checks(model, ts, max_damping) if linear else absent()
 
-        return validate_narx(
-            model,
-            data,
-            lags=lags,
-            levels=levels,
-            residuals=residuals,
-            gain=gain,
-            warmup=warmup,
-            label=label,
-        )
-    u, y, ts, lags, predictor = _valid_inputs(model, data, lags, residuals)
+    # The shared part, the same for every structure.
     n = y.size
     w = _gain(gain, model, y)
     penalty = float(getattr(model, "penalty", 1e6))
-    poles = np.asarray(_attr(model, "poles"), dtype=complex)
-    zeros = np.asarray(_attr(model, "zeros"), dtype=complex)
-    # The one stability verdict (Schur-Cohn on the coefficients, see
-    # spiralid.sysid.models.polynomials), not |np.roots| < 1, which misjudges
-    # clustered poles near the circle.
-    # Without the known integrators' poles (z = 1), which the model has by
-    # design (`identify(integrator=...)`).
-    denominator = np.asarray(
-        getattr(model, "free_denominator", model.theta[: model.arx.na]), dtype=float
-    )
-    stable = bool(is_stable_polynomial(denominator))
-    max_radius = float(max_pole_radius(denominator))
-    y_sim, y_pred, start = responses(model, data, warmup)
-    y_sim, diverged = _bounded_run(
-        y_sim, y, f" (max |pole| = {format_pole_radius(max_radius)})"
-    )
+    with np.errstate(all="ignore"):  # a diverging free run is reported below
+        y_sim, y_pred, start = responses(model, data, warmup)
+    y_sim, diverged = _bounded_run(y_sim, y, runaway_note(extras))
     y, y_pred = check_pair(y, y_pred, "data.y", "model.predict(data)")
     e_sim, e_pred = y - y_sim, y - y_pred
 
     # Eq. (2)-(3) on the very errors the fit and error range are computed
-    # from, so the columns of a Table-2 row agree with one another.
+    # from, so the columns of a Table-2 row agree with one another. A
+    # nonlinear model has no poles to penalise: its free run is its verdict.
     e_cost = e_sim if predictor == "simulation" else e_pred
+    stable = extras["stable"] is not False
     cost = cost_of_errors(e_cost, w, stable, penalty)
 
     e_test = e_pred if residuals == "one-step" else e_sim
     fs = 1.0 / ts
     spec_y = psd(y, fs, nperseg=nperseg)
     spec_m = psd(y_sim, fs, nperseg=nperseg)
-    # An IdentifiedModel's own polynomials: those of its effective order
-    # when the estimation removed a pole-zero pair.
-    num, den = getattr(model, "polynomials", None) or model.arx.polynomials(model.theta)
     label = label if label is not None else str(getattr(model, "method", "") or "")
+
+    nonlinear = None
+    if not linear:
+        whole = u if warmup is None else np.r_[_signals_of(warmup, "warmup")[0], u]
+        nonlinear = nonlinear_checks(model, u, e_test, y, whole, start, lags, levels)
 
     return Validation(
         label=label,
@@ -266,48 +251,21 @@ def validate(
         psd_model=spec_m,
         peaks_measured=find_resonances(spec_y, n_peaks),
         peaks_model=find_resonances(spec_m, n_peaks),
-        modes=modes_from_poles(poles, ts, max_damping=max_damping),
-        stable=bool(stable),
-        max_pole_radius=max_radius,
-        realization=realization_tests(num, den),
-        poles=poles,
-        zeros=zeros,
         t=(np.arange(n) + start) * ts,
         u=u,
         y=y,
         y_sim=y_sim,
         y_pred=y_pred,
-        integrator=int(getattr(model, "integrator", 0)),
         output_name=str(getattr(data, "output_name", "output")),
         output_unit=str(getattr(data, "output_unit", "")),
         initial="rest" if warmup is None else "warmup",
-        fit_percent_measured=_fit_from_measured(model, data),
+        fit_percent_measured=fit_from_measured(model, data),
         diverged=diverged,
         output_error=_fitted_error(model) == "simulation",
-        mode_table=_mode_table(model),
-        reduction=getattr(model, "reduction", None),
         choice=(getattr(model, "selection", None) or {}).get("note"),
+        nonlinear=nonlinear,
+        **extras,
     )
-
-
-def _fit_from_measured(model, data) -> float:
-    """The free run's fit from the record's first measured samples (its
-    initial state), on the samples after them."""
-    arx = getattr(model, "arx", None)
-    if arx is None or not hasattr(data, "u"):
-        return float("nan")
-    residual, _ = error_functions(arx, data, "simulation", "measured")
-    with np.errstate(all="ignore"):
-        e = residual(np.asarray(model.theta, dtype=float))
-        y = np.asarray(data.y, dtype=float)[arx.max_lag :]
-        fit = 100.0 * (1.0 - np.linalg.norm(e) / np.linalg.norm(y - y.mean()))
-    return float(fit) if np.isfinite(fit) else -np.inf
-
-
-def _mode_table(model) -> ModeTable | None:
-    if getattr(model, "covariance", None) is None:
-        return None
-    return model.modes
 
 
 def _fitted_error(model) -> str:
@@ -320,25 +278,27 @@ def _fitted_error(model) -> str:
     return (method.minimises if method is not None else None) or predictor
 
 
-def _valid_inputs(model, data, lags, residuals):
+def _valid_inputs(model, data, lags, residuals, linear: bool):
     """`validate`'s argument checks: the signals, ``lags`` and the predictor,
     before any simulation or spectrum is computed."""
-    if not all(hasattr(model, k) for k in ("simulate", "predict", "arx", "theta")):
+    needs = ("simulate", "predict", "arx", "theta") if linear else ("simulate",
+             "predict", "structure")  # fmt: skip
+    if not all(hasattr(model, k) for k in needs):
         raise ValueError(
-            "`model` must be an IdentifiedModel (from identify() or "
-            f"IdentifiedModel.from_dict); got {type(model).__name__}"
+            "`model` must be an IdentifiedModel or a NARXModel (from identify() "
+            f"or load_model); got {type(model).__name__}"
         )
     u, y, ts = _signals_of(data)
     # Checked here too (the correlation tests would) so a bad `lags` fails
     # before the simulation and spectra are computed.
     lags = check_lags(lags, y.size)
-    arx = model.arx
-    if arx.max_lag >= y.size:
+    structure = model.arx if linear else model.structure
+    if structure.max_lag >= y.size:
         # Before any signal of that length is built (a tampered file's nk
         # could ask for terabytes).
         raise ValueError(
-            f"`model` reaches {arx.max_lag} samples into the past ({arx}), more "
-            f"than `data`'s N = {y.size} samples hold"
+            f"`model` reaches {structure.max_lag} samples into the past "
+            f"({structure}), more than `data`'s N = {y.size} samples hold"
         )
     if residuals not in _RESIDUALS:
         raise ValueError(
