@@ -49,7 +49,7 @@ from .correlation import (
     whiteness_test,
 )
 
-__all__ = ["BILLINGS_VOON", "BillingsVoon", "billings_voon"]
+__all__ = ["BILLINGS_VOON", "BillingsVoon", "billings_voon", "correlation_dict"]
 
 # The one list of the tests: name -> what the figure and tables call it.
 BILLINGS_VOON = {
@@ -130,7 +130,7 @@ class BillingsVoon:
             "level": float(self.level),
             "passed": {k: bool(v) for k, v in self.passed.items()},
             "not_applicable": list(self.not_applicable),
-            "tests": {k: t.to_dict() for k, t in self.tests.items()},
+            "tests": {k: correlation_dict(t) for k, t in self.tests.items()},
         }
 
     def plot(self):
@@ -158,6 +158,22 @@ class BillingsVoon:
         )
         fig.tight_layout()
         return fig
+
+
+def correlation_dict(test: CorrelationTest) -> dict:
+    """A test's JSON-safe dictionary with ``"applicable"``: a test with no
+    degrees of freedom has nothing to test, so its verdicts are null rather
+    than the ``true`` its statistic of zero would give.
+
+    Parameters
+    ----------
+    test : CorrelationTest
+    """
+    out = test.to_dict()
+    out["applicable"] = bool(test.dof > 0)
+    if not out["applicable"]:
+        out["passed"] = dict.fromkeys(out["passed"])
+    return out
 
 
 def _product_test(e, u, lags, levels) -> CorrelationTest:

@@ -15,6 +15,7 @@ from ..models.polynomials import format_pole_radius
 from ..spectra import PSD, Modes, Peaks
 from .correlation import CorrelationTest
 from .fit import _format_fit
+from .higher_order import correlation_dict
 from .nonlinear import NonlinearChecks
 from .realization import Realization
 
@@ -389,8 +390,8 @@ class Validation:
             "error_range": [float(v) for v in self.error_range],
             "error_range_one_step": [float(v) for v in self.error_range_one_step],
             "residuals": self.residuals,
-            "whiteness": self.whiteness.to_dict(),
-            "independence": self.independence.to_dict(),
+            "whiteness": correlation_dict(self.whiteness),
+            "independence": correlation_dict(self.independence),
             "psd_resolution_hz": float(self.psd_measured.resolution),
             "psd_nperseg": int(self.psd_measured.nperseg),
             "peaks_measured_hz": [float(v) for v in self.peaks_measured.frequency],
