@@ -44,7 +44,9 @@ from .spectra import psd as psd
 from .validation.correlation import CorrelationTest as CorrelationTest
 from .validation.correlation import independence_test as independence_test
 from .validation.correlation import whiteness_test as whiteness_test
+from .validation.higher_order import BillingsVoon as BillingsVoon
 from .validation.higher_order import billings_voon as billings_voon
+from .validation.nonlinear import NonlinearChecks as NonlinearChecks
 from .validation.outputs import OutputsValidation as OutputsValidation
 from .validation.outputs import joint_fit as joint_fit
 from .validation.outputs import validate_outputs as validate_outputs
@@ -65,6 +67,7 @@ __all__ = [
     "METHODS",
     "NARX",
     "PARAMETRIZATIONS",
+    "BillingsVoon",
     "CorrelationTest",
     "EstimatorResult",
     "FittedModel",
@@ -73,6 +76,7 @@ __all__ = [
     "ModalParametrization",
     "ModeTable",
     "NARXModel",
+    "NonlinearChecks",
     "OutputsValidation",
     "PaperCost",
     "ParetoIdentification",
