@@ -21,6 +21,7 @@ from spiralid.sysid import (
     load_model,
     validate,
 )
+from spiralid.sysid.models.fitted import Provenance
 from spiralid.sysid.validation.validate import Validation
 
 
@@ -93,6 +94,51 @@ def test_load_model_reads_a_shared_denominator_model():
     old = model.to_dict()
     old["kind"] = old.pop("model")
     assert isinstance(load_model(old), SharedDenominatorModel)
+
+
+def _shared(**provenance):
+    return SharedDenominatorModel(
+        a=[-1.5, 0.7], b=[[1.0, 0.5], [0.2, 0.1]], arx=ARX(2, 2, 1), ts=0.01,
+        output_names=("a", "b"), **provenance,
+    )  # fmt: skip
+
+
+def test_a_shared_denominator_model_writes_the_same_provenance():
+    """The record-wide provenance of every fitted model, in the same keys;
+    the estimator's wall time is not in the result summary, and the wall
+    times leave the file on request, as a one-output model's."""
+    model = _shared(
+        method="oe", fraction=0.5, timings={"total": 1.5},
+        result={"nfev": 12, "message": "done", "elapsed": 1.5},
+    )  # fmt: skip
+    d = json.loads(json.dumps(model.to_dict()))
+    keys = [f.name for f in dataclasses.fields(Provenance)]
+    assert not [k for k in keys if k not in d]
+    assert d["result"] == {"nfev": 12, "message": "done"}
+    assert d["fraction"] == 0.5 and d["timings"] == {"total": 1.5}
+    assert d["predictor"] == "simulation" and d["gain"] is None
+    assert "timings" not in model.to_dict(timings=False)
+    back = load_model(d)
+    for name in keys:
+        if name != "result":
+            expected = pytest.approx(getattr(model, name), nan_ok=True)
+            assert getattr(back, name) == expected, name
+
+
+def test_a_shared_denominator_file_written_before_the_shared_provenance_loads():
+    """A file as the several-output model wrote it before: only its method,
+    cost (null when NaN), input name, unit and offset of the provenance."""
+    d = _shared(method="spiral", u_offset=0.25).to_dict()
+    for key in ("predictor", "initial", "gain", "penalty", "history", "timings",
+                "fraction", "result"):  # fmt: skip
+        del d[key]
+    d["cost"] = None
+    back = load_model(json.loads(json.dumps(d)))
+    assert isinstance(back, SharedDenominatorModel)
+    assert back.method == "spiral" and back.u_offset == 0.25
+    assert np.isnan(back.cost) and np.isnan(back.gain)
+    assert (back.predictor, back.initial, back.penalty) == ("simulation", "rest", 0.0)
+    assert back.fraction is None and back.timings == {}
 
 
 @pytest.mark.parametrize(

@@ -16,12 +16,13 @@ barely sees it, the others do.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import KW_ONLY, dataclass, field
 
 import numpy as np
 from scipy import signal
 
 from .arx import ARX
+from .fitted import Provenance
 from .identified import IdentifiedModel, python_control
 from .modes import ModeTable, interval_format, mode_table
 from .polynomials import is_stable_polynomial, max_pole_radius, with_integrator
@@ -88,9 +89,19 @@ def _plain(value) -> float | None:
     return float(value) if np.isfinite(value) else None
 
 
+# Provenance fields this file writes as null for NaN.
+_NULLABLE = ("cost", "gain")
+
+
 @dataclass
-class SharedDenominatorModel:
+class SharedDenominatorModel(Provenance):
     """A single-input multi-output model with one denominator.
+
+    Its provenance (method, cost, result, timings, input name and offset,
+    fraction...) is the record-wide :class:`~.fitted.Provenance` every
+    fitted model holds, written to and read from its file alike; the
+    output's name, unit and offset of a one-output
+    :class:`~.fitted.FittedModel` are here one per output.
 
     Parameters
     ----------
@@ -128,7 +139,23 @@ class SharedDenominatorModel:
         Each output's known integrators, poles at ``z = 1`` outside the
         shared ``A``: output ``i`` is ``B_i / (A (1 - z^-1)^k_i)``.
     result : dict
-        What the estimator reports (budget, messages, timings).
+        What the estimator reports (budget, messages, its wall time
+        ``elapsed``); the model file keeps its scalars but ``elapsed``.
+    predictor, initial : str
+        ``"simulation"`` and ``"rest"``: the joint cost is the outputs'
+        free-run error from rest.
+    gain : float
+        NaN: the joint cost weights each output by its noise, not by one
+        gain of eq. (2).
+    penalty : float
+        0: an unstable estimate has no cost (NaN), not a penalised one.
+    history : ndarray or None
+        Best cost after each iteration of a search (None: not kept).
+    timings : dict
+        Wall times in seconds, written to the file unless
+        ``to_dict(timings=False)``.
+    fraction : float or None
+        The share of the record that estimated the model, when known.
     """
 
     a: np.ndarray
@@ -137,20 +164,20 @@ class SharedDenominatorModel:
     ts: float
     output_names: tuple[str, ...]
     output_units: tuple[str, ...] = ()
-    input_name: str = "u"
-    input_unit: str = ""
-    u_offset: float = 0.0
     y_offsets: tuple[float, ...] = ()
-    method: str = "spiral"
-    cost: float = float("nan")
     weights: np.ndarray | None = None
     costs: np.ndarray | None = None
     covariance: np.ndarray | None = None
     covariance_factor: np.ndarray | None = None
     integrators: tuple[int, ...] = ()
+    _: KW_ONLY
+    # The provenance's fields whose defaults differ for several outputs.
+    method: str = "spiral"
+    penalty: float = 0.0
     result: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        self._check_provenance()
         self.a = np.asarray(self.a, dtype=float).ravel()
         self.b = np.atleast_2d(np.asarray(self.b, dtype=float))
         p = self.b.shape[0]
@@ -274,9 +301,17 @@ class SharedDenominatorModel:
         a, b, c, d = signal.tf2ss(num[:, lead:], polys[0][1])
         return control.ss(a, b, c, d, self.ts)
 
-    def to_dict(self) -> dict:
-        """A JSON-safe form (what ``model.json`` holds)."""
-        return {
+    def to_dict(self, *, timings: bool = True) -> dict:
+        """A JSON-safe form (what ``model.json`` holds).
+
+        Parameters
+        ----------
+        timings : bool, default True
+            Include the wall times (``timings``), which differ between
+            runs; False leaves them out, so that two runs with the same
+            seed write the same file.
+        """
+        out = {
             "model": "shared-denominator",
             "structure": {"na": self.arx.na, "nb": self.arx.nb, "nk": self.arx.nk},
             "ts": self.ts,
@@ -296,6 +331,14 @@ class SharedDenominatorModel:
             "integrators": list(self.integrators),
             "modes": self.modes.to_dict(),
         }
+        # The provenance every fitted model writes, after the keys this
+        # file had before it shared them (NaN as null, as for the cost).
+        prov = self._provenance_dict()
+        prov["gain"] = _plain(self.gain)
+        if not timings:
+            del prov["timings"]
+        out.update({k: v for k, v in prov.items() if k not in out})
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> SharedDenominatorModel:
@@ -312,6 +355,12 @@ class SharedDenominatorModel:
             value = d.get(key)
             return None if value is None else np.asarray(value, dtype=float)
 
+        # Files written before the provenance was shared hold only its
+        # method, cost, input name, unit and offset: the rest defaults. A
+        # null cost or gain is NaN; any method name is read (the file
+        # names what estimated it, nothing here depends on it).
+        known = {k: v for k, v in d.items() if v is not None or k not in _NULLABLE}
+        provenance = cls._provenance_fields({"method": "", **known}, None, penalty=0.0)
         return cls(
             a=np.asarray(d["a"], dtype=float),
             b=np.asarray(d["b"], dtype=float),
@@ -319,16 +368,12 @@ class SharedDenominatorModel:
             ts=float(d["ts"]),
             output_names=tuple(d["output_names"]),
             output_units=tuple(d.get("output_units") or ()),
-            input_name=str(d.get("input_name", "u")),
-            input_unit=str(d.get("input_unit", "")),
-            u_offset=float(d.get("u_offset", 0.0)),
             y_offsets=tuple(d.get("y_offsets") or ()),
-            method=str(d.get("method", "")),
-            cost=float(d["cost"]) if d.get("cost") is not None else float("nan"),
             costs=array("costs"),
             weights=array("weights"),
             covariance=array("covariance"),
             integrators=tuple(d.get("integrators") or ()),
+            **provenance,
         )
 
     def __repr__(self) -> str:
