@@ -116,6 +116,34 @@ def test_constant_residual_gives_zero_correlation_and_a_verdict():
     assert np.all(t.values == 0.0) and t.passed[0.99]
 
 
+def test_a_test_without_degrees_of_freedom_has_no_verdict():
+    """A constant input is uncorrelated with anything: nothing to test, so
+    neither pass nor fail, where the statistic of 0 would read "pass"."""
+    e = np.random.default_rng(3).standard_normal(300)
+    t = independence_test(np.full(300, 2.0), e, lags=6)
+    assert t.dof == 0 and not t.applicable
+    assert t.passed == {0.95: None, 0.99: None}
+    d = t.to_dict()
+    assert d["applicable"] is False and d["passed"] == {"0.95": None, "0.99": None}
+
+
+def test_an_ordinary_test_still_passes_or_fails_by_chi_square():
+    """Applicable tests keep their chi-square verdicts, True or False."""
+    rng = np.random.default_rng(4)
+    u = rng.standard_normal(600)
+    for e, expected in (
+        (rng.standard_normal(600), True),
+        (np.convolve(u, [0.0, 1.0, 0.5])[:600], False),
+    ):
+        t = independence_test(u, e, lags=8)
+        assert t.applicable and t.dof > 0
+        for lv in t.levels:
+            crit = stats.chi2.ppf(lv, t.dof)
+            assert t.passed[lv] is bool(t.statistic <= crit)
+        assert t.passed[0.99] is expected
+        assert t.to_dict()["applicable"] is True
+
+
 def test_to_dict_is_json_safe():
     import json
 

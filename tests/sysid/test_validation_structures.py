@@ -5,6 +5,7 @@ the ARX model it equals."""
 
 import json
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 from scipy import signal
@@ -192,14 +193,55 @@ def test_a_higher_order_test_without_degrees_of_freedom_is_not_applicable():
         assert d["tests"][name]["applicable"] is False
         assert set(d["tests"][name]["passed"].values()) == {None}
     assert d["tests"]["ee"]["applicable"] is True
+    for name in ("u2e", "u2e2"):
+        t = bv.tests[name]
+        assert not t.applicable and set(t.passed.values()) == {None}
+    # The figure: "n/a" in grey for the two, a verdict for the others.
+    figures = v.plot()
+    plt.close(figures["billings_voon"])  # drawn with pyplot, which keeps it
+    axes = figures["billings_voon"].axes
+    titles = {name: ax.title for name, ax in zip(bv.tests, axes, strict=True)}
+    for name in ("u2e", "u2e2"):
+        text = titles[name].get_text()
+        assert _verdict_words(text) == {"n/a"} and _grey(titles[name]), text
+    for name in ("ee", "ue", "e(eu)"):
+        text = titles[name].get_text()
+        want = "pass" if bv.passed[name] else "FAIL"
+        assert text.endswith(f": {want}") and not _grey(titles[name]), text
+    # Its residual figure: the input is not constant, so both tests apply
+    # and read pass or fail as before.
+    residual_axes = figures["residuals"].axes
+    for ax, t in zip(residual_axes, (v.whiteness, v.independence), strict=True):
+        assert t.applicable and _verdict_words(ax.get_title()) <= {"pass", "fail"}
+
+
+def _grey(title) -> bool:
+    """Whether a title is drawn in matplotlib's grey (tab:gray)."""
+    from matplotlib.colors import same_color
+
+    return same_color(title.get_color(), "tab:gray")
+
+
+def _verdict_words(text: str) -> set[str]:
+    return {w for w in ("pass", "fail", "n/a") if w in text.lower()}
 
 
 def test_a_shared_test_without_degrees_of_freedom_is_not_applicable():
     """A constant input leaves the input-residual test nothing to test."""
     rec = _record(np.ones(600), seed=6)
     v = validate(_arx(np.r_[A, B]), rec)
-    assert v.independence.dof == 0
+    assert v.independence.dof == 0 and not v.independence.applicable
+    assert set(v.independence.passed.values()) == {None}
     row = next(r for r in v.summary().splitlines() if r.startswith("independence"))
     assert "not applicable" in row and "pass" not in row
     d = v.to_dict()["independence"]
     assert d["applicable"] is False and set(d["passed"].values()) == {None}
+    # The residual figure: whiteness keeps its verdict, independence reads
+    # "n/a" in grey and never "pass".
+    axes = v.plot()["residuals"].axes
+    white, indep = axes[0].title, axes[1].title
+    assert _verdict_words(indep.get_text()) == {"n/a"} and _grey(indep)
+    assert "p =" not in indep.get_text()
+    assert "n/a" not in white.get_text() and not _grey(white)
+    words = {"pass" if v.whiteness.passed[lv] else "fail" for lv in v.whiteness.levels}
+    assert _verdict_words(white.get_text()) == words

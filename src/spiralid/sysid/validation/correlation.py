@@ -15,7 +15,10 @@ and a verdict per level from a joint chi-square statistic. The verdict is joint
 rather than "every lag inside the band" because that rule rejects white noise
 far too often: with 25 lags at 95 % its false-alarm rate is
 ``1 - 0.95**25 = 72 %``. The joint statistics have false-alarm rate
-``1 - level`` under the null hypothesis.
+``1 - level`` under the null hypothesis. A test with no degrees of freedom
+(a constant input) has nothing to test: its verdicts are None and
+:attr:`CorrelationTest.applicable` is False, so it reads "not applicable",
+never "pass".
 """
 
 from __future__ import annotations
@@ -66,9 +69,10 @@ class CorrelationTest:
     dof : int
         Degrees of freedom of ``statistic``.
     p_value : float
-        ``P(chi2(dof) >= statistic)``.
+        ``P(chi2(dof) >= statistic)`` (1 when ``dof`` is 0).
     passed : dict
-        ``{level: statistic <= chi2.ppf(level, dof)}``.
+        ``{level: statistic <= chi2.ppf(level, dof)}``; ``{level: None}``
+        when the test has no degrees of freedom (see :attr:`applicable`).
     band_scale : float
         Standard deviation of a single correlation under the null hypothesis,
         in units of ``1/sqrt(N)``: 1 for the whiteness test; for the
@@ -88,11 +92,21 @@ class CorrelationTest:
     statistic: float
     dof: int
     p_value: float
-    passed: dict[float, bool] = field(default_factory=dict)
+    passed: dict[float, bool | None] = field(default_factory=dict)
     band_scale: float = 1.0
 
+    @property
+    def applicable(self) -> bool:
+        """Whether the test has anything to test: False with no degrees of
+        freedom (a constant input, or the ``u^2`` of a binary one, is
+        uncorrelated with anything), when its verdicts are None, neither
+        pass nor fail."""
+        return self.dof > 0
+
     def to_dict(self) -> dict:
-        """JSON-safe dictionary (level keys become strings such as ``"0.95"``)."""
+        """JSON-safe dictionary (level keys become strings such as ``"0.95"``;
+        a test that does not apply has ``"applicable": false`` and null
+        verdicts)."""
         return {
             "kind": self.kind,
             "lags": [int(k) for k in self.lags],
@@ -104,8 +118,11 @@ class CorrelationTest:
             "statistic": float(self.statistic),
             "dof": int(self.dof),
             "p_value": float(self.p_value),
-            "passed": {str(k): bool(v) for k, v in self.passed.items()},
+            "passed": {
+                str(k): None if v is None else bool(v) for k, v in self.passed.items()
+            },
             "band_scale": float(self.band_scale),
+            "applicable": self.applicable,
         }
 
 
@@ -207,8 +224,11 @@ def _finish(
         statistic=float(statistic),
         dof=int(dof),
         p_value=p_value,
+        # No degrees of freedom: a statistic of 0 "passes" any level, but
+        # there was nothing to test, so the verdict is None, not True.
         passed={
-            lv: bool(dof == 0 or statistic <= stats.chi2.ppf(lv, dof)) for lv in levels
+            lv: bool(statistic <= stats.chi2.ppf(lv, dof)) if dof > 0 else None
+            for lv in levels
         },
         band_scale=float(band_scale),
     )

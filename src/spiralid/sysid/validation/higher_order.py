@@ -81,7 +81,7 @@ class BillingsVoon:
         """Tests with no degrees of freedom: nothing to test (a binary
         input's ``u^2`` is constant, so the two ``u^2'`` tests), reported as
         not applicable, never as passed."""
-        return tuple(k for k, t in self.tests.items() if t.dof == 0)
+        return tuple(k for k, t in self.tests.items() if not t.applicable)
 
     @property
     def passed(self) -> dict[str, bool]:
@@ -144,11 +144,13 @@ class BillingsVoon:
             ax.plot(t.lags, t.values, "o", color="C0", ms=3)
             ax.axhline(band, color="C3", ls="--", lw=1)
             ax.axhline(-band, color="C3", ls="--", lw=1)
-            if name in self.not_applicable:
-                verdict = "not applicable (no degrees of freedom)"
-            else:
+            if t.applicable:
                 verdict = "pass" if t.passed[self.level] else "FAIL"
-            ax.set_title(f"{BILLINGS_VOON[name]}: {verdict}", fontsize=9)
+                colour = "black"
+            else:
+                verdict = "n/a (no degrees of freedom)"
+                colour = "tab:gray"
+            ax.set_title(f"{BILLINGS_VOON[name]}: {verdict}", fontsize=9, color=colour)
             ax.set_ylim(-1.05, 1.05)
             ax.set_ylabel("correlation", fontsize=8)
         axes[-1].set_xlabel("lag (samples)")
@@ -163,17 +165,14 @@ class BillingsVoon:
 def correlation_dict(test: CorrelationTest) -> dict:
     """A test's JSON-safe dictionary with ``"applicable"``: a test with no
     degrees of freedom has nothing to test, so its verdicts are null rather
-    than the ``true`` its statistic of zero would give.
+    than the ``true`` its statistic of zero would give (what
+    :meth:`CorrelationTest.to_dict` itself writes; kept for its callers).
 
     Parameters
     ----------
     test : CorrelationTest
     """
-    out = test.to_dict()
-    out["applicable"] = bool(test.dof > 0)
-    if not out["applicable"]:
-        out["passed"] = dict.fromkeys(out["passed"])
-    return out
+    return test.to_dict()
 
 
 def _product_test(e, u, lags, levels) -> CorrelationTest:

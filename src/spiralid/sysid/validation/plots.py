@@ -125,7 +125,8 @@ def plot_residual_tests(*tests: CorrelationTest) -> Figure:
     Each test (from :func:`~spiralid.sysid.validation.correlation.whiteness_test` or
     :func:`~spiralid.sysid.validation.correlation.independence_test`) is drawn as stems
     with dashed ``+-z/sqrt(N)`` bands for each of its levels, and its verdict
-    in the title, as MATLAB's ``resid`` lays them out. When the test's
+    in the title, as MATLAB's ``resid`` lays them out; a test with no
+    degrees of freedom reads "n/a" in grey, never "pass". When the test's
     ``band_scale`` differs from 1 (coloured input and residual), the
     colour-adjusted bands ``band_scale * z / sqrt(N)`` are drawn as well.
 
@@ -171,16 +172,24 @@ def plot_residual_tests(*tests: CorrelationTest) -> Figure:
                 lab = f"{100 * lv:g} % band, colour-adjusted"
                 ax.axhline(b, color="tab:green", ls=ls, lw=0.9, label=lab)
                 ax.axhline(-b, color="tab:green", ls=ls, lw=0.9)
-        verdict = ", ".join(
-            f"{'pass' if tst.passed[lv] else 'fail'} {100 * lv:g} %"
-            for lv in tst.levels
-        )
         what = (
             "Residual autocorrelation"
             if tst.kind == "autocorrelation"
             else "Input-residual cross-correlation"
         )
-        ax.set_title(f"{what}: {verdict} (p = {tst.p_value:.3g})", fontsize="medium")
+        if tst.applicable:
+            verdict = ", ".join(
+                f"{'pass' if tst.passed[lv] else 'fail'} {100 * lv:g} %"
+                for lv in tst.levels
+            )
+            title = f"{what}: {verdict} (p = {tst.p_value:.3g})"
+            colour = "black"
+        else:
+            # Nothing was tested (a constant input): its p-value of 1 would
+            # read as a clean pass.
+            title = f"{what}: n/a (no degrees of freedom)"
+            colour = "tab:gray"
+        ax.set_title(title, fontsize="medium", color=colour)
         ax.set_xlabel("lag (samples)")
         ax.set_ylabel("normalised correlation")
         # Beside the axes: inside, the legend hides stems at some lags.

@@ -470,7 +470,7 @@ class Validation:
 
 def _verdict(test: CorrelationTest) -> str:
     """A test's verdict at each level, or why it does not apply."""
-    if test.dof == 0:
+    if not test.applicable:
         return "not applicable: no degrees of freedom"
     parts = [
         f"{'pass' if test.passed[lv] else 'FAIL'} at {100 * lv:g} %"
