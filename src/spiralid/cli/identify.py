@@ -319,7 +319,11 @@ def _run_shared(args, progress, arx, est, val, options, argv) -> int:
         )
         progress.phase("writing", "writing files and figures")
         staged = folder.path
-        (staged / "model.json").write_text(json.dumps(model.to_dict(), indent=2))
+        # The wall times go to timings.json, so that model.json is what the
+        # seed decides, byte for byte the same on a rerun.
+        (staged / "model.json").write_text(
+            json.dumps(model.to_dict(timings=False), indent=2)
+        )
         (staged / "validation.json").write_text(
             json.dumps(
                 {"estimation": v_est.to_dict(), "validation": v_val.to_dict()}, indent=2
@@ -349,7 +353,7 @@ def _run_shared(args, progress, arx, est, val, options, argv) -> int:
             stabilisation_note=_stabilisation_note(orders),
             command="spiralid " + shlex.join(argv),
         )
-        _write_timings(staged, progress)
+        _write_timings(staged, progress, model)
         written = folder.commit(last="model.json")
     if not args.quiet:
         print(summary)

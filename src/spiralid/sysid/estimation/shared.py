@@ -322,7 +322,7 @@ def identify_shared(
     if method == "ls":
         theta = joint_least_squares(_parts_record(first), arx, first.weights)
         a, b = theta[: arx.na], theta[arx.na :].reshape(data.n_outputs, arx.nb)
-        return _model(data, arx, "ls", first, a, b, None, {"elapsed": 0.0}, t0)
+        return _model(data, arx, "ls", first, a, b, None, {}, t0)
     par = ModalParametrization(
         arx.na, data.ts, max_radius=_radius(data, max_time_constant)
     )
@@ -410,8 +410,8 @@ def _weighted_polish(first, par, z, data, arx, reweight: bool):
 
 
 def _model(data, arx, method, cost, a, b, covariance, result, t0):
-    """The model; `covariance` is ``(C, R)`` or None."""
-    result = dict(result, elapsed=time.perf_counter() - t0)
+    """The model; `covariance` is ``(C, R)`` or None. Its wall time goes
+    to ``timings`` as every fitted model's does, not to ``result``."""
     covariance, root = (None, None) if covariance is None else covariance
     # Least squares' poles may be unstable: no simulation cost then.
     stable = is_stable_polynomial(a)
@@ -434,6 +434,7 @@ def _model(data, arx, method, cost, a, b, covariance, result, t0):
         covariance_factor=root,
         integrators=cost.integrators,
         result=result,
+        timings={"total": time.perf_counter() - t0},
     )
 
 

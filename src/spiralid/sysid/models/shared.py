@@ -139,8 +139,8 @@ class SharedDenominatorModel(Provenance):
         Each output's known integrators, poles at ``z = 1`` outside the
         shared ``A``: output ``i`` is ``B_i / (A (1 - z^-1)^k_i)``.
     result : dict
-        What the estimator reports (budget, messages, its wall time
-        ``elapsed``); the model file keeps its scalars but ``elapsed``.
+        What the estimator reports (budget, messages); the model file keeps
+        its scalars.
     predictor, initial : str
         ``"simulation"`` and ``"rest"``: the joint cost is the outputs'
         free-run error from rest.
@@ -152,8 +152,8 @@ class SharedDenominatorModel(Provenance):
     history : ndarray or None
         Best cost after each iteration of a search (None: not kept).
     timings : dict
-        Wall times in seconds, written to the file unless
-        ``to_dict(timings=False)``.
+        Wall times in seconds (``"total"``: the estimation's), written to
+        the file unless ``to_dict(timings=False)``.
     fraction : float or None
         The share of the record that estimated the model, when known.
     """
