@@ -5,20 +5,22 @@ Runs every spiral rule of :func:`spiralid.optim.minimize` (the paper's SDA,
 Eb-SDA and LASDA, the scale-free Eb-SDA, Tamura & Yasuda's periodic and
 convergent settings, the learned-metric spiral), each also with restarts;
 the learned-metric spiral with one ingredient taken away at a time
-(``learned-metric-axes``: the box's axes, no learned basis;
-``-scheduled``: the periodic setting's budget schedule instead of
-success-based steps; ``-no-model``: no model step; ``-polls-only``:
-restarts without population periods); IPOP-CMA-ES and BIPOP-CMA-ES
-(pycma), SciPy's BFGS (finite differences) and Nelder-Mead restarted from
-uniform points, and uniform random search, through ``cocoex`` on the
-noiseless ``bbob`` suite at a budget of ``budget x D`` evaluations per
-problem. It writes the standard COCO data folder (``OUTPUT/exdata/<method>``,
-one per method) that ``cocopp`` post-processes (``OUTPUT/ppdata``), and
-prints per method and dimension the fraction of (function, instance, target)
-triples reached for COCO's 51 standard targets ``10^2 ... 10^-8`` on
-``f - f_opt``, with wall times and the optimiser's own time per evaluation
-(wall time minus the time spent inside the COCO problem, observer logging
-included).
+(``learned-metric-axes``: the box's axes, no learned basis; ``-scheduled``:
+the periodic setting's budget schedule instead of success-based steps;
+``-no-model``: no model step; ``-polls-only``: restarts without population
+periods; ``-orthogonal``: orthogonal instead of independent directions in
+the population periods, an option added rather than an ingredient taken
+away; ``-global-stall``: a run's stall counted from the best of all runs,
+not its own); IPOP-CMA-ES and BIPOP-CMA-ES (pycma), SciPy's BFGS (finite
+differences) and Nelder-Mead restarted from uniform points, and uniform
+random search, through ``cocoex`` on the noiseless ``bbob`` suite at a
+budget of ``budget x D`` evaluations per problem. It writes the standard
+COCO data folder (``OUTPUT/exdata/<method>``, one per method) that
+``cocopp`` post-processes (``OUTPUT/ppdata``), and prints per method and
+dimension the fraction of (function, instance, target) triples reached for
+COCO's 51 standard targets ``10^2 ... 10^-8`` on ``f - f_opt``, with wall
+times and the optimiser's own time per evaluation (wall time minus the time
+spent inside the COCO problem, observer logging included).
 
 Needs the ``bench`` extra: ``pip install -e ".[bench]"``.
 
@@ -74,6 +76,8 @@ INGREDIENTS = {
     "learned-metric-scheduled": LearnedMetricSpiral(success_steps=False),
     "learned-metric-no-model": LearnedMetricSpiral(model_step=False),
     "learned-metric-polls-only": LearnedMetricSpiral(populations=False),
+    "learned-metric-orthogonal": LearnedMetricSpiral(sampling="orthogonal"),
+    "learned-metric-global-stall": LearnedMetricSpiral(run_stall=False),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

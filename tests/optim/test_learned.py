@@ -21,6 +21,7 @@ from spiralid.optim import (
     SpiralSearch,
     minimize,
 )
+from spiralid.optim._kernels import orthonormal_rows
 
 
 def _quadratic(H):
@@ -222,6 +223,87 @@ def test_restarts_alternate_polls_and_population_periods():
     assert res.fun < 5.0  # the population regime finds a deep basin
 
 
+def test_orthonormal_rows_match_lapack_qr():
+    # Gram-Schmidt on the rows is the Q of a QR of their transpose with R's
+    # diagonal made positive (LAPACK's Householder QR, signs fixed).
+    g = np.random.default_rng(0).standard_normal((5, 8))
+    q, r = np.linalg.qr(g.T)
+    expected = (q * np.sign(np.diag(r))).T
+    np.testing.assert_allclose(orthonormal_rows(g.copy()), expected, atol=1e-12)
+
+
+def _first_population_batch(rule, n, seed):
+    """The first population period's evaluated points and its centre, for a
+    search whose first poll started at the sphere's minimum."""
+    batches = []
+
+    def sphere(X):
+        batches.append(X.copy())
+        return np.sum(X**2, axis=1)
+
+    search = LearnedMetricSearch(
+        sphere,
+        [(-1, 1)] * n,
+        rule,
+        n_points=1,
+        x0=np.zeros(n),
+        rng=seed,
+        vectorized=True,
+    )
+    search.step()
+    search.restart(1)  # no population has run yet: its regime goes next
+    assert search.regime == "population"
+    centre = search.centre
+    batches.clear()
+    search.step()
+    return batches[0], centre
+
+
+def test_population_directions_are_orthogonal_in_blocks_and_mirrored():
+    # Fresh population runs use the box's axes: the offsets are 2 sigma z
+    # (the box is [-1, 1]), so each block of n directions must be mutually
+    # orthogonal and the second half the first's mirror.
+    n = 4
+    rule = LearnedMetricSpiral(sampling="orthogonal")
+    x, centre = _first_population_batch(rule, n, seed=1)
+    half = x.shape[0] // 2
+    z = x[:half] - centre
+    np.testing.assert_allclose(x[half:] - centre, -z, atol=1e-12)
+    assert half > n  # at least one whole block and part of another
+    for start in range(0, half, n):
+        block = z[start : start + n]
+        unit = block / np.linalg.norm(block, axis=1)[:, None]
+        np.testing.assert_allclose(unit @ unit.T, np.eye(len(block)), atol=1e-10)
+    # Independent directions are not orthogonal.
+    x, centre = _first_population_batch(LearnedMetricSpiral(), n, seed=1)
+    z = x[:n] - centre
+    unit = z / np.linalg.norm(z, axis=1)[:, None]
+    assert np.abs(unit @ unit.T - np.eye(n)).max() > 1e-3
+
+
+@pytest.mark.parametrize("run_stall", [True, False])
+def test_a_restarted_run_stalls_against_its_own_best(run_stall):
+    # The first poll starts at the minimum (cost 0), so no later run can
+    # beat it; a population run on the sphere still improves its own best,
+    # so it stalls only when counted against the best of all runs.
+    rule = LearnedMetricSpiral(run_stall=run_stall)
+    search = LearnedMetricSearch(
+        lambda x: float(x @ x), [(-1, 1)] * 3, rule, n_points=1, x0=np.zeros(3), rng=0
+    )
+    search.step()
+    search.restart(1)
+    restarts = Restarts(stall=3, tol_radius=1e-300)
+    costs = []
+    # Counted from all runs, the first period "moves" (to the first run's 0
+    # from the fresh centre's cost); stall periods more follow.
+    for _ in range(4):
+        search.step()
+        costs.append(search.centre_cost)
+    assert search.fun == 0.0
+    assert costs[-1] < costs[0]  # the run itself is converging
+    assert search.collapsed(restarts) is (not run_stall)
+
+
 def test_non_finite_costs_rank_worst_and_never_become_the_best():
     def fun(x):
         return math.nan if x[0] > 0 else float(x @ x)
@@ -250,6 +332,8 @@ def test_x0_seeds_the_first_poll():
         ({"delta": 0.0}, "`delta`"),
         ({"basis": "yes"}, "`basis` must be True or False"),
         ({"populations": 1}, "`populations` must be True or False"),
+        ({"run_stall": "yes"}, "`run_stall` must be True or False"),
+        ({"sampling": "sobol"}, "`sampling` must be one of"),
     ],
 )
 def test_bad_settings_are_named(kwargs, match):

@@ -126,3 +126,29 @@ def exponential(d, lower, span, c2, log_c1, cap):  # pragma: no cover - compiled
                 e = t / (1.0 + t)
             out[j, i] = lower[j] + span[j] * e
     return out, zeros, invalid
+
+
+@numba.njit(cache=True, nogil=True)
+def orthonormal_rows(g):  # pragma: no cover - compiled
+    """Orthonormalise the rows of ``g`` (k, n), k <= n, in place by modified
+    Gram-Schmidt and return it.
+
+    For Gaussian rows this gives the first k rows of a uniformly random
+    rotation (the Q of a QR with R's diagonal positive), without the
+    Python-level work of ``np.linalg.qr`` on a small matrix.
+    """
+    k, n = g.shape
+    for i in range(k):
+        for j in range(i):
+            d = 0.0
+            for t in range(n):
+                d += g[i, t] * g[j, t]
+            for t in range(n):
+                g[i, t] -= d * g[j, t]
+        s = 0.0
+        for t in range(n):
+            s += g[i, t] * g[i, t]
+        s = np.sqrt(s)
+        for t in range(n):
+            g[i, t] /= s
+    return g
