@@ -51,9 +51,21 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
+# One BLAS thread per process, set before NumPy loads: the tasks share two
+# cores with each other and other jobs, and OpenBLAS's threads spinning for
+# a core made a D = 40 eigendecomposition up to ten times slower under load
+# (for pycma and the spiral alike), which the times per evaluation showed.
+for _name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
 
-from spiralid.optim import RULES, LearnedMetricSpiral, Restarts, minimize
+import numpy as np  # noqa: E402
+
+from spiralid.optim import (  # noqa: E402
+    RULES,
+    LearnedMetricSpiral,
+    Restarts,
+    minimize,
+)
 
 TARGETS = 10.0 ** (2.0 - 0.2 * np.arange(51))  # COCO's 51 standard targets
 DIMS = (2, 5, 10, 20)
