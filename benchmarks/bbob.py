@@ -90,6 +90,7 @@ INGREDIENTS = {
     "learned-metric-polls-only": LearnedMetricSpiral(populations=False),
     "learned-metric-orthogonal": LearnedMetricSpiral(sampling="orthogonal"),
     "learned-metric-global-stall": LearnedMetricSpiral(run_stall=False),
+    "learned-metric-lazy": LearnedMetricSpiral(lazy_basis=True),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

@@ -5,6 +5,7 @@ eigenvectors and condition), the geometric sequences a success rule must
 follow, and the same search on a rotated copy of the problem.
 """
 
+import itertools
 import math
 
 import numpy as np
@@ -334,6 +335,7 @@ def test_x0_seeds_the_first_poll():
         ({"populations": 1}, "`populations` must be True or False"),
         ({"run_stall": "yes"}, "`run_stall` must be True or False"),
         ({"sampling": "sobol"}, "`sampling` must be one of"),
+        ({"lazy_basis": 1}, "`lazy_basis` must be True or False"),
     ],
 )
 def test_bad_settings_are_named(kwargs, match):
@@ -372,3 +374,69 @@ def test_adaptive_encoding_checks_its_input_and_keeps_a_valid_metric():
         enc.update(rng.normal(size=(2, 3)))
     np.testing.assert_allclose(enc.basis @ enc.inverse, np.eye(3), atol=1e-10)
     assert enc.condition >= 1.0
+
+
+def _encoding_update(C, path, shift, steps, weights, inverse, c_p, c_1, c_mu):
+    """Hansen's Adaptive Encoding update written out, row by row."""
+    n = C.shape[0]
+    z = [v * math.sqrt(n) / np.linalg.norm(inverse @ v) for v in [shift, *steps]]
+    path = (1 - c_p) * path + math.sqrt(c_p * (2 - c_p)) * z[0]
+    rank_mu = sum(w * np.outer(v, v) for w, v in zip(weights, z[1:], strict=True))
+    return (1 - c_1 - c_mu) * C + c_1 * np.outer(path, path) + c_mu * rank_mu, path
+
+
+@pytest.mark.parametrize("n", [3, 12, 40])
+def test_the_compiled_encoding_update_follows_the_formula(n):
+    rng = np.random.default_rng(n)
+    enc = AdaptiveEncoding(n, n)
+    for _ in range(5):
+        C, path, inverse = enc.covariance, enc.path.copy(), enc.inverse
+        shift, steps = rng.normal(size=n), rng.normal(size=(n, n))
+        expected, expected_path = _encoding_update(
+            C, path, shift, steps, enc.weights, inverse, enc.c_p, enc.c_1, enc.c_mu
+        )
+        enc.learn(shift, steps)
+        np.testing.assert_allclose(enc.covariance, expected, rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(enc.path, expected_path, rtol=1e-12, atol=1e-14)
+        # The basis is the covariance's square root along its eigenvectors.
+        values = eigh(enc.covariance, eigvals_only=True)
+        np.testing.assert_allclose(np.sort(enc.lengths**2), values, rtol=1e-10)
+        np.testing.assert_allclose(
+            enc.basis @ enc.basis.T, enc.covariance, rtol=1e-10, atol=1e-12
+        )
+
+
+def test_a_lazy_encoding_decomposes_every_k_updates():
+    rng = np.random.default_rng(0)
+    lazy = AdaptiveEncoding(4, 3, eigen_every=3)
+    for update in range(1, 10):
+        shift, steps = rng.normal(size=4), rng.normal(size=(3, 4))
+        before = lazy.basis.copy()
+        lazy_inverse = lazy.inverse.copy()
+        lazy.learn(shift, steps)
+        if update % 3:
+            np.testing.assert_array_equal(lazy.basis, before)
+            np.testing.assert_array_equal(lazy.inverse, lazy_inverse)
+        else:
+            np.testing.assert_allclose(
+                lazy.basis @ lazy.basis.T, lazy.covariance, rtol=1e-10, atol=1e-12
+            )
+            assert not np.allclose(lazy.basis, before)
+    with pytest.raises(ValueError, match="`eigen_every` must be an integer"):
+        AdaptiveEncoding(3, 2, eigen_every=0)
+
+
+def test_lazy_basis_decomposes_every_n_over_10_periods():
+    n = 20
+    H = _rotated_ellipsoid(n, 1e4, 1)
+    search = LearnedMetricSearch(
+        _quadratic(H), [(-5, 5)] * n, LearnedMetricSpiral(lazy_basis=True), rng=0
+    )
+    bases = []
+    for _ in range(6):
+        search.step()
+        bases.append(search.basis)
+    # The first period sets the encoding's mean; it decomposes after every
+    # second update from then on (n // 10 = 2).
+    changed = [not np.array_equal(a, b) for a, b in itertools.pairwise(bases)]
+    assert changed == [False, True, False, True, False]

@@ -152,3 +152,60 @@ def orthonormal_rows(g):  # pragma: no cover - compiled
         for t in range(n):
             g[i, t] /= s
     return g
+
+
+@numba.njit(cache=True, nogil=True)
+def covariance_update(
+    covariance, path, z, weights, inverse, c_p, c_1, c_mu, normalise
+):  # pragma: no cover - compiled
+    """Adaptive Encoding's update of ``covariance`` (n, n) and ``path`` (n,).
+
+    Row 0 of ``z`` is the mean's shift, rows 1.. the selected steps, best
+    first, with ``weights``. With ``normalise`` each row of ``z`` is first
+    scaled, in place, to length ``sqrt(n)`` in the metric ``inverse``
+    (``B^-1``; zero rows stay zero). ``path`` is updated in place; the new
+    covariance is returned, symmetric by construction:
+    ``(1 - c_1 - c_mu) C + c_1 p p^T + c_mu sum_i w_i z_i z_i^T``.
+
+    One compiled pass instead of about fifteen NumPy calls on small arrays,
+    which cost more than their arithmetic at n = 10-40.
+    """
+    k, n = z.shape
+    if normalise:
+        root_n = np.sqrt(n)
+        # B^-1 z_i with the inner loop along rows of B^-T: independent sums
+        # that the compiler vectorises without reordering any of them.
+        inverse_t = np.ascontiguousarray(inverse.T)
+        t = np.empty(n)
+        for i in range(k):
+            t[:] = 0.0
+            for b in range(n):
+                zb = z[i, b]
+                for a in range(n):
+                    t[a] += inverse_t[b, a] * zb
+            s = 0.0
+            for a in range(n):
+                s += t[a] * t[a]
+            length = np.sqrt(s)
+            scale = root_n / length if length > 0.0 else 0.0
+            for a in range(n):
+                z[i, a] *= scale
+    gain = np.sqrt(c_p * (2.0 - c_p))
+    for a in range(n):
+        path[a] = (1.0 - c_p) * path[a] + gain * z[0, a]
+    # The rank-mu sum row by row of z, so the inner loop runs along memory.
+    rank_mu = np.zeros((n, n))
+    for i in range(1, k):
+        wi = weights[i - 1]
+        for a in range(n):
+            wa = wi * z[i, a]
+            for b in range(a, n):
+                rank_mu[a, b] += wa * z[i, b]
+    keep = 1.0 - c_1 - c_mu
+    out = np.empty((n, n))
+    for a in range(n):
+        for b in range(a, n):
+            v = keep * covariance[a, b] + c_1 * path[a] * path[b] + c_mu * rank_mu[a, b]
+            out[a, b] = v
+            out[b, a] = v
+    return out

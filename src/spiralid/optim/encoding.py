@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from spiralid._checks import integer, positive
+from spiralid.optim._kernels import covariance_update
 
 __all__ = ["AdaptiveEncoding"]
 
@@ -37,6 +38,11 @@ class AdaptiveEncoding:
         Coordinate Descent's (Loshchilov et al., GECCO 2011), for a poll
         of ``2n`` points; :meth:`for_population` gives CMA-ES's for a
         sampled population.
+    eigen_every : int, optional
+        Decompose the covariance into the basis after every this many
+        updates (default 1, every update); in between the covariance
+        learns while the basis, its inverse and :attr:`condition` stay as
+        they were (CMA-ES's lazy update).
 
     Examples
     --------
@@ -45,7 +51,9 @@ class AdaptiveEncoding:
     [[1.0, 0.0], [0.0, 1.0]]
     """
 
-    def __init__(self, n: int, mu: int, *, c_p=None, c_1=None, c_mu=None):
+    def __init__(
+        self, n: int, mu: int, *, c_p=None, c_1=None, c_mu=None, eigen_every: int = 1
+    ):
         self.n = n = integer(n, "n", 1)
         mu = integer(mu, "mu", 1)
         w = np.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
@@ -55,18 +63,24 @@ class AdaptiveEncoding:
         self.c_mu = 0.5 / n if c_mu is None else positive(c_mu, "c_mu")
         if self.c_p > 1.0 or self.c_1 + self.c_mu > 1.0:
             raise ValueError("`c_p` and `c_1 + c_mu` must be at most 1")
+        self.eigen_every = integer(eigen_every, "eigen_every", 1)
+        self._pending = 0
         self.covariance = np.eye(n)
         self.basis = np.eye(n)
+        self.lengths = np.ones(n)
         self._inverse = np.eye(n)
         self.path = np.zeros(n)
         self.mean = None
         self.condition = 1.0
 
     @classmethod
-    def for_population(cls, n: int, mu: int) -> "AdaptiveEncoding":
+    def for_population(
+        cls, n: int, mu: int, *, eigen_every: int = 1
+    ) -> "AdaptiveEncoding":
         """The learning rates CMA-ES uses for ``mu`` selected points of a
-        sampled population (Hansen's tutorial, 2016, table 1)."""
-        enc = cls(n, mu)
+        sampled population (Hansen's tutorial, 2016, table 1);
+        `eigen_every` as in the class."""
+        enc = cls(n, mu, eigen_every=eigen_every)
         mu_eff = 1.0 / float(np.sum(enc.weights**2))
         enc.c_p = (4.0 + mu_eff / n) / (n + 4.0 + 2.0 * mu_eff / n)
         enc.c_1 = 2.0 / ((n + 1.3) ** 2 + mu_eff)
@@ -80,15 +94,6 @@ class AdaptiveEncoding:
     def inverse(self) -> np.ndarray:
         """``B^-1``."""
         return self._inverse
-
-    def _normalised(self, steps: np.ndarray) -> np.ndarray:
-        """Rows scaled to length sqrt(n) in the current metric (zero rows
-        stay zero)."""
-        lengths = np.linalg.norm(steps @ self._inverse.T, axis=1)
-        scale = np.divide(
-            math.sqrt(self.n), lengths, out=np.zeros_like(lengths), where=lengths > 0
-        )
-        return steps * scale[:, None]
 
     def update(self, points) -> None:
         """Learn from the ``mu`` best points of a sample, best first."""
@@ -119,16 +124,26 @@ class AdaptiveEncoding:
         without, they are taken as they are (CMA-ES's update, for steps
         divided by the step size and a shift by ``sigma / sqrt(mu_eff)``).
         """
-        c_p, c_1, c_mu = self.c_p, self.c_1, self.c_mu
-        z = np.vstack([shift, steps])
-        if normalise:
-            z = self._normalised(z)
-        self.path = (1.0 - c_p) * self.path + math.sqrt(c_p * (2.0 - c_p)) * z[0]
         w = self.weights if weights is None else np.asarray(weights, dtype=float)
-        rank_mu = (z[1:].T * w) @ z[1:]
-        C = (1.0 - c_1 - c_mu) * self.covariance
-        C += c_1 * np.outer(self.path, self.path) + c_mu * rank_mu
-        C = 0.5 * (C + C.T)
+        z = np.empty((w.size + 1, self.n))
+        z[0] = shift
+        z[1:] = steps
+        C = covariance_update(
+            self.covariance,
+            self.path,
+            z,
+            w,
+            self._inverse,
+            float(self.c_p),
+            float(self.c_1),
+            float(self.c_mu),
+            normalise,
+        )
+        self._pending += 1
+        if self._pending < self.eigen_every:
+            self.covariance = C
+            return
+        self._pending = 0
         values, vectors = np.linalg.eigh(C)
         if not (np.all(np.isfinite(values)) and values[0] > 0.0):
             # Rounding broke positive definiteness: keep the last metric.
@@ -136,6 +151,7 @@ class AdaptiveEncoding:
             return
         self.covariance = C
         d = np.sqrt(values)
+        self.lengths = d
         self.basis = vectors * d
         self._inverse = (vectors / d).T
         self.condition = float(values[-1] / values[0])
