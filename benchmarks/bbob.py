@@ -11,9 +11,11 @@ the periodic setting's budget schedule instead of success-based steps;
 periods; ``-orthogonal``: orthogonal instead of independent directions in
 the population periods, an option added rather than an ingredient taken
 away; ``-global-stall``: a run's stall counted from the best of all runs,
-not its own); IPOP-CMA-ES and BIPOP-CMA-ES (pycma), SciPy's BFGS (finite
-differences) and Nelder-Mead restarted from uniform points, and uniform
-random search, through ``cocoex`` on the noiseless ``bbob`` suite at a
+not its own; ``-lazy``: the basis decomposed every ``n // 10`` periods;
+``-uncapped``: the poll's metric's condition unbounded); IPOP-CMA-ES
+and BIPOP-CMA-ES (pycma), SciPy's BFGS (finite differences) and
+Nelder-Mead restarted from uniform points, and uniform random search,
+through ``cocoex`` on the noiseless ``bbob`` suite at a
 budget of ``budget x D`` evaluations per problem. It writes the standard
 COCO data folder (``OUTPUT/exdata/<method>``, one per method) that
 ``cocopp`` post-processes (``OUTPUT/ppdata``), and prints per method and
@@ -91,6 +93,7 @@ INGREDIENTS = {
     "learned-metric-orthogonal": LearnedMetricSpiral(sampling="orthogonal"),
     "learned-metric-global-stall": LearnedMetricSpiral(run_stall=False),
     "learned-metric-lazy": LearnedMetricSpiral(lazy_basis=True),
+    "learned-metric-uncapped": LearnedMetricSpiral(max_condition=None),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

@@ -336,6 +336,7 @@ def test_x0_seeds_the_first_poll():
         ({"run_stall": "yes"}, "`run_stall` must be True or False"),
         ({"sampling": "sobol"}, "`sampling` must be one of"),
         ({"lazy_basis": 1}, "`lazy_basis` must be True or False"),
+        ({"max_condition": 0.5}, "`max_condition` must be >= 1 or None"),
     ],
 )
 def test_bad_settings_are_named(kwargs, match):
@@ -440,3 +441,24 @@ def test_lazy_basis_decomposes_every_n_over_10_periods():
     # second update from then on (n // 10 = 2).
     changed = [not np.array_equal(a, b) for a, b in itertools.pairwise(bases)]
     assert changed == [False, True, False, True, False]
+
+
+def test_a_capped_metric_keeps_its_axes_and_raises_the_small_eigenvalues():
+    # Steps all along one axis: the normalised update grows that axis's
+    # variance without bound. Capped, the eigenvalues are the uncapped
+    # ones with the small ones raised to the largest over the cap.
+    rng = np.random.default_rng(3)
+    free, capped = AdaptiveEncoding(3, 3), AdaptiveEncoding(3, 3, max_condition=50.0)
+    for _ in range(40):
+        steps = np.outer(rng.normal(size=3), [1.0, 0.0, 0.0]) + 1e-3 * rng.normal(
+            size=(3, 3)
+        )
+        shift = steps[0]
+        free.learn(shift, steps)
+        capped.learn(shift, steps)
+    assert free.condition > 1e3
+    assert capped.condition == pytest.approx(50.0, rel=1e-9)
+    values, vectors = np.linalg.eigh(capped.covariance)
+    assert values[-1] / values[0] == pytest.approx(50.0, rel=1e-9)
+    # The long axis is the x axis, as the steps are.
+    assert abs(vectors[0, -1]) == pytest.approx(1.0, abs=1e-3)

@@ -43,6 +43,10 @@ class AdaptiveEncoding:
         updates (default 1, every update); in between the covariance
         learns while the basis, its inverse and :attr:`condition` stay as
         they were (CMA-ES's lazy update).
+    max_condition : float, optional
+        Bound the metric's condition: at each decomposition, eigenvalues
+        below the largest over `max_condition` are raised to it, in the
+        covariance too (default None, unbounded).
 
     Examples
     --------
@@ -52,7 +56,15 @@ class AdaptiveEncoding:
     """
 
     def __init__(
-        self, n: int, mu: int, *, c_p=None, c_1=None, c_mu=None, eigen_every: int = 1
+        self,
+        n: int,
+        mu: int,
+        *,
+        c_p=None,
+        c_1=None,
+        c_mu=None,
+        eigen_every: int = 1,
+        max_condition: float | None = None,
     ):
         self.n = n = integer(n, "n", 1)
         mu = integer(mu, "mu", 1)
@@ -65,6 +77,11 @@ class AdaptiveEncoding:
             raise ValueError("`c_p` and `c_1 + c_mu` must be at most 1")
         self.eigen_every = integer(eigen_every, "eigen_every", 1)
         self._pending = 0
+        self.max_condition = (
+            None if max_condition is None else positive(max_condition, "max_condition")
+        )
+        if self.max_condition is not None and self.max_condition < 1.0:
+            raise ValueError(f"`max_condition` must be >= 1; got {max_condition!r}")
         self.covariance = np.eye(n)
         self.basis = np.eye(n)
         self.lengths = np.ones(n)
@@ -75,12 +92,12 @@ class AdaptiveEncoding:
 
     @classmethod
     def for_population(
-        cls, n: int, mu: int, *, eigen_every: int = 1
+        cls, n: int, mu: int, *, eigen_every: int = 1, max_condition=None
     ) -> "AdaptiveEncoding":
         """The learning rates CMA-ES uses for ``mu`` selected points of a
         sampled population (Hansen's tutorial, 2016, table 1);
-        `eigen_every` as in the class."""
-        enc = cls(n, mu, eigen_every=eigen_every)
+        `eigen_every` and `max_condition` as in the class."""
+        enc = cls(n, mu, eigen_every=eigen_every, max_condition=max_condition)
         mu_eff = 1.0 / float(np.sum(enc.weights**2))
         enc.c_p = (4.0 + mu_eff / n) / (n + 4.0 + 2.0 * mu_eff / n)
         enc.c_1 = 2.0 / ((n + 1.3) ** 2 + mu_eff)
@@ -149,6 +166,14 @@ class AdaptiveEncoding:
             # Rounding broke positive definiteness: keep the last metric.
             self.condition = math.inf
             return
+        if self.max_condition is not None and values[-1] > (
+            self.max_condition * values[0]
+        ):
+            # A direction every selected step favours grows without bound
+            # in the normalised update (the bent cigar's, to 1e13); keep
+            # the others' scale within reach of the poll's steps.
+            values = np.maximum(values, values[-1] / self.max_condition)
+            C = (vectors * values) @ vectors.T
         self.covariance = C
         d = np.sqrt(values)
         self.lengths = d

@@ -121,6 +121,14 @@ class LearnedMetricSpiral:
         last basis). Off by default: it cut the optimiser's own time at
         ``n = 40`` by a third but lost triples on BBOB (at D = 40 the
         ellipsoids' metric learned too slowly; figures in the BBOB results).
+    max_condition : float or None
+        Bound on the poll's metric's condition, ``>= 1`` (its eigenvalues
+        are raised to the largest over it); default 1e8. The normalised
+        update grows a direction that every period's best points favour
+        without bound (the bent cigar's, to 1e13, where the run collapsed
+        at 1e14); 1e8 leaves the 1e6 of BBOB's ill-conditioned functions
+        room, and the poll's steps carry any scale beyond it. None leaves
+        it unbounded.
     grow, shrink : float
         Step factors after a success (``> 1``) and a failure (in (0, 1));
         default 2 and 1/2, Adaptive Coordinate Descent's.
@@ -155,6 +163,7 @@ class LearnedMetricSpiral:
     sampling: str = "gaussian"
     run_stall: bool = True
     lazy_basis: bool = False
+    max_condition: float | None = 1e8
     grow: float = 2.0
     shrink: float = 0.5
     delta: float = 1e-3
@@ -175,6 +184,13 @@ class LearnedMetricSpiral:
             raise ValueError(
                 f"`sampling` must be one of {_SAMPLINGS}; got {self.sampling!r}"
             )
+        if self.max_condition is not None:
+            cap = positive(self.max_condition, "max_condition")
+            if cap < 1.0:
+                raise ValueError(
+                    f"`max_condition` must be >= 1 or None; got {self.max_condition!r}"
+                )
+            object.__setattr__(self, "max_condition", cap)
         grow = positive(self.grow, "grow")
         if grow <= 1.0:
             raise ValueError(f"`grow` must be > 1; got {self.grow!r}")
@@ -297,7 +313,12 @@ class LearnedMetricSearch(SearchBase):
         self._c = x[best].copy()
         self._f = float(f[best])
         self._steps = np.full(n, 0.25)
-        self._encoding = AdaptiveEncoding(n, n, eigen_every=self.rule.eigen_gap(n))
+        self._encoding = AdaptiveEncoding(
+            n,
+            n,
+            eigen_every=self.rule.eigen_gap(n),
+            max_condition=self.rule.max_condition,
+        )
         self._regime = "poll"
         self._flat = False
         self._m = m
