@@ -336,6 +336,7 @@ def test_x0_seeds_the_first_poll():
         ({"run_stall": "yes"}, "`run_stall` must be True or False"),
         ({"sampling": "sobol"}, "`sampling` must be one of"),
         ({"lazy_basis": 1}, "`lazy_basis` must be True or False"),
+        ({"suspend_crawl": 1}, "`suspend_crawl` must be True or False"),
         ({"max_condition": 0.5}, "`max_condition` must be >= 1 or None"),
     ],
 )
@@ -462,3 +463,59 @@ def test_a_capped_metric_keeps_its_axes_and_raises_the_small_eigenvalues():
     assert values[-1] / values[0] == pytest.approx(50.0, rel=1e-9)
     # The long axis is the x axis, as the steps are.
     assert abs(vectors[0, -1]) == pytest.approx(1.0, abs=1e-3)
+
+
+def _trail(f, steps, conditions):
+    return [
+        (float(a), float(b), float(c))
+        for a, b, c in zip(f, steps, conditions, strict=True)
+    ]
+
+
+def test_the_crawl_test_tells_a_crawl_from_a_converging_poll():
+    # n = 2: the window is 30 periods. A converging poll's gains shrink with
+    # the square of its steps (f = s^2 on a quadratic); a crawl's gains stay
+    # while its steps fall; a metric still growing its condition is spared.
+    search = LearnedMetricSearch(
+        _quadratic(np.eye(2)),
+        [(-1, 1)] * 2,
+        LearnedMetricSpiral(suspend_crawl=True),
+        n_points=4,
+        rng=0,
+    )
+    k = np.arange(61)
+    steps = 0.5 * 0.9**k
+    settled = np.full(k.size, 10.0)
+    search._trail = _trail(steps**2, steps, settled)
+    assert not search._crawling()
+    crawl = 1.0 - 1e-3 * k
+    search._trail = _trail(crawl, steps, settled)
+    assert search._crawling()
+    search._trail = _trail(crawl, steps, 10.0 * 2.0 ** (k / 30))
+    assert not search._crawling()  # condition doubled over the window
+    search._trail = _trail(crawl, steps, settled)[:-1]
+    assert not search._crawling()  # fewer than two windows
+
+
+def test_suspend_crawl_leaves_a_converging_run_alone():
+    # An ill-conditioned quadratic converges: no poll crawls, the run is the
+    # default's bit for bit.
+    H = _rotated_ellipsoid(6, 1e4, 1)
+    runs = [
+        minimize(
+            _quadratic(H),
+            [(-5, 5)] * 6,
+            LearnedMetricSpiral(suspend_crawl=flag),
+            max_nfev=6000,
+            rng=2,
+            restarts=Restarts(),
+        )
+        for flag in (False, True)
+    ]
+    # Until it converges; past 1e-10 the gains are rounding, which may crawl.
+    first = [int(np.argmax(r.history < 1e-10)) for r in runs]
+    assert runs[0].history[first[0]] < 1e-10
+    assert first[0] == first[1]
+    np.testing.assert_array_equal(
+        runs[0].history[: first[0] + 1], runs[1].history[: first[1] + 1]
+    )

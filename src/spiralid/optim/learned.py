@@ -80,6 +80,15 @@ _MAX_CONDITION = 1e14
 # IPOP-CMA-ES is run with on [-5, 5]^n).
 _SIGMA0 = 0.2
 _SAMPLINGS = ("gaussian", "orthogonal")
+# suspend_crawl: a poll crawls when, over its last `w` periods, its gains fell
+# by less than 1/_CRAWL_RATIO of the fall its steps' squares predict (a
+# converging run's gains shrink with the square of its steps) while the
+# metric's condition grew by less than _CRAWL_CONDITION (a metric still being
+# learned makes Rosenbrock and the discus look alike). The population run that
+# follows gets _HELD_SHARE of the poll's evaluations to do better.
+_CRAWL_RATIO = 10.0
+_CRAWL_CONDITION = 1.5
+_HELD_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -121,6 +130,17 @@ class LearnedMetricSpiral:
         last basis). Off by default: it cut the optimiser's own time at
         ``n = 40`` by a third but lost triples on BBOB (at D = 40 the
         ellipsoids' metric learned too slowly; figures in the BBOB results).
+    suspend_crawl : bool
+        With restarts, suspend a poll that crawls instead of letting it spend
+        the budget: a population run goes next, with half the poll's
+        evaluations; if it does not go below the poll's cost by then, the
+        poll resumes where it stopped (once; it is not suspended again). A
+        poll crawls when, over its last ``max(30, 4 n)`` periods, its gains
+        fell by less than a tenth of what the fall of its largest step
+        predicts for a converging run (the square), while the metric's
+        condition grew by less than 1.5. Off by default: on BBOB at D = 20
+        it gains the attractive sector and Schaffer's functions and loses on
+        Rosenbrock and the bent cigar (figures in the BBOB results).
     max_condition : float or None
         Bound on the poll's metric's condition, ``>= 1`` (its eigenvalues
         are raised to the largest over it); default 1e8. The normalised
@@ -163,6 +183,7 @@ class LearnedMetricSpiral:
     sampling: str = "gaussian"
     run_stall: bool = True
     lazy_basis: bool = False
+    suspend_crawl: bool = False
     max_condition: float | None = 1e8
     grow: float = 2.0
     shrink: float = 0.5
@@ -177,6 +198,7 @@ class LearnedMetricSpiral:
             "populations",
             "run_stall",
             "lazy_basis",
+            "suspend_crawl",
         ):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"`{name}` must be True or False")
@@ -285,6 +307,9 @@ class LearnedMetricSearch(SearchBase):
         self._best = (None, math.inf)
         self._spent = {"poll": 0, "population": 0}
         self._population = default_population(n) // 2
+        self._held = None
+        self._held_nfev = 0
+        self._resumed = False
         self._polled = np.empty((2 * n, n))
         self._polled_f = np.empty(2 * n)
         self._start_poll(seed_points(x0, self._lo, self._hi, m), m)
@@ -325,6 +350,9 @@ class LearnedMetricSearch(SearchBase):
         self._run_nfev = self.nfev - m
         self._run_best = self._f
         self.last_move = self.nit
+        self._resumed = False
+        self._trail = []
+        self._crawled = False
 
     def _start_population(self, size: int) -> None:
         """Start a population run of `size` points around a uniform centre."""
@@ -343,6 +371,8 @@ class LearnedMetricSearch(SearchBase):
         self._run_nfev = self.nfev - 1
         self._run_best = self._f
         self.last_move = self.nit
+        self._trail = []
+        self._crawled = False
 
     def restart(self, n_points: int, max_iter: int | None = None) -> None:
         """Start a new run: a poll from the best of ``n_points`` fresh
@@ -352,13 +382,60 @@ class LearnedMetricSearch(SearchBase):
         m = integer(n_points, "n_points", 1)
         self._set_budget(max_iter)
         self._spent[self._regime] += self.nfev - self._run_nfev
+        if self._crawled:
+            # The crawling poll waits; a population run goes next.
+            self._held = (self._c, self._f, self._steps, self._encoding, self._m)
+            self._held_nfev = self.nfev - self._run_nfev
+            self._population *= 2
+            self._start_population(self._population)
+        elif self._held is not None and self._held[1] < self._run_best:
+            held, self._held = self._held, None
+            self._resume(held)
+        else:
+            self._held = None  # the population run did better: drop the poll
+            self._next_run(m)
+        self.restarts += 1
+        self.history.append(self.fun)
+
+    def _next_run(self, m: int) -> None:
+        """BIPOP's rule: the regime whose runs have spent fewer evaluations."""
         if self.rule.populations and self._spent["population"] <= self._spent["poll"]:
             self._population *= 2
             self._start_population(self._population)
         else:
             self._start_poll(np.empty((0, self._lo.size)), m)
-        self.restarts += 1
-        self.history.append(self.fun)
+
+    def _resume(self, held: tuple) -> None:
+        """Resume a suspended poll where it stopped, never to be suspended
+        again."""
+        self._c, self._f, self._steps, self._encoding, self._m = held
+        self._regime = "poll"
+        self._flat = False
+        self._run_nfev = self.nfev
+        self._run_best = self._f
+        self.last_move = self.nit
+        self._resumed = True
+        self._trail = []
+        self._crawled = False
+
+    def _crawling(self) -> bool:
+        """Whether the poll crawls (see `suspend_crawl`)."""
+        w = max(30, 4 * self._lo.size)
+        trail = self._trail
+        if len(trail) <= 2 * w:
+            return False
+        (old, _, _), (mid, mid_step, mid_cond), (now, now_step, now_cond) = (
+            trail[-2 * w - 1],
+            trail[-w - 1],
+            trail[-1],
+        )
+        recent = mid - now
+        fall = (mid_step / now_step) ** 2
+        return (
+            recent > 0.0
+            and (old - mid) * _CRAWL_RATIO < recent * fall
+            and now_cond < _CRAWL_CONDITION * mid_cond
+        )
 
     def next_step_cost(self) -> int:
         """At most this many evaluations in the next :meth:`step`."""
@@ -381,6 +458,21 @@ class LearnedMetricSearch(SearchBase):
         if best < self._run_best:
             self._run_best = best
             self.last_move = self.nit
+        rule = self.rule
+        if (
+            rule.suspend_crawl
+            and rule.populations
+            and self._regime == "poll"
+            and not self._resumed
+        ):
+            self._trail.append(
+                (
+                    self._run_best,
+                    float(self._step_lengths().max()),
+                    self._encoding.condition,
+                )
+            )
+            self._crawled = self._crawling()
         self.history.append(self.fun)
         self._mean_step.append(float(self._step_lengths().mean()))
         return self.x, self.fun
@@ -545,8 +637,16 @@ class LearnedMetricSearch(SearchBase):
     def collapsed(self, restarts: Restarts) -> bool:
         """Whether the current run has collapsed by ``restarts``' criteria
         (see the module's description)."""
+        if (
+            self._held is not None
+            and self._regime == "population"
+            and self.nfev - self._run_nfev > _HELD_SHARE * self._held_nfev
+            and self._run_best >= self._held[1]
+        ):
+            return True  # the suspended poll is better: resume it
         return (
-            self._flat
+            self._crawled
+            or self._flat
             or self.nit - self.last_move >= restarts.stall_for(self._lo.size)
             or float(self._step_lengths().max()) <= restarts.tol_radius
             or self._encoding.condition > _MAX_CONDITION
