@@ -94,7 +94,7 @@ INGREDIENTS = {
     "learned-metric-global-stall": LearnedMetricSpiral(run_stall=False),
     "learned-metric-lazy": LearnedMetricSpiral(lazy_basis=True),
     "learned-metric-uncapped": LearnedMetricSpiral(max_condition=None),
-    "learned-metric-suspend": LearnedMetricSpiral(suspend_crawl=True),
+    "learned-metric-no-suspend": LearnedMetricSpiral(suspend_crawl=False),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

@@ -84,10 +84,15 @@ _SAMPLINGS = ("gaussian", "orthogonal")
 # by less than 1/_CRAWL_RATIO of the fall its steps' squares predict (a
 # converging run's gains shrink with the square of its steps) while the
 # metric's condition grew by less than _CRAWL_CONDITION (a metric still being
-# learned makes Rosenbrock and the discus look alike). The population run that
-# follows gets _HELD_SHARE of the poll's evaluations to do better.
+# learned makes Rosenbrock and the discus look alike), its largest step is
+# below _CRAWL_STEP of the box (Rosenbrock's valley is followed with larger
+# ones) and the condition below _CRAWL_MAX_CONDITION (a metric at the cap is
+# still stretching: the bent cigar). The population run that follows gets
+# _HELD_SHARE of the poll's evaluations to do better.
 _CRAWL_RATIO = 10.0
 _CRAWL_CONDITION = 1.5
+_CRAWL_STEP = 1e-3
+_CRAWL_MAX_CONDITION = 1e7
 _HELD_SHARE = 0.5
 
 
@@ -138,9 +143,10 @@ class LearnedMetricSpiral:
         poll crawls when, over its last ``max(30, 4 n)`` periods, its gains
         fell by less than a tenth of what the fall of its largest step
         predicts for a converging run (the square), while the metric's
-        condition grew by less than 1.5. Off by default: on BBOB at D = 20
-        it gains the attractive sector and Schaffer's functions and loses on
-        Rosenbrock and the bent cigar (figures in the BBOB results).
+        condition grew by less than 1.5 and stays below 1e7, with its
+        largest step below 1e-3 of the box. Default True: on BBOB at D = 20
+        it gains the attractive sector and Schaffer's functions (figures in
+        the BBOB results); a converging poll is left alone.
     max_condition : float or None
         Bound on the poll's metric's condition, ``>= 1`` (its eigenvalues
         are raised to the largest over it); default 1e8. The normalised
@@ -183,7 +189,7 @@ class LearnedMetricSpiral:
     sampling: str = "gaussian"
     run_stall: bool = True
     lazy_basis: bool = False
-    suspend_crawl: bool = False
+    suspend_crawl: bool = True
     max_condition: float | None = 1e8
     grow: float = 2.0
     shrink: float = 0.5
@@ -435,6 +441,8 @@ class LearnedMetricSearch(SearchBase):
             recent > 0.0
             and (old - mid) * _CRAWL_RATIO < recent * fall
             and now_cond < _CRAWL_CONDITION * mid_cond
+            and now_step < _CRAWL_STEP
+            and now_cond < _CRAWL_MAX_CONDITION
         )
 
     def next_step_cost(self) -> int:
