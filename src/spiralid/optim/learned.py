@@ -42,6 +42,9 @@ metric they are taken in:
    over the best half is what lets a large population see through local
    minima; the population doubles at each such restart, as in IPOP. The
    regime whose runs have spent fewer evaluations goes next (BIPOP's rule).
+   A poll that crawls (its gains fall far slower than its steps' squares)
+   is suspended for a population run, and resumed if that run does no
+   better (``suspend_crawl``).
 
 The search runs in the box scaled to the unit cube, so the basis starts as
 the box's own axes and the first poll steps are a quarter of its widths. A
