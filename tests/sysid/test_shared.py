@@ -5,41 +5,15 @@ cost, estimate and model (`sysid/estimation/shared.py`,
 import numpy as np
 import pytest
 from scipy import signal
+from two_modes import MODES, TS, A, B, record
 
 from spiralid.sysid import ARX, IOData, PaperCost, identify, validate
 from spiralid.sysid.estimation.shared import SharedProjectedCost
 from spiralid.sysid.models.shared import SharedDenominatorModel
 
-TS = 0.01
-# Two modes at 3 Hz (damping 0.03) and 11 Hz (0.05), sampled by zero-order hold.
-MODES = ((3.0, 0.03), (11.0, 0.05))
-
-
-def _denominator() -> np.ndarray:
-    poles = []
-    for f, zeta in MODES:
-        wn = 2 * np.pi * f
-        s = -zeta * wn + 1j * wn * np.sqrt(1 - zeta**2)
-        poles += [np.exp(s * TS), np.exp(np.conj(s) * TS)]
-    return np.poly(poles).real
-
-
-A = _denominator()
-# Sensor 2 sits near a node of the 11 Hz mode: its numerator nearly cancels
-# that pole pair in its own response (the zeros put on it).
-B = np.array([[0.0, 0.02, 0.015, -0.01, 0.004], [0.0, 0.01, 0.0, 0.0, 0.0]])
-
-
-def _record(seed=0, n=1500, noise=(0.002, 0.002)) -> IOData:
-    rng = np.random.default_rng(seed)
-    u = rng.standard_normal(n)
-    y = np.column_stack([signal.lfilter(b, A, u) for b in B])
-    y += rng.standard_normal(y.shape) * np.array(noise)
-    return IOData(u, y, ts=TS, output_name=("near", "far"), output_unit=("m", "m"))
-
 
 def test_the_shared_cost_of_one_output_is_the_papers_cost():
-    data = _record().output(0)
+    data = record().output(0)
     arx = ARX(4, 4, 1)
     shared = SharedProjectedCost(arx, data)
     a = A[1:] * 0.99 ** np.arange(1, 5)
@@ -50,7 +24,7 @@ def test_the_shared_cost_of_one_output_is_the_papers_cost():
 
 
 def test_two_outputs_give_one_denominator_with_intervals_that_hold_the_truth():
-    data = _record(1)
+    data = record(1)
     fit = identify(data, ARX(4, 4, 1), rng=0, max_nfev=3000)
     assert isinstance(fit, SharedDenominatorModel) and fit.n_outputs == 2
     np.testing.assert_allclose(fit.a, A[1:], atol=2e-3)
@@ -67,7 +41,7 @@ def test_two_outputs_give_one_denominator_with_intervals_that_hold_the_truth():
 
 
 def test_noise_weights_come_from_the_first_fit():
-    data = _record(2, noise=(0.0005, 0.02))
+    data = record(2, noise=(0.0005, 0.02))
     fit = identify(data, ARX(4, 4, 1), rng=0, max_nfev=2000)
     # 1 / sigma^2: the quiet sensor weighs about (0.02 / 0.0005)^2 more.
     ratio = fit.weights[0] / fit.weights[1]
@@ -77,25 +51,25 @@ def test_noise_weights_come_from_the_first_fit():
 
 
 def test_the_model_round_trips_through_json_and_refuses_bad_input():
-    fit = identify(_record(3), ARX(4, 4, 1), rng=0, max_nfev=1000)
+    fit = identify(record(3), ARX(4, 4, 1), rng=0, max_nfev=1000)
     again = SharedDenominatorModel.from_dict(fit.to_dict())
     np.testing.assert_array_equal(again.a, fit.a)
     np.testing.assert_array_equal(again.b, fit.b)
     assert again.output_names == ("near", "far")
     np.testing.assert_array_equal(again.simulate(np.ones(5)), fit.simulate(np.ones(5)))
     with pytest.raises(ValueError, match="`weights` must be 2 finite numbers"):
-        identify(_record(3), ARX(4, 4, 1), weights=[1.0, -1.0])
+        identify(record(3), ARX(4, 4, 1), weights=[1.0, -1.0])
     with pytest.raises(ValueError, match="`method` 'sda' takes one output"):
-        identify(_record(3), ARX(4, 4, 1), method="sda")
+        identify(record(3), ARX(4, 4, 1), method="sda")
     with pytest.raises(ValueError, match="`max_nfev` does not apply to method 'oe'"):
-        identify(_record(3), ARX(4, 4, 1), method="oe", max_nfev=100)
+        identify(record(3), ARX(4, 4, 1), method="oe", max_nfev=100)
     with pytest.raises(ValueError, match="`refine` does not apply to method 'spiral'"):
-        identify(_record(3), ARX(4, 4, 1), refine=True)
+        identify(record(3), ARX(4, 4, 1), refine=True)
 
 
 def test_to_control_is_a_simo_system():
     control = pytest.importorskip("control")
-    fit = identify(_record(4), ARX(4, 4, 1), rng=0, max_nfev=1000)
+    fit = identify(record(4), ARX(4, 4, 1), rng=0, max_nfev=1000)
     sys = fit.to_control()
     assert (sys.noutputs, sys.ninputs) == (2, 1) and sys.dt == TS
     _, y = control.forced_response(sys, U=np.r_[1.0, np.zeros(49)])
@@ -105,7 +79,7 @@ def test_to_control_is_a_simo_system():
 def test_each_output_is_validated_and_the_joint_fit_combines_them():
     from spiralid.sysid import joint_fit, validate_outputs
 
-    est, val = _record(5).split(2 / 3)
+    est, val = record(5).split(2 / 3)
     fit = identify(est, ARX(4, 4, 1), rng=0, max_nfev=1000)
     report = validate_outputs(fit, val, warmup=est)
     fits = [v.fit_percent for v in report.outputs.values()]
@@ -124,7 +98,7 @@ def test_each_output_is_validated_and_the_joint_fit_combines_them():
 
 
 def test_output_error_and_least_squares_for_the_same_structure():
-    data = _record(6)
+    data = record(6)
     oe = identify(data, ARX(4, 4, 1), method="oe")
     spiral = identify(data, ARX(4, 4, 1), rng=0, max_nfev=2000)
     ls = identify(data, ARX(4, 4, 1), method="ls")
@@ -191,7 +165,7 @@ def test_the_stabilisation_diagram_keeps_the_true_modes_and_flags_the_rest():
     assert _classify(prev_f, prev_z, 10.05, 0.0205, 0.01, 0.05) == "stable"
     assert _classify(prev_f, prev_z, 10.05, 0.03, 0.01, 0.05) == "frequency"
     assert _classify(prev_f, prev_z, 20.0, 0.02, 0.01, 0.05) == "new"
-    diagram = stabilisation(_record(8), [4, 6, 8], nk=1, rng=0, max_nfev=1500)
+    diagram = stabilisation(record(8), [4, 6, 8], nk=1, rng=0, max_nfev=1500)
     assert diagram.orders == (4, 6, 8)
     stable = diagram.stable_modes(min_orders=3)
     np.testing.assert_allclose(stable, [f for f, _ in MODES], rtol=1e-3)
@@ -199,13 +173,13 @@ def test_the_stabilisation_diagram_keeps_the_true_modes_and_flags_the_rest():
     assert set(first) == {"new"}  # nothing below the first order
     assert diagram.to_dict()["modes"][0]["order"] == 4
     with pytest.raises(ValueError, match="`orders` must be"):
-        stabilisation(_record(8), [0, 2])
+        stabilisation(record(8), [0, 2])
 
 
 def test_the_stabilisation_figure_draws_every_mode():
     from spiralid.sysid import plots, stabilisation
 
-    data = _record(9)
+    data = record(9)
     diagram = stabilisation(data, [4, 6], nk=1, rng=0, max_nfev=800)
     fig = plots.plot_stabilisation(diagram, data)
     ax = fig.axes[0]
@@ -221,7 +195,7 @@ def test_the_search_never_ends_above_output_error():
     # The spiral's best is polished beside output error's starts, and the
     # lowest cost kept (before the noise weights, which both then share).
     for seed in range(3):
-        data = _record(20 + seed, noise=(0.01, 0.004))
+        data = record(20 + seed, noise=(0.01, 0.004))
         spiral = identify(data, ARX(4, 4, 1), rng=seed, max_nfev=300, weights=[1, 1])
         oe = identify(data, ARX(4, 4, 1), method="oe", weights=[1, 1])
         assert spiral.cost <= oe.cost * (1 + 1e-12)
@@ -256,7 +230,7 @@ def test_a_sensor_at_a_node_of_a_mode_still_gets_that_mode_from_the_others():
 def test_the_subspace_poles_are_the_true_ones_and_a_short_record_is_refused():
     from spiralid.sysid import subspace_denominator
 
-    data = _record(30, noise=(0.0005, 0.0005))
+    data = record(30, noise=(0.0005, 0.0005))
     a = subspace_denominator(data, 4)
     np.testing.assert_allclose(np.sort_complex(np.roots(np.r_[1.0, a])),
                                np.sort_complex(np.roots(A)), atol=5e-3)  # fmt: skip
@@ -268,7 +242,7 @@ def test_output_error_starts_from_the_subspace_poles_too():
     from spiralid.sysid.estimation.modal import ModalParametrization
     from spiralid.sysid.estimation.shared import SharedProjectedCost, _subspace_start
 
-    data = _record(31)
+    data = record(31)
     par = ModalParametrization(4, TS)
     start = _subspace_start(SharedProjectedCost(ARX(4, 4, 1), data), par)
     # The subspace poles, as modal coordinates, are the true modes.
@@ -318,7 +292,7 @@ def test_the_covariance_is_s2_over_the_stacked_jacobian_with_its_factor():
     # freedom; the factor R (C = R^T R) gives the same standard errors.
     from spiralid.sysid.models.modes import mode_table
 
-    data = _record(12)
+    data = record(12)
     arx = ARX(4, 4, 1)
     fit = identify(data, arx, method="oe")
     cost = SharedProjectedCost(arx, data, fit.weights)

@@ -9,39 +9,14 @@ import math
 import numpy as np
 import pytest
 from clitools import run
-from scipy import signal
+from two_modes import TS, record
 
 from spiralid.sysid import ARX, IOData, identify, load_model
 from spiralid.sysid.models.shared import SharedDenominatorModel
 
-TS = 0.01
-# Modes at 3 Hz (damping 0.03) and 11 Hz (0.05), by zero-order hold.
-MODES = ((3.0, 0.03), (11.0, 0.05))
-
-
-def _denominator() -> np.ndarray:
-    poles = []
-    for f, zeta in MODES:
-        wn = 2 * np.pi * f
-        s = complex(-zeta * wn, wn * math.sqrt(1 - zeta**2))
-        poles += [np.exp(s * TS), np.exp(s.conjugate() * TS)]
-    return np.poly(poles).real
-
-
-A = _denominator()
-B = np.array([[0.0, 0.02, 0.015, -0.01, 0.004], [0.0, 0.01, 0.0, 0.0, 0.0]])
-
-
-def _signals(seed=0, n=900):
-    rng = np.random.default_rng(seed)
-    u = rng.standard_normal(n)
-    y = np.column_stack([signal.lfilter(b, A, u) for b in B])
-    return u, y + 0.002 * rng.standard_normal(y.shape)
-
 
 def _record(seed=0) -> IOData:
-    u, y = _signals(seed)
-    return IOData(u, y, ts=TS, output_name=("near", "far"))
+    return record(seed, n=900)
 
 
 @pytest.mark.parametrize(
@@ -93,7 +68,8 @@ def test_a_file_written_before_loads_without_timings(timings):
 
 
 def test_identify_twice_with_one_seed_writes_the_same_model_json(tmp_path):
-    u, y = _signals(3)
+    rec = _record(3)
+    u, y = rec.u, rec.y
     np.savez(tmp_path / "rec.npz", u=u, near=y[:, 0], far=y[:, 1], ts=TS)
     folders = ("first", "second")
     for out in folders:
