@@ -21,6 +21,13 @@ fit % (``100 (1 - |y - yhat| / |y - mean y|)``) and the seconds of:
   NARXNN, one hidden layer of 10 tanh units, Adam, 200 epochs of one-step
   training on the scaled signals, the same lags, run free.
 
+Diagnostics (``--methods``): ``narx-holdout0``, the default NARX with
+nothing held back (``holdout=0``: up to 50 rounds on the whole estimation
+part); ``narx-fair``, :func:`fair_stopping`. The NARX rows run for every
+seed of ``--seeds`` (the ARX and the order choice use seed 0; FROLS is not
+random) and say whether training kept the linear start or how many final
+Levenberg-Marquardt rounds it ran.
+
 SysIdentPy pins ``numpy<=2.3.5``: run its rows from a separate virtual
 environment holding spiralid and sysidentpy (``--methods sipy,sipy-nn``,
 ``--lags`` to reuse the lags the main run chose).
@@ -70,8 +77,8 @@ Records (files looked for in ``DIR``; a missing file skips its record):
     validation on the last 512 (their split). Copy: the same RGP folder.
 
 Usage: ``python benchmarks/real_records.py --data DIR [--records a,b]
-[--methods arx,narx,poly,sipy,sipy-nn] [--orders 1,2,3,4,6] [--seed 0]
-[--lags "record=n,nk,k;..."]`` (minutes per record at most, one process).
+[--methods arx,narx,poly,sipy,sipy-nn] [--orders 1,2,3,4,6] [--seeds 0-4]
+[--lags "record=n,k;..."]`` (minutes per record at most, one process).
 """
 
 from __future__ import annotations
@@ -269,10 +276,40 @@ def _sipy_nn(est, val, joined, n, nk, k, seed):
     return yf[est.n :] if joined else yf
 
 
-def run(rec: Record, methods, orders, seed: int, lags=None) -> None:
+def fair_stopping(est: IOData, st: NARX, seed: int):
+    """Diagnostic: the early stopping of ``identify(est, st, method="oe")``
+    with a linear start fitted on the training part only.
+
+    The default NARX's linear start is fitted on the whole estimation part,
+    the held-back fifth included, so on that fifth it is scored in-sample
+    while the network's rounds are scored out of sample. Here the start is
+    the default ARX of the first four fifths; the round count with the
+    lowest held-back cost is then run from the usual start on the whole
+    part (``holdout=0``). Uses private training code (``narx._with_hidden``,
+    ``NARXProblem.polish``); ``st`` without integrator.
+    """
+    from spiralid.sysid.estimation.narx import _with_hidden
+    from spiralid.sysid.estimation.narx_problem import NARXProblem
+
+    prob = NARXProblem(est, st, "simulation", "rest", 0.2, np.random.default_rng(seed))
+    prob.decay = 1e-3
+    part = IOData(est.u[: prob.split], est.y[: prob.split], ts=est.ts)
+    theta = np.asarray(identify(part, ARX(st.ny, st.nu, st.nk), rng=seed).theta)
+    start = _with_hidden(
+        prob, st.from_arx(theta[: st.ny], theta[st.ny :], prob.scaling)
+    )
+    _, rounds = prob.polish(start, "simulation", 50, 3)
+    if rounds == 0:
+        # The start itself: the whole part's linear model, which the NARX holds.
+        return identify(est, ARX(st.ny, st.nu, st.nk), rng=seed), 0
+    opts = {"holdout": 0.0, "max_rounds": rounds, "patience": rounds + 1}
+    return identify(est, st, method="oe", rng=seed, **opts), rounds
+
+
+def run(rec: Record, methods, orders, seeds, lags=None) -> None:
     est, val = detrended(rec)
     t0 = time.perf_counter()
-    n, k = lags if lags else choose_arx(est, rec, orders, seed)
+    n, k = lags if lags else choose_arx(est, rec, orders, 0)
     t_choice = time.perf_counter() - t0
     nk = rec.nk
     print(
@@ -281,14 +318,18 @@ def run(rec: Record, methods, orders, seed: int, lags=None) -> None:
         f"({'given' if lags else f'{t_choice:.1f} s of order choice'})",
         flush=True,
     )
-    print("| model | validation fit % | s |\n|---|---|---|", flush=True)
+    print("| model | seed | validation fit % | s | note |", flush=True)
+    print("|---|---|---|---|---|", flush=True)
 
-    def row(label, fn):
+    def row(label, seed, fn):
         t = time.perf_counter()
+        note = ""
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 yhat = fn()
+            if isinstance(yhat, tuple):
+                yhat, note = yhat
             ok = np.all(np.isfinite(yhat))
             fit = fit_percent(val.y, yhat) if ok else -np.inf
             fit = f"{fit:.2f}" if fit > -999 else "diverges"
@@ -296,33 +337,75 @@ def run(rec: Record, methods, orders, seed: int, lags=None) -> None:
             return
         except Exception as exc:  # a failing model is reported, not hidden
             fit = f"fails: {type(exc).__name__}: {str(exc)[:80]}"
-        print(f"| {label} | {fit} | {time.perf_counter() - t:.1f} |", flush=True)
+        wall = time.perf_counter() - t
+        print(f"| {label} | {seed} | {fit} | {wall:.1f} | {note} |", flush=True)
 
     def sim(model):
         return free_run(model.simulate, est, val, rec.joined)
 
+    def narx_note(model):
+        r = model.result
+        if r.get("kept_linear"):
+            return "kept the linear start"
+        rounds = r.get("final_rounds", r.get("nit"))
+        return f"start {r.get('start')}, {rounds} final rounds"
+
     if "arx" in methods:
         row(
             f"ARX({n}, {n}, {nk}), integrator={k}, default method",
-            lambda: sim(identify(est, ARX(n, n, nk), integrator=k, rng=seed)),
+            0,
+            lambda: sim(identify(est, ARX(n, n, nk), integrator=k, rng=0)),
         )
     ny = n - 1 if k else n
-    if "narx" in methods:
-        st = NARX(ny, n, nk, integrator=k)
-        row(
-            f"NARX({ny}, {n}, {nk}), integrator={k}, default",
-            lambda: sim(identify(est, st, rng=seed)),
-        )
+    st = NARX(ny, n, nk, integrator=k)
+    for seed in seeds:
+        if "narx" in methods:
+
+            def fit_narx(seed=seed):
+                m = identify(est, st, rng=seed)
+                return sim(m), narx_note(m)
+
+            row(f"NARX({ny}, {n}, {nk}), integrator={k}, default", seed, fit_narx)
+        if "narx-holdout0" in methods:
+
+            def fit_h0(seed=seed):
+                m = identify(est, st, rng=seed, holdout=0.0)
+                return sim(m), narx_note(m)
+
+            row(f"NARX({ny}, {n}, {nk}), holdout=0", seed, fit_h0)
+        if "narx-fair" in methods and not k:
+
+            def fit_fair(seed=seed):
+                m, rounds = fair_stopping(est, st, seed)
+                return sim(m), f"{rounds} rounds chosen"
+
+            row(f"NARX({ny}, {n}, {nk}) oe, fair early stopping", seed, fit_fair)
     if "poly" in methods and k <= 1:
         pn = PolynomialNARX(ny, n, nk, degree=2, n_terms=15, integrator=bool(k))
-        row(f"PolynomialNARX({ny}, {n}, {nk}) FROLS", lambda: sim(identify(est, pn)))
-    if "sipy" in methods:
-        row("SysIdentPy FROLS", lambda: _sipy_frols(est, val, rec.joined, n, nk, k))
-    if "sipy-nn" in methods:
         row(
-            "SysIdentPy neural NARX",
-            lambda: _sipy_nn(est, val, rec.joined, n, nk, k, seed),
+            f"PolynomialNARX({ny}, {n}, {nk}) FROLS",
+            "-",
+            lambda: sim(identify(est, pn)),
         )
+    if "sipy" in methods:
+        row(
+            "SysIdentPy FROLS", "-", lambda: _sipy_frols(est, val, rec.joined, n, nk, k)
+        )
+    if "sipy-nn" in methods:
+        for seed in seeds:
+            row(
+                "SysIdentPy neural NARX",
+                seed,
+                lambda seed=seed: _sipy_nn(est, val, rec.joined, n, nk, k, seed),
+            )
+
+
+def _seeds(text: str) -> list[int]:
+    """``"0-4"`` or ``"0,3"``."""
+    if "-" in text:
+        a, b = text.split("-")
+        return list(range(int(a), int(b) + 1))
+    return [int(x) for x in text.split(",")]
 
 
 def main() -> None:
@@ -331,7 +414,9 @@ def main() -> None:
     ap.add_argument("--records", default="", help="names to run (default: all found)")
     ap.add_argument("--methods", default="arx,narx,poly,sipy,sipy-nn")
     ap.add_argument("--orders", default="1,2,3,4,6")
-    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument(
+        "--seeds", default="0", help="of the NARX and the neural peer: 0-4 or 0,3"
+    )
     ap.add_argument("--silverbox-est", type=int, default=17384)
     ap.add_argument("--lags", default="", help='"record=n,k;..." instead of the choice')
     args = ap.parse_args()
@@ -351,7 +436,7 @@ def main() -> None:
         print(f"# load average at start: {fh.read().split()[:3]}")
     t0 = time.perf_counter()
     for rec in records:
-        run(rec, methods, orders, args.seed, given.get(rec.name))
+        run(rec, methods, orders, _seeds(args.seeds), given.get(rec.name))
     print(f"\n# {time.perf_counter() - t0:.0f} s in all")
 
 
