@@ -266,8 +266,10 @@ def identify(
 
     For a NARX structure every method takes ``rng``, ``predictor``,
     ``initial``, ``holdout`` and ``decay``, and: ``"ls"`` and ``"oe"``
-    ``max_rounds``, ``patience``; ``"spiral"`` ``rule``, ``n_points``,
-    ``max_nfev``, ``polish_every``, ``polish_nfev``, ``max_iter``; a rule
+    ``max_rounds``, ``patience``, ``patience_share``; ``"spiral"``
+    ``rule``, ``n_points``, ``max_nfev``, ``polish_every``,
+    ``polish_nfev``, ``max_iter``, ``max_rounds``, ``patience``,
+    ``patience_share``; a rule
     ``n_points``, ``max_iter``, ``max_nfev``, ``max_time``, ``target``,
     ``x0``, ``callback``, ``bounds_policy``, ``restarts``. A
     PolynomialNARX (``"ls"`` only) takes ``rng``, ``predictor`` and

@@ -40,7 +40,11 @@ free run covers the whole record but the training residuals only the part
 before it; Levenberg-Marquardt (:mod:`.levenberg`, the one implementation
 of the ARX polish too) runs in rounds of 10 evaluations and stops
 after `patience` (3) rounds without a lower held-back cost, returning the
-parameters with the lowest held-back cost. Searches minimise the training
+parameters with the lowest held-back cost. For the default method the
+patience grows with the best round (``patience_share=0.5``: a polish whose
+best round is 100 waits 50 rounds) and the cap of 500 rounds is a safety,
+so the held-back cost decides the training length; ``"ls"`` and ``"oe"``
+keep a fixed patience and 50 rounds. Searches minimise the training
 cost only. The Levenberg-Marquardt fits add a weight decay on the
 network's weights (``decay``, default 1e-3; see :func:`identify_narx`).
 The reported ``cost`` is the paper's (eq. (2) with the gain
@@ -65,7 +69,15 @@ from ..models.arx import ARX, arx_least_squares
 from ..models.narx import NARX, NARXModel, PolynomialNARX
 from .frols import frols
 from .levenberg import levenberg_marquardt
-from .narx_problem import _TOL, NARXProblem, narx_result
+from .narx_problem import (
+    _TOL,
+    MAX_ROUNDS,
+    PATIENCE,
+    PATIENCE_SHARE,
+    NARXProblem,
+    narx_result,
+    stopping_options,
+)
 
 __all__ = ["NARXProblem", "identify_narx"]
 
@@ -132,11 +144,12 @@ def _fit(problem: NARXProblem, starts: dict, predictor: str, options: dict):
     thrown away. Returns ``(params, start name, rounds)``; with nothing
     held back the rounds run until `max_rounds` or convergence.
     """
-    max_rounds = options.get("max_rounds", 50)
-    patience = options.get("patience", 3)
+    max_rounds = options.get("max_rounds", MAX_ROUNDS)
+    patience = options.get("patience", PATIENCE)
+    share = options.get("patience_share", PATIENCE_SHARE)
     best = None
     for name, p0 in starts.items():
-        p, rounds = problem.polish(p0, predictor, max_rounds, patience)
+        p, rounds = problem.polish(p0, predictor, max_rounds, patience, share)
         pick = 1 if problem.hold is not None else 0
         score = problem._score(p, predictor, pick)
         if best is None or score < best[0]:
@@ -145,7 +158,7 @@ def _fit(problem: NARXProblem, starts: dict, predictor: str, options: dict):
     if problem.hold is None:
         return p, name, rounds
     whole = problem.whole()
-    p, _ = whole.polish(starts[name], predictor, rounds, patience=rounds + 1)
+    p, _ = whole.polish(starts[name], predictor, rounds, rounds + 1, 0.0)
     problem.nfev += whole.nfev
     return p, name, rounds
 
@@ -184,7 +197,11 @@ def _train(problem, starts: dict, linear, predictor: str, options: dict, t0, **e
 
 
 def estimate_ls(
-    problem: NARXProblem, *, max_rounds: int = 50, patience: int = 3
+    problem: NARXProblem,
+    *,
+    max_rounds: int = 50,
+    patience: int = 3,
+    patience_share: float = 0.0,
 ) -> OptimiserResult:
     """``"ls"``: one-step least squares (LM for the MLP, FROLS for the
     polynomial).
@@ -194,6 +211,10 @@ def estimate_ls(
     problem : NARXProblem
     max_rounds, patience : int
         Of the early stopping (:meth:`NARXProblem.polish`).
+    patience_share : float
+        Of the early stopping: the patience grows to this share of the best
+        round (0: the fixed `patience`, this method's default; the default
+        method ``"spiral"`` uses 0.5 and 500 rounds).
 
     Returns
     -------
@@ -204,7 +225,7 @@ def estimate_ls(
     t0 = time.perf_counter()
     linear, what = _linear_start(problem, "ls")
     start = _starting_network(problem, linear)
-    options = {"max_rounds": max_rounds, "patience": patience}
+    options = stopping_options(max_rounds, patience, patience_share)
     return _train(
         problem,
         {"linear": start},
@@ -226,7 +247,11 @@ def _starting_network(problem: NARXProblem, linear) -> np.ndarray:
 
 
 def estimate_oe(
-    problem: NARXProblem, *, max_rounds: int = 50, patience: int = 3
+    problem: NARXProblem,
+    *,
+    max_rounds: int = 50,
+    patience: int = 3,
+    patience_share: float = 0.0,
 ) -> OptimiserResult:
     """``"oe"``: the gradient baseline on the predictor's error, from the
     linear start (:func:`_linear_start`).
@@ -236,6 +261,10 @@ def estimate_oe(
     problem : NARXProblem
     max_rounds, patience : int
         Of the early stopping (:meth:`NARXProblem.polish`).
+    patience_share : float
+        Of the early stopping: the patience grows to this share of the best
+        round (0: the fixed `patience`, this method's default; the default
+        method ``"spiral"`` uses 0.5 and 500 rounds).
 
     Returns
     -------
@@ -252,7 +281,7 @@ def estimate_oe(
     t0 = time.perf_counter()
     linear, what = _linear_start(problem)
     start = _starting_network(problem, linear)
-    options = {"max_rounds": max_rounds, "patience": patience}
+    options = stopping_options(max_rounds, patience, patience_share)
     return _train(
         problem,
         {"linear": start},
@@ -340,6 +369,9 @@ def estimate_spiral(
     polish_every: int = 10,
     polish_nfev: int = 5,
     max_iter: int | None = None,
+    max_rounds: int = MAX_ROUNDS,
+    patience: int = PATIENCE,
+    patience_share: float = PATIENCE_SHARE,
 ) -> OptimiserResult:
     """``"spiral"``: Eb-SDA with safe starts and a memetic polish.
 
@@ -363,6 +395,16 @@ def estimate_spiral(
         are the values the NARX method was added with, not tuned since.
     max_iter : int, optional
         Cap on the iterations.
+    max_rounds, patience : int
+        The final polish's early stopping (:meth:`NARXProblem.polish`):
+        at most `max_rounds` rounds of 10 evaluations (default 500, a
+        safety: the held-back cost decides), stopping after `patience`
+        rounds without a lower held-back cost, or more (`patience_share`).
+    patience_share : float
+        The patience grows with the best round: the polish stops after
+        ``max(patience, ceil(patience_share * best_round))`` rounds without
+        a lower held-back cost (default 0.5; 0 with ``max_rounds=50`` is
+        the final polish before this option).
 
     Returns
     -------
@@ -378,6 +420,7 @@ def estimate_spiral(
     max_nfev = integer(max_nfev, "max_nfev", n_points)
     polish_every = integer(polish_every, "polish_every", 1)
     polish_nfev = integer(polish_nfev, "polish_nfev", 1)
+    stopping = stopping_options(max_rounds, patience, patience_share)
     linear, what = _linear_start(problem)
     starts = {"linear": _starting_network(problem, linear)}
     seeds = np.array(list(starts.values()))
@@ -421,7 +464,7 @@ def estimate_spiral(
         finals,
         linear,
         problem.predictor,
-        {},
+        stopping,
         t0,
         linear_model=what,
         n_polish=n_polish,

@@ -10,14 +10,30 @@ import time
 
 import numpy as np
 
+from spiralid._checks import integer, nonneg
 from spiralid.optim.result import OptimiserResult
 
 from ..models.narx import NARX, Scaling
 from .levenberg import levenberg_marquardt
 
-__all__ = ["NARXProblem", "narx_result"]
+__all__ = [
+    "MAX_ROUNDS",
+    "PATIENCE",
+    "PATIENCE_SHARE",
+    "NARXProblem",
+    "narx_result",
+    "stopping_options",
+]
 
 _ROUND = 10  # LM evaluations per early-stopping round
+# The default method's early stopping (estimate_spiral): the held-back cost
+# decides the training length, the cap on rounds is a safety, and the
+# patience grows with the best round (a polish that has gained for 100
+# rounds is not stopped by a 3-round plateau). Chosen on seeds 4-7 of the
+# paper experiment's nonlinear end-acceleration record (docs/results/narx.md).
+MAX_ROUNDS = 500
+PATIENCE = 3
+PATIENCE_SHARE = 0.5
 # LM's tolerances (gradient, relative fall, step), SciPy's 1e-8 as before
 # the polish moved onto levenberg.py.
 _TOL = 1e-8
@@ -193,7 +209,12 @@ class NARXProblem:
         return other
 
     def polish(
-        self, p0, predictor: str, max_rounds: int = 50, patience: int = 3
+        self,
+        p0,
+        predictor: str,
+        max_rounds: int = MAX_ROUNDS,
+        patience: int = PATIENCE,
+        patience_share: float = PATIENCE_SHARE,
     ) -> tuple[np.ndarray, int]:
         """Levenberg-Marquardt in rounds with early stopping on the held-back
         cost; returns the parameters with the lowest held-back cost (the
@@ -210,6 +231,10 @@ class NARXProblem:
             Rounds of 10 evaluations at most.
         patience : int
             Rounds without a lower held-back cost before stopping.
+        patience_share : float
+            The patience grows with the best round: training stops after
+            ``max(patience, ceil(patience_share * best_round))`` rounds
+            without a lower held-back cost (0: a fixed `patience`).
         """
         fun, jac = self.residual_and_jacobian(predictor)
         p = np.asarray(p0, dtype=float).copy()
@@ -233,7 +258,8 @@ class NARXProblem:
             else:
                 waited += 1
             # A stop other than the evaluation cap (stop 0) is convergence.
-            if waited >= patience or not moved or res.stop != 0:
+            wait = max(patience, math.ceil(patience_share * best_round))
+            if waited >= wait or not moved or res.stop != 0:
                 break
         return best_p, best_round
 
@@ -244,6 +270,30 @@ class NARXProblem:
         other.__dict__.update(self.__dict__)
         other.predictor = predictor
         return float(other.costs(p)[pick][0])
+
+
+def stopping_options(max_rounds, patience, patience_share) -> dict:
+    """The early stopping's options, checked, as :func:`~.narx._fit` takes
+    them.
+
+    Parameters
+    ----------
+    max_rounds : int
+        Rounds of 10 evaluations at most, >= 1.
+    patience : int
+        Rounds without a lower held-back cost before stopping, >= 1.
+    patience_share : float
+        Share of the best round added to the patience, finite and >= 0.
+
+    Returns
+    -------
+    dict
+    """
+    return {
+        "max_rounds": integer(max_rounds, "max_rounds", 1),
+        "patience": integer(patience, "patience", 1),
+        "patience_share": nonneg(patience_share, "patience_share"),
+    }
 
 
 def narx_result(problem, p, t0, **extra) -> OptimiserResult:
