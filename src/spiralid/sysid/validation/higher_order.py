@@ -184,6 +184,26 @@ def _product_test(e, u, lags, levels) -> CorrelationTest:
     return _finish("e(eu)", k, r, n, levels, q, lags)
 
 
+def _square_part(u: np.ndarray) -> np.ndarray:
+    """``u^2 - mean(u^2)``, or zeros when it is an affine function of ``u``.
+
+    Any function of a two-level input is affine in it (``u^2 = (a + b) u -
+    a b`` for levels ``a``, ``b``), so the ``u^2'`` tests of a binary input
+    repeat the ``u`` tests; with symmetric levels ``u^2`` is constant. An
+    offset binary input (a PRBS between 0 and 5 V, or one detrended by
+    another record's mean) is the same case: no degrees of freedom.
+    """
+    u2 = u**2 - np.mean(u**2)
+    uc = u - np.mean(u)
+    norm_u, norm_u2 = float(np.linalg.norm(uc)), float(np.linalg.norm(u2))
+    if norm_u > 0.0 and norm_u2 > 0.0:
+        # What of u2 is left after its projection on u' (relative).
+        left = u2 - (np.dot(u2, uc) / norm_u**2) * uc
+        if np.linalg.norm(left) <= 1e-9 * norm_u2:
+            return np.zeros_like(u2)
+    return u2
+
+
 def billings_voon(u, e, lags: int = 25, levels=_DEFAULT_LEVELS) -> BillingsVoon:
     """The five Billings-Voon correlation tests of a residual.
 
@@ -215,7 +235,7 @@ def billings_voon(u, e, lags: int = 25, levels=_DEFAULT_LEVELS) -> BillingsVoon:
     u, e = check_pair(u, e, "u", "e")
     lags = check_lags(lags, e.size)
     levels = _check_levels(levels)
-    u2 = u**2 - np.mean(u**2)
+    u2 = _square_part(u)
     ec = e - np.mean(e)
     tests = {
         "ee": whiteness_test(e, lags, levels),
