@@ -118,10 +118,26 @@ class Selection:
                 "on the held-back part"
             )
         if not self.overrode_cost:
+            head = f"{len(self.candidates)} distinct minima; the lowest cost "
+            where = (
+                f"on the held-back {100 * self.holdback:.0f} % of the estimation record"
+            )
+            scored = [c for c in self.candidates if c.held_rms is not None]
+            best = min(scored, key=lambda c: c.held_rms, default=chosen)
+            if chosen.held_rms is None or best.held_rms >= chosen.held_rms:
+                return f"{head}({_words(self.chosen)}) also validates best {where}"
+            # Kept although another validates better: say why, not "best".
+            rms = f"held-back RMS {best.held_rms:.3g} against {chosen.held_rms:.3g}"
+            if best.capped and best.held_rms < (1.0 - MARGIN) * chosen.held_rms:
+                why = (
+                    f"({rms}), but its refit stopped at its evaluation cap, so "
+                    "that score is not trusted"
+                )
+            else:
+                why = f"by less than {100 * MARGIN:.0f} % ({rms})"
             return (
-                f"{len(self.candidates)} distinct minima; the lowest cost "
-                f"({_words(self.chosen)}) also validates best on the held-back "
-                f"{100 * self.holdback:.0f} % of the estimation record"
+                f"{head}({_words(self.chosen)}) is kept: {_words(best.name)} "
+                f"validates better {where} {why}"
             )
         return (
             f"the held-back {100 * self.holdback:.0f} % of the estimation record: "
