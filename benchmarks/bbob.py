@@ -12,7 +12,8 @@ periods; ``-orthogonal``: orthogonal instead of independent directions in
 the population periods, an option added rather than an ingredient taken
 away; ``-global-stall``: a run's stall counted from the best of all runs,
 not its own; ``-lazy``: the basis decomposed every ``n // 10`` periods;
-``-uncapped``: the poll's metric's condition unbounded); IPOP-CMA-ES
+``-uncapped``: the poll's metric's condition unbounded; ``-mirror-biased``:
+every population run's step size with the mirrored pairs' bias); IPOP-CMA-ES
 and BIPOP-CMA-ES (pycma), SciPy's BFGS (finite differences) and
 Nelder-Mead restarted from uniform points, and uniform random search,
 through ``cocoex`` on the noiseless ``bbob`` suite at a
@@ -36,6 +37,13 @@ loaded core)::
 
     python benchmarks/bbob.py --dims 40 --instances 1 2 3 \
         --methods learned-metric+restarts cma bipop-cma --output bbob-40
+
+Instances that no setting was chosen on (``--instances`` picks positions in
+COCO's default list, which holds instances 1-5 and 71-80;
+``--instance-ids`` names instances themselves)::
+
+    python benchmarks/bbob.py --dims 20 --instance-ids 16-30 \
+        --methods learned-metric+restarts cma bipop-cma --output bbob-held-out
 
 Reduced size, as the test suite runs it::
 
@@ -95,6 +103,7 @@ INGREDIENTS = {
     "learned-metric-lazy": LearnedMetricSpiral(lazy_basis=True),
     "learned-metric-uncapped": LearnedMetricSpiral(max_condition=None),
     "learned-metric-no-suspend": LearnedMetricSpiral(suspend_crawl=False),
+    "learned-metric-mirror-biased": LearnedMetricSpiral(unbiased_sigma=False),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")
@@ -278,12 +287,15 @@ def run_task(method, dim, functions, instances, budget, output, n_points) -> Non
 
     os.chdir(output)  # cocoex writes to ./exdata/<result_folder>
     cocoex.log_level("warning")
+    # A string names COCO's instance numbers themselves (instances held out
+    # of the default list); a list picks positions in the default list.
+    held_out = isinstance(instances, str)
     suite = cocoex.Suite(
         "bbob",
-        "",
+        f"instances: {instances}" if held_out else "",
         f"dimensions:{dim} "
-        f"function_indices:{','.join(map(str, functions))} "
-        f"instance_indices:{','.join(map(str, instances))}",
+        f"function_indices:{','.join(map(str, functions))}"
+        + ("" if held_out else f" instance_indices:{','.join(map(str, instances))}"),
     )
     folder = f"{method}/D{dim}"
     observer = cocoex.Observer(
@@ -373,6 +385,13 @@ def _parse(argv):
     parser.add_argument("--functions", type=int, nargs="+", default=list(FUNCTIONS))
     parser.add_argument("--instances", type=int, nargs="+", default=list(INSTANCES))
     parser.add_argument(
+        "--instance-ids",
+        default="",
+        help="COCO instance numbers instead of --instances' positions in the "
+        "default list (1-5 and 71-80), e.g. 16-30 for instances no setting "
+        "was chosen on",
+    )
+    parser.add_argument(
         "--budget", type=int, default=1000, help="evaluations per dimension"
     )
     parser.add_argument(
@@ -413,7 +432,15 @@ def main(argv=None) -> dict:
         # Small dimensions first, so that an interrupted run leaves whole
         # dimensions behind (--report tabulates them).
         tasks = [
-            (m, d, args.functions, args.instances, args.budget, out, _points(args, m))
+            (
+                m,
+                d,
+                args.functions,
+                args.instance_ids or args.instances,
+                args.budget,
+                out,
+                _points(args, m),
+            )
             for d in sorted(args.dims)
             for m in args.methods
         ]
@@ -477,7 +504,12 @@ def _print(args, summary, total) -> None:
     load = os.getloadavg()
     print(
         f"bbob: D = {args.dims}, {len(args.functions)} functions, "
-        f"{len(args.instances)} instances, budget {args.budget} D, "
+        + (
+            f"instances {args.instance_ids}, "
+            if args.instance_ids
+            else f"{len(args.instances)} instances, "
+        )
+        + f"budget {args.budget} D, "
         f"spiral population {args.n_points} ({args.restart_points} first with "
         f"restarts); {total:.0f} s wall with "
         f"{args.jobs} process(es); load {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; "

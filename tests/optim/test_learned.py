@@ -23,6 +23,7 @@ from spiralid.optim import (
     minimize,
 )
 from spiralid.optim._kernels import orthonormal_rows
+from spiralid.optim.learned import paired_mu_eff
 
 
 def _quadratic(H):
@@ -337,6 +338,7 @@ def test_x0_seeds_the_first_poll():
         ({"sampling": "sobol"}, "`sampling` must be one of"),
         ({"lazy_basis": 1}, "`lazy_basis` must be True or False"),
         ({"suspend_crawl": 1}, "`suspend_crawl` must be True or False"),
+        ({"unbiased_sigma": "yes"}, "`unbiased_sigma` must be True or False"),
         ({"max_condition": 0.5}, "`max_condition` must be >= 1 or None"),
     ],
 )
@@ -519,3 +521,63 @@ def test_suspend_crawl_leaves_a_converging_run_alone():
     np.testing.assert_array_equal(
         runs[0].history[: first[0] + 1], runs[1].history[: first[1] + 1]
     )
+
+
+def test_paired_mu_eff_sums_each_pairs_weights_with_opposite_signs():
+    # Pairs 0..2 are rows 0..2 (+z) and 3..5 (-z). Selected: row 0 (+z_0,
+    # 0.5), row 3 (-z_0, 0.3), row 1 (+z_1, 0.2): the mean's step is
+    # 0.2 z_0 + 0.2 z_1, so sum c^2 = 0.08.
+    w = np.array([0.5, 0.3, 0.2])
+    assert paired_mu_eff(np.array([0, 3, 1]), 3, w) == pytest.approx(1 / 0.08)
+    # No pair with both members selected: CMA-ES's mu_eff.
+    assert paired_mu_eff(np.array([0, 4, 2]), 3, w) == pytest.approx(1 / np.sum(w**2))
+
+
+def test_the_paired_mu_eff_makes_the_path_step_standard_under_blind_selection():
+    # Under blind selection the path's step sqrt(mu) * mean step must have
+    # E|.|^2 = n (cumulative step-size adaptation's premise); CMA-ES's
+    # mu_eff undershoots it with mirrored pairs, which is the collapse.
+    rng = np.random.default_rng(0)
+    n, half, trials = 10, 12, 20_000
+    mu = half
+    w = np.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
+    w /= w.sum()
+    corrected, plain = np.empty(trials), np.empty(trials)
+    for t in range(trials):
+        z = rng.standard_normal((half, n))
+        rows = np.concatenate([z, -z])
+        order = rng.permutation(2 * half)[:mu]
+        step = w @ rows[order]
+        corrected[t] = paired_mu_eff(order, half, w) * (step @ step)
+        plain[t] = (step @ step) / np.sum(w**2)
+    assert corrected.mean() == pytest.approx(n, rel=0.03)
+    assert plain.mean() < 0.8 * n
+
+
+def _plateaus(x):
+    # A stepped sphere: flat within each cell of width 0.5.
+    return float(np.sum(np.floor(np.abs(x) * 2.0) ** 2))
+
+
+def test_unbiased_sigma_changes_no_run_before_the_second_population():
+    def run(unbiased):
+        seen = []
+        minimize(
+            _plateaus,
+            [(-5, 5)] * 6,
+            LearnedMetricSpiral(unbiased_sigma=unbiased),
+            max_nfev=6_000,
+            rng=4,
+            restarts=Restarts(),
+            callback=lambda r: seen.append(
+                (r.search.regime, r.search._population_runs, r.fun, r.nfev)
+            ),
+        )
+        return seen
+
+    on, off = run(True), run(False)
+    first = [i for i, s in enumerate(off) if s[1] >= 2]
+    assert first, "the run never reached a second population run"
+    k = first[0]
+    assert on[:k] == off[:k]
+    assert on != off
