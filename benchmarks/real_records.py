@@ -59,8 +59,9 @@ Records (files looked for in ``DIR``; a missing file skips its record):
 ``drives 0.5`` / ``drives 1.0`` / ``drives 1.5`` -- ``drive.mat`` with
     ``u1, z1`` (PRBS amplitude 1.0), ``u2, z2`` (1.5), ``u3, z3`` (0.5),
     500 samples each, Ts = 20 ms: the coupled electric drives (T. Wigren,
-    Uppsala report 2010-020; M. Schoukens, T. Wigren 2017, report 2017-024),
-    the speed measured by a pulse counter blind to the sign. Estimation on
+    M. Schoukens, Uppsala report 2017-024, whose DATAPRBS.csv holds the
+    same kind of records; this copy was not compared with it), the speed
+    measured by a pulse counter blind to the sign. Estimation on
     the first 300 samples, validation on the last 200 (the benchmark's
     split). A copy: github.com/zhenwendai/RGP (BSD-3),
     ``datasets/system_identification/drive.mat``.
