@@ -87,10 +87,11 @@ def seeded_search(problem, *, rule: str = "learned-metric", max_nfev: int = 3000
     The NARX estimator protocol of identify_narx (``estimate(problem,
     **options)``)."""
     from spiralid.sysid.estimation import narx as nx
+    from spiralid.sysid.estimation import narx_starts
 
     t0 = time.perf_counter()
-    linear, what = nx._linear_start(problem)
-    start = nx._starting_network(problem, linear)
+    linear, what = narx_starts._linear_start(problem)
+    start = narx_starts._starting_network(problem, linear)
     box = nx.default_box(problem, [start])
     raw = minimize(
         problem.objective,

@@ -35,7 +35,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 from spiralid.fms import nonlinear_rig, paper_experiment
 from spiralid.sysid import ARX, NARX, fit_percent, identify
 from spiralid.sysid.estimation import narx as narx_mod
-from spiralid.sysid.estimation import narx_problem
+from spiralid.sysid.estimation import narx_problem, narx_starts
 
 RECORDS = {
     "nonlinear acc": (True, "end_acceleration", 0),
@@ -109,6 +109,7 @@ def main() -> None:
                 linear=linear,
                 predictor=predictor,
                 rng=copy.deepcopy(problem.rng),
+                refit=extra.get("refit"),
                 nfev=problem.nfev,
                 search_s=time.perf_counter() - t0,
             )
@@ -142,13 +143,19 @@ def main() -> None:
             opts = dict(opts)
             n_inits = opts.pop("n_inits", 1)
             for i in range(2, n_inits + 1):
-                starts[f"linear {i}"] = narx_mod._with_hidden(
+                starts[f"linear {i}"] = narx_starts._with_hidden(
                     problem, captured["linear"]
                 )
             log.clear()
             t = time.perf_counter()
             res = real_train(
-                problem, starts, captured["linear"], captured["predictor"], opts, t
+                problem,
+                starts,
+                captured["linear"],
+                captured["predictor"],
+                opts,
+                t,
+                refit=captured["refit"],
             )
             train_s = time.perf_counter() - t
             m = dataclasses.replace(model, params=res.x)

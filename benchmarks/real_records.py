@@ -286,11 +286,11 @@ def fair_stopping(est: IOData, st: NARX, seed: int):
     while the network's rounds are scored out of sample. Here the start is
     the default ARX of the first four fifths; the round count with the
     lowest held-back cost is then run from the usual start on the whole
-    part (``holdout=0``). Uses private training code (``narx._with_hidden``,
+    part (``holdout=0``). Uses private training code (``narx_starts._with_hidden``,
     ``NARXProblem.polish``); ``st`` without integrator.
     """
-    from spiralid.sysid.estimation.narx import _with_hidden
     from spiralid.sysid.estimation.narx_problem import NARXProblem
+    from spiralid.sysid.estimation.narx_starts import _with_hidden
 
     prob = NARXProblem(est, st, "simulation", "rest", 0.2, np.random.default_rng(seed))
     prob.decay = 1e-3

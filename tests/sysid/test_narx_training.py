@@ -1,5 +1,6 @@
 """NARX early stopping: the rule that ends Levenberg-Marquardt's rounds."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -101,3 +102,50 @@ def test_bad_early_stopping_options_are_one_line_errors(option, value, match):
     data = _problem().data
     with pytest.raises(ValueError, match=match):
         identify(data, NARX(2, 2, 1, hidden=(2,)), method="oe", **{option: value})
+
+
+def _linear_record(n=600, seed=3):
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1.0, 1.0, n)
+    y = lfilter([0.0, 0.5, 0.2], [1.0, -1.3, 0.6], u)
+    return IOData(u, y + 0.02 * rng.standard_normal(n), ts=0.01)
+
+
+def test_the_linear_start_is_the_default_arx_a_user_gets():
+    from spiralid.sysid import ARX
+
+    data = _linear_record()
+    arx = identify(data, ARX(2, 2, 1), rng=5)
+    narx = identify(data, NARX(2, 2, 1, hidden=(2,)), rng=5, max_nfev=200)
+    start = dataclasses.replace(narx, params=np.asarray(narx.result.linear_params))
+    gap = np.max(np.abs(start.simulate(data.u) - arx.simulate(data.u)))
+    assert gap <= 1e-9 * np.std(data.y)
+
+
+def test_early_stopping_starts_from_the_training_parts_linear_model():
+    # The start scored on the held-back part must not have seen it: the
+    # training start is the default ARX of the training part, drawn from
+    # the generator after the whole record's (the refit's) start.
+    from spiralid.sysid import ARX
+    from spiralid.sysid.estimation.identify import _default_arx
+    from spiralid.sysid.estimation.narx_starts import _linear_starts
+
+    data = _linear_record()
+    problem = NARXProblem(
+        data,
+        NARX(2, 2, 1, hidden=(2,)),
+        "simulation",
+        "rest",
+        0.2,
+        np.random.default_rng(7),
+    )
+    problem.linear_estimator = _default_arx
+    train, whole, _ = _linear_starts(problem)
+    g = np.random.default_rng(7)
+    by_hand_whole = identify(data, ARX(2, 2, 1), rng=g)
+    by_hand_train = identify(data[: problem.split], ARX(2, 2, 1), rng=g)
+    st = problem.structure
+    for params, arx in ((whole, by_hand_whole), (train, by_hand_train)):
+        theta = np.asarray(arx.theta)
+        assert np.allclose(params, st.from_arx(theta[:2], theta[2:], problem.scaling))
+    assert not np.allclose(train, whole)

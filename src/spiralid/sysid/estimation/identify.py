@@ -329,11 +329,11 @@ def identify(
 
 def _default_arx(data: IOData, arx: ARX, integrator: int, rng) -> np.ndarray:
     """The default method's ARX theta, a NARX's linear start: handed to
-    the NARX estimator so that it does not import this module back."""
-    # The whole budget: the NARX then draws its networks from the generator
-    # where the search left it, so a stop at convergence (the same minimum,
-    # fewer draws) would change every NARX result per seed.
-    return identify(data, arx, integrator=integrator, rng=rng, stop="budget").theta
+    the NARX estimator so that it does not import this module back. With
+    the default stop, as a user's call: on the whole record, from a fresh
+    generator, it is the model ``identify(data, arx, integrator=...,
+    rng=seed)`` returns."""
+    return identify(data, arx, integrator=integrator, rng=rng).theta
 
 
 def _problem(method: str, data: IOData, arx: ARX, given: dict):

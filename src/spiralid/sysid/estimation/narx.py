@@ -60,13 +60,11 @@ import time
 import numpy as np
 
 from spiralid._checks import generator, integer
-from spiralid.choices import DEFAULT_METHOD
 from spiralid.optim import MINIMIZE_OPTIONS, SpiralSearch, minimize
 from spiralid.optim.result import OptimiserResult
 
 from ..data import IOData
-from ..models.arx import ARX, arx_least_squares
-from ..models.narx import NARX, NARXModel, PolynomialNARX
+from ..models.narx import NARXModel, PolynomialNARX
 from .frols import frols
 from .levenberg import levenberg_marquardt
 from .narx_problem import (
@@ -78,71 +76,27 @@ from .narx_problem import (
     narx_result,
     stopping_options,
 )
+from .narx_starts import _starts
 
 __all__ = ["NARXProblem", "identify_narx"]
 
 
-def _linear_start(problem: NARXProblem, method: str = "default"):
-    """The linear model of the structure's lags in the bypass, and what it
-    is; ``(None, "")`` for a structure without a bypass.
-
-    ``"default"``: for a free run from rest, the default method's ARX
-    (``identify(data, ARX(ny + 1, nu, nk), integrator=k)`` for ``k``
-    integrators, ``ARX(ny, nu, nk)`` without, through the problem's
-    ``linear_estimator``), so a NARX contains the linear model a user would
-    get; otherwise (a one-step predictor, a run from measured samples,
-    which ``"spiral"`` does not fit, or no ``linear_estimator``) and for
-    ``"ls"``: least squares of the one-step error.
-    """
-    st = problem.structure
-    if not isinstance(st, NARX) or not st.linear:
-        return None, ""
-    data = problem.data
-    k = st.integrator
-    free_run = problem.predictor == "simulation" and problem.initial == "rest"
-    estimator = getattr(problem, "linear_estimator", None)
-    if method == "ls" or not free_run or estimator is None:
-        arx = ARX(st.ny, st.nu, st.nk)
-        if k:
-            # One step ahead, the increment's error is the output's.
-            data = IOData(data.u, np.diff(data.y, prepend=0.0), ts=data.ts)
-        theta = arx_least_squares(data, arx)
-        a, b = theta[: st.ny], theta[st.ny :]
-        what = f"ARX({st.ny}, {st.nu}, {st.nk}) of the increments" if k else str(arx)
-        return st.from_arx(a, b, problem.scaling), f"{what} by least squares"
-    arx = ARX(st.ny + (1 if k else 0), st.nu, st.nk)
-    theta = estimator(data, arx, k, problem.rng)
-    a = theta[: arx.na]
-    if k:
-        # A = C (1 - z^-1): the increments' denominator C is A's running sum
-        # (its last term, A(1), is zero); C keeps any second integrator.
-        a = np.cumsum(np.r_[1.0, a])[1:-1]
-    what = f"{arx}, integrator={k}" if k else str(arx)
-    return (
-        st.from_arx(a, theta[arx.na :], problem.scaling),
-        f"{what}, by {DEFAULT_METHOD}",
-    )
-
-
-def _with_hidden(problem: NARXProblem, p: np.ndarray) -> np.ndarray:
-    """`p` with Glorot-uniform hidden weights (output weights stay zero, so
-    the map is unchanged but its gradient reaches the network)."""
-    st = problem.structure
-    init = st.initial_params(problem.rng)
-    q = p.copy()
-    q[: st.h * st.n_regressors] = init[: st.h * st.n_regressors]
-    return q
-
-
-def _fit(problem: NARXProblem, starts: dict, predictor: str, options: dict):
+def _fit(
+    problem: NARXProblem,
+    starts: dict,
+    predictor: str,
+    options: dict,
+    refit: dict | None = None,
+):
     """Train from `starts` with early stopping, then refit on every sample.
 
     Each start is polished in rounds on the training part while the
     held-back part is scored; the start and round count with the lowest
-    held-back cost win. That start is then polished again on the whole
-    record for exactly that many rounds, so the end of the record is not
-    thrown away. Returns ``(params, start name, rounds)``; with nothing
-    held back the rounds run until `max_rounds` or convergence.
+    held-back cost win. That start (or its entry in `refit`: the same
+    network on the whole record's linear model) is then polished again on
+    the whole record for exactly that many rounds, so the end of the record
+    is not thrown away. Returns ``(params, start name, rounds)``; with
+    nothing held back the rounds run until `max_rounds` or convergence.
     """
     max_rounds = options.get("max_rounds", MAX_ROUNDS)
     patience = options.get("patience", PATIENCE)
@@ -158,7 +112,8 @@ def _fit(problem: NARXProblem, starts: dict, predictor: str, options: dict):
     if problem.hold is None:
         return p, name, rounds
     whole = problem.whole()
-    p, _ = whole.polish(starts[name], predictor, rounds, rounds + 1, 0.0)
+    p0 = (refit or {}).get(name, starts[name])
+    p, _ = whole.polish(p0, predictor, rounds, rounds + 1, 0.0)
     problem.nfev += whole.nfev
     return p, name, rounds
 
@@ -175,9 +130,18 @@ def _contain(problem: NARXProblem, p, linear, predictor: str):
     return np.asarray(linear, dtype=float).copy(), True
 
 
-def _train(problem, starts: dict, linear, predictor: str, options: dict, t0, **extra):
+def _train(
+    problem,
+    starts: dict,
+    linear,
+    predictor: str,
+    options: dict,
+    t0,
+    refit: dict | None = None,
+    **extra,
+):
     """:func:`_fit` then :func:`_contain`, as an OptimiserResult."""
-    p, name, rounds = _fit(problem, starts, predictor, options)
+    p, name, rounds = _fit(problem, starts, predictor, options, refit)
     p, kept = _contain(problem, p, linear, predictor)
     if kept:
         name, rounds = "linear", 0
@@ -223,8 +187,7 @@ def estimate_ls(
     if isinstance(problem.structure, PolynomialNARX):
         return frols(problem)
     t0 = time.perf_counter()
-    linear, what = _linear_start(problem, "ls")
-    start = _starting_network(problem, linear)
+    start, refit, linear, what = _starts(problem, "ls")
     options = stopping_options(max_rounds, patience, patience_share)
     return _train(
         problem,
@@ -233,17 +196,10 @@ def estimate_ls(
         "one-step",
         options,
         t0,
+        refit={"linear": refit},
         linear_model=what,
         message="Levenberg-Marquardt, one-step error.",
     )
-
-
-def _starting_network(problem: NARXProblem, linear) -> np.ndarray:
-    """The linear start with Glorot hidden weights (the map unchanged), or
-    a network's initial weights when there is no bypass."""
-    if linear is None:
-        return problem.structure.initial_params(problem.rng)
-    return _with_hidden(problem, linear)
 
 
 def estimate_oe(
@@ -254,7 +210,7 @@ def estimate_oe(
     patience_share: float = 0.0,
 ) -> OptimiserResult:
     """``"oe"``: the gradient baseline on the predictor's error, from the
-    linear start (:func:`_linear_start`).
+    linear start (:func:`.narx_starts._linear_start`).
 
     Parameters
     ----------
@@ -279,8 +235,7 @@ def estimate_oe(
             "method 'ls' (forward-regression orthogonal least squares)"
         )
     t0 = time.perf_counter()
-    linear, what = _linear_start(problem)
-    start = _starting_network(problem, linear)
+    start, refit, linear, what = _starts(problem)
     options = stopping_options(max_rounds, patience, patience_share)
     return _train(
         problem,
@@ -289,6 +244,7 @@ def estimate_oe(
         problem.predictor,
         options,
         t0,
+        refit={"linear": refit},
         linear_model=what,
         message="Levenberg-Marquardt with early stopping from the linear start.",
     )
@@ -421,8 +377,8 @@ def estimate_spiral(
     polish_every = integer(polish_every, "polish_every", 1)
     polish_nfev = integer(polish_nfev, "polish_nfev", 1)
     stopping = stopping_options(max_rounds, patience, patience_share)
-    linear, what = _linear_start(problem)
-    starts = {"linear": _starting_network(problem, linear)}
+    start, refit, linear, what = _starts(problem)
+    starts = {"linear": start}
     seeds = np.array(list(starts.values()))
     box = default_box(problem, seeds)
     seeds = np.clip(seeds, box[:, 0], box[:, 1])
@@ -466,6 +422,7 @@ def estimate_spiral(
         problem.predictor,
         stopping,
         t0,
+        refit={"linear": refit},
         linear_model=what,
         n_polish=n_polish,
         history=np.asarray(history, dtype=float),
