@@ -214,7 +214,15 @@ def test_ctrl_c_after_the_work_is_done_is_still_one_line(monkeypatch, capsys):
         return 0
 
     monkeypatch.setattr("spiralid.cli.simulate.run", run)
-    assert cli.main(["simulate"]) == 130
+    # SIGINT as an interactive shell leaves it: a test run started in the
+    # background of a script inherits it ignored, and the command then
+    # rightly keeps ignoring it (the interpreter's own rule).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        status = cli.main(["simulate"])
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert status == 130
     assert capsys.readouterr().err.splitlines() == ["spiralid simulate: interrupted"]
 
 

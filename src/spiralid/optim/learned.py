@@ -42,8 +42,8 @@ metric they are taken in:
    first population run, without the bias the mirrored pairs give it:
    ``unbiased_sigma``). Averaging over the best half is what lets a large
    population see through local minima; the population doubles at each
-   such restart, as in IPOP. The
-   regime whose runs have spent fewer evaluations goes next (BIPOP's rule).
+   such restart, as in IPOP. The regime whose runs have spent fewer
+   evaluations goes next (BIPOP's rule).
    A poll that crawls (its gains fall far slower than its steps' squares)
    is suspended for a population run, and resumed if that run does no
    better (``suspend_crawl``).

@@ -251,7 +251,7 @@ def method_options(method: str, narx: bool = False) -> tuple[str, ...]:
     >>> method_options("ls")
     ()
     >>> method_options("ls", narx=True)
-    ('max_rounds', 'patience')
+    ('max_rounds', 'patience', 'patience_share')
     """
     spec = METHODS[method]
     if narx:

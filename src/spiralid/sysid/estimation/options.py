@@ -77,8 +77,9 @@ def identify_options(method: str, structure, refine: bool = False) -> tuple[str,
     --------
     >>> identify_options("ls", ARX(2, 2, 1))
     ('rng', 'predictor', 'initial', 'gain', 'penalty', 'integrator')
-    >>> identify_options("oe", NARX(2, 2, 1))
-    ('rng', 'predictor', 'initial', 'holdout', 'decay', 'max_rounds', 'patience')
+    >>> identify_options("oe", NARX(2, 2, 1))  # doctest: +NORMALIZE_WHITESPACE
+    ('rng', 'predictor', 'initial', 'holdout', 'decay', 'max_rounds', 'patience',
+     'patience_share')
     """
     if isinstance(structure, PolynomialNARX):
         return ("rng", "predictor", "initial")
