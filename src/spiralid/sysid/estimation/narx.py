@@ -98,12 +98,9 @@ def _fit(
     is not thrown away. Returns ``(params, start name, rounds)``; with
     nothing held back the rounds run until `max_rounds` or convergence.
     """
-    max_rounds = options.get("max_rounds", MAX_ROUNDS)
-    patience = options.get("patience", PATIENCE)
-    share = options.get("patience_share", PATIENCE_SHARE)
     best = None
     for name, p0 in starts.items():
-        p, rounds = problem.polish(p0, predictor, max_rounds, patience, share)
+        p, rounds = problem.polish(p0, predictor, **options)
         pick = 1 if problem.hold is not None else 0
         score = problem._score(p, predictor, pick)
         if best is None or score < best[0]:

@@ -82,8 +82,8 @@ def _linear_starts(problem: NARXProblem, method: str = "default"):
 
 
 def _same_hidden(problem: NARXProblem, start: np.ndarray, linear) -> np.ndarray:
-    """`linear` with the hidden weights `start` drew (:func:`_with_hidden`;
-    the output weights stay zero, so it is still the linear model)."""
+    """`linear` with `start`'s hidden weights (`linear`'s output weights stay
+    zero, so it is still the linear model)."""
     st = problem.structure
     out = np.asarray(linear, dtype=float).copy()
     hidden = st.h * st.n_regressors
@@ -94,11 +94,7 @@ def _same_hidden(problem: NARXProblem, start: np.ndarray, linear) -> np.ndarray:
 def _with_hidden(problem: NARXProblem, p: np.ndarray) -> np.ndarray:
     """`p` with Glorot-uniform hidden weights (output weights stay zero, so
     the map is unchanged but its gradient reaches the network)."""
-    st = problem.structure
-    init = st.initial_params(problem.rng)
-    q = p.copy()
-    q[: st.h * st.n_regressors] = init[: st.h * st.n_regressors]
-    return q
+    return _same_hidden(problem, problem.structure.initial_params(problem.rng), p)
 
 
 def _starts(problem: NARXProblem, method: str = "default"):
