@@ -512,6 +512,7 @@ class LearnedMetricSearch(SearchBase):
             self._run_best = best
             self.last_move = self.nit
         rule = self.rule
+        lengths = self._step_lengths()
         if (
             rule.suspend_crawl
             and rule.populations
@@ -519,15 +520,11 @@ class LearnedMetricSearch(SearchBase):
             and not self._resumed
         ):
             self._trail.append(
-                (
-                    self._run_best,
-                    float(self._step_lengths().max()),
-                    self._encoding.condition,
-                )
+                (self._run_best, float(lengths.max()), self._encoding.condition)
             )
             self._crawled = self._crawling()
         self.history.append(self.fun)
-        self._mean_step.append(float(self._step_lengths().mean()))
+        self._mean_step.append(float(lengths.mean()))
         return self.x, self.fun
 
     def _poll_period(self) -> None:
