@@ -499,6 +499,24 @@ def test_the_crawl_test_tells_a_crawl_from_a_converging_poll():
     assert not search._crawling()  # fewer than two windows
 
 
+def test_a_poll_stepped_past_its_steps_underflow_raises_nothing():
+    # Stepped by hand, with no restart to end it, the sphere's poll shrinks
+    # its steps to exactly zero (period 840 of this seed); the crawl test
+    # divided by the last step.
+    search = LearnedMetricSearch(
+        lambda X: np.sum(X**2, axis=1),
+        [(-5, 5)] * 3,
+        LearnedMetricSpiral(),
+        n_points=10,
+        rng=0,
+        vectorized=True,
+    )
+    for _ in range(1200):
+        search.step()
+    assert np.all(search.steps == 0.0)
+    assert search.fun == 0.0
+
+
 def test_suspend_crawl_leaves_a_converging_run_alone():
     # An ill-conditioned quadratic converges: no poll crawls, the run is the
     # default's bit for bit.

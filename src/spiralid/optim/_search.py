@@ -51,7 +51,11 @@ class SearchBase:
         if self.vectorized:
             # A copy: the search reorders its costs in place, and the caller
             # may keep the array it returned.
-            out = check_costs(self._fun(x.copy()), (k,), self._batch_shape(x))
+            raw = self._fun(x.copy())
+            out = np.asarray(raw)
+            if out.shape != (k,) or out.dtype.kind not in "biuf":
+                # Only now build the message: this runs once per period.
+                check_costs(raw, (k,), self._batch_shape(x))
             return np.array(out, np.float64)
         out = np.empty(k)
         for i in range(k):
