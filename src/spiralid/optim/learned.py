@@ -550,10 +550,7 @@ class LearnedMetricSearch(SearchBase):
         signed = np.empty((2 * n, n))
         signed[0::2] = directions
         np.negative(directions, out=signed[1::2])
-        model = [0.0] * n
-        success = [False] * n
-        for j in range(n):
-            success[j], model[j] = self._poll(j, signed[2 * j : 2 * j + 2])
+        success, model = self._pairs(signed)
         if rule.success_steps:
             self._steps *= np.where(success, rule.grow, rule.shrink)
         if rule.model_step and any(model):
@@ -571,46 +568,68 @@ class LearnedMetricSearch(SearchBase):
             best = np.argsort(self._polled_f, kind="stable")[:n]
             self._encoding.update((self._polled[best] - self._lo) / self._width)
 
-    def _poll(self, j: int, offsets: np.ndarray) -> tuple[bool, float]:
-        """Poll ``x* + offsets`` (the pair ``x* +- s_j b_j`` of step ``j`` of
-        the period); move the centre to the better if it improves. Returns
-        whether it did, and the minimum of the parabola through the three
-        costs, in units of the direction from the (possibly moved) centre
-        (0 if not convex)."""
-        pair = np.add(self._c, offsets, out=self._polled[2 * j : 2 * j + 2])
-        if self.bounds_policy != "none":
-            apply_bounds(pair, self._lo, self._hi, self.bounds_policy)
-        # The poll's hot path, once per two evaluations: the costs as
-        # floats without _evaluate's array bookkeeping.
-        if self.vectorized:
-            raw = self._fun(pair.copy())
-            out = np.asarray(raw)
-            if out.shape != (2,) or out.dtype.kind not in "biuf":
-                # Only now build the message.
-                check_costs(raw, (2,), self._batch_shape(pair))
-            a, b = out.tolist()
-            a, b = float(a), float(b)
-        else:
-            a = float(check_costs(self._fun(pair[0].copy()), (), _SCALAR))
-            b = float(check_costs(self._fun(pair[1].copy()), (), _SCALAR))
-        self.nfev += 2
-        if not math.isfinite(a):
-            a = math.inf
-        if not math.isfinite(b):
-            b = math.inf
-        self._polled_f[2 * j] = a
-        self._polled_f[2 * j + 1] = b
-        f = self._f
-        better, side = (a, 0) if a <= b else (b, 1)
-        if better < self._best[1]:
-            self._best = (pair[side].copy(), better)
-        curvature = a + b - 2.0 * f
-        vertex = 0.5 * (b - a) / curvature if curvature > 0.0 else 0.0
-        if not better < f:
-            return False, vertex
-        self._c = pair[side].copy()
-        self._f = better
-        return True, (vertex - (1.0 if side == 0 else -1.0)) if vertex else 0.0
+    def _pairs(self, signed: np.ndarray) -> tuple[list, list]:
+        """Poll the period's pairs ``x* + signed[2j : 2j + 2]`` (``x* +- s_j
+        b_j``) in turn, moving the centre to the better of a pair when it
+        improves on it. Returns, per pair, whether it did, and the minimum of
+        the parabola through the three costs in units of the direction from
+        the (possibly moved) centre (0 if not convex).
+
+        The hot loop of the search, two evaluations an iteration: the state
+        is held in local names and written back once (also if ``fun``
+        raises), and the costs are read as floats without
+        :meth:`_evaluate`'s array bookkeeping.
+        """
+        n = self._lo.size
+        polled, polled_f = self._polled, self._polled_f
+        fun, vectorized = self._fun, self.vectorized
+        bounded = self.bounds_policy != "none"
+        c, fc = self._c, self._f
+        best_x, best_f = self._best
+        success = [False] * n
+        model = [0.0] * n
+        evaluated = 0
+        try:
+            for j in range(n):
+                pair = np.add(
+                    c, signed[2 * j : 2 * j + 2], out=polled[2 * j : 2 * j + 2]
+                )
+                if bounded:
+                    apply_bounds(pair, self._lo, self._hi, self.bounds_policy)
+                if vectorized:
+                    raw = fun(pair.copy())
+                    out = np.asarray(raw)
+                    if out.shape != (2,) or out.dtype.kind not in "biuf":
+                        # Only now build the message.
+                        check_costs(raw, (2,), self._batch_shape(pair))
+                    a, b = out.tolist()
+                    a, b = float(a), float(b)
+                else:
+                    a = float(check_costs(fun(pair[0].copy()), (), _SCALAR))
+                    b = float(check_costs(fun(pair[1].copy()), (), _SCALAR))
+                evaluated += 2
+                if not math.isfinite(a):
+                    a = math.inf
+                if not math.isfinite(b):
+                    b = math.inf
+                polled_f[2 * j] = a
+                polled_f[2 * j + 1] = b
+                better, side = (a, 0) if a <= b else (b, 1)
+                if better < best_f:
+                    best_x, best_f = pair[side].copy(), better
+                curvature = a + b - 2.0 * fc
+                vertex = 0.5 * (b - a) / curvature if curvature > 0.0 else 0.0
+                if better < fc:
+                    c, fc = pair[side].copy(), better
+                    success[j] = True
+                    # From the moved centre, the vertex is one step nearer.
+                    vertex = (vertex - (1.0 if side == 0 else -1.0)) if vertex else 0.0
+                model[j] = vertex
+        finally:
+            self.nfev += evaluated
+            self._c, self._f = c, fc
+            self._best = (best_x, best_f)
+        return success, model
 
     def _generation(self) -> None:
         """A population period: mirrored pairs ``x* +- sigma B z_l``, the
