@@ -13,7 +13,9 @@ the population periods, an option added rather than an ingredient taken
 away; ``-global-stall``: a run's stall counted from the best of all runs,
 not its own; ``-lazy``: the basis decomposed every ``n // 10`` periods;
 ``-uncapped``: the poll's metric's condition unbounded; ``-mirror-biased``:
-every population run's step size with the mirrored pairs' bias); IPOP-CMA-ES
+every population run's step size with the mirrored pairs' bias;
+``-fixed-share``: the population run after a suspended poll cut at half the
+poll's evaluations even while it closes in on the poll); IPOP-CMA-ES
 and BIPOP-CMA-ES (pycma), SciPy's BFGS (finite differences) and
 Nelder-Mead restarted from uniform points, and uniform random search,
 through ``cocoex`` on the noiseless ``bbob`` suite at a
@@ -104,6 +106,7 @@ INGREDIENTS = {
     "learned-metric-uncapped": LearnedMetricSpiral(max_condition=None),
     "learned-metric-no-suspend": LearnedMetricSpiral(suspend_crawl=False),
     "learned-metric-mirror-biased": LearnedMetricSpiral(unbiased_sigma=False),
+    "learned-metric-fixed-share": LearnedMetricSpiral(extend_closing=False),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

@@ -7,6 +7,7 @@ follow, and the same search on a rotated copy of the problem.
 
 import itertools
 import math
+from collections import deque
 
 import numpy as np
 import pytest
@@ -339,6 +340,7 @@ def test_x0_seeds_the_first_poll():
         ({"lazy_basis": 1}, "`lazy_basis` must be True or False"),
         ({"suspend_crawl": 1}, "`suspend_crawl` must be True or False"),
         ({"unbiased_sigma": "yes"}, "`unbiased_sigma` must be True or False"),
+        ({"extend_closing": 1}, "`extend_closing` must be True or False"),
         ({"max_condition": 0.5}, "`max_condition` must be >= 1 or None"),
     ],
 )
@@ -515,6 +517,33 @@ def test_a_poll_stepped_past_its_steps_underflow_raises_nothing():
         search.step()
     assert np.all(search.steps == 0.0)
     assert search.fun == 0.0
+
+
+@pytest.mark.parametrize("extend", [True, False])
+def test_a_population_run_closing_in_on_the_held_poll_goes_on(extend):
+    # n = 2: the trail holds the run's best over its last 3 periods. The
+    # held poll is at 0.0; the run, at 1.0, gained 0.4 over the window: at
+    # that rate it reaches 0.0 within 3 windows (1.2 >= 1.0), so it is not
+    # cut at its share; having gained 0.3 (0.9 < 1.0), it is.
+    search = LearnedMetricSearch(
+        _quadratic(np.eye(2)),
+        [(-1, 1)] * 2,
+        LearnedMetricSpiral(extend_closing=extend),
+        n_points=4,
+        rng=0,
+    )
+    search._start_population(8)
+    search._held = (np.zeros(2), 0.0, None, None, 4)
+    search._held_nfev = 10
+    search._run_nfev = search.nfev - 6  # past the share, 5 evaluations
+    search._closing = deque(maxlen=3)
+    search._run_best = 1.0
+    restarts = Restarts()
+    for old, cut in ((1.4, not extend), (1.3, True)):
+        search._closing.extend([old, 1.2, 1.0])
+        assert search.collapsed(restarts) is cut
+    search._closing = deque([1.0], maxlen=3)
+    assert search.collapsed(restarts) is not extend  # fewer than n periods
 
 
 def test_suspend_crawl_leaves_a_converging_run_alone():
