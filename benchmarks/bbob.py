@@ -15,7 +15,9 @@ not its own; ``-lazy``: the basis decomposed every ``n // 10`` periods;
 ``-uncapped``: the poll's metric's condition unbounded; ``-mirror-biased``:
 every population run's step size with the mirrored pairs' bias;
 ``-fixed-share``: the population run after a suspended poll cut at half the
-poll's evaluations even while it closes in on the poll); IPOP-CMA-ES
+poll's evaluations even while it closes in on the poll;
+``-long-crawl-window``: the crawl test over ``max(30, 4 n)`` periods, not
+``max(30, 2 n)``); IPOP-CMA-ES
 and BIPOP-CMA-ES (pycma), SciPy's BFGS (finite differences) and
 Nelder-Mead restarted from uniform points, and uniform random search,
 through ``cocoex`` on the noiseless ``bbob`` suite at a
@@ -107,6 +109,7 @@ INGREDIENTS = {
     "learned-metric-no-suspend": LearnedMetricSpiral(suspend_crawl=False),
     "learned-metric-mirror-biased": LearnedMetricSpiral(unbiased_sigma=False),
     "learned-metric-fixed-share": LearnedMetricSpiral(extend_closing=False),
+    "learned-metric-long-crawl-window": LearnedMetricSpiral(crawl_window=4.0),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

@@ -341,6 +341,7 @@ def test_x0_seeds_the_first_poll():
         ({"suspend_crawl": 1}, "`suspend_crawl` must be True or False"),
         ({"unbiased_sigma": "yes"}, "`unbiased_sigma` must be True or False"),
         ({"extend_closing": 1}, "`extend_closing` must be True or False"),
+        ({"crawl_window": 0}, "`crawl_window` must be a finite number > 0"),
         ({"max_condition": 0.5}, "`max_condition` must be >= 1 or None"),
     ],
 )
@@ -517,6 +518,24 @@ def test_a_poll_stepped_past_its_steps_underflow_raises_nothing():
         search.step()
     assert np.all(search.steps == 0.0)
     assert search.fun == 0.0
+
+
+@pytest.mark.parametrize(("window", "periods"), [(2.0, 40), (4.0, 80)])
+def test_the_crawl_test_looks_back_crawl_window_periods_per_dimension(window, periods):
+    # n = 20: a crawl is seen once the trail holds two windows and one.
+    search = LearnedMetricSearch(
+        _quadratic(np.eye(20)),
+        [(-1, 1)] * 20,
+        LearnedMetricSpiral(crawl_window=window),
+        n_points=4,
+        rng=0,
+    )
+    k = np.arange(2 * periods + 1)
+    crawl = _trail(1.0 - 1e-3 * k, 0.5 * 0.9**k, np.full(k.size, 10.0))
+    search._trail = crawl[:-1]
+    assert not search._crawling()
+    search._trail = crawl
+    assert search._crawling()
 
 
 @pytest.mark.parametrize("extend", [True, False])

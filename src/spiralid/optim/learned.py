@@ -87,7 +87,8 @@ _MAX_CONDITION = 1e14
 _SIGMA0 = 0.2
 _SAMPLINGS = ("gaussian", "orthogonal")
 _TINY = float(np.finfo(float).tiny)
-# suspend_crawl: a poll crawls when, over its last `w` periods, its gains fell
+# suspend_crawl: a poll crawls when, over its last `w` periods (at least
+# _CRAWL_MIN_WINDOW, `crawl_window` n otherwise), its gains fell
 # by less than 1/_CRAWL_RATIO of the fall its steps' squares predict (a
 # converging run's gains shrink with the square of its steps) while the
 # metric's condition grew by less than _CRAWL_CONDITION (a metric still being
@@ -96,6 +97,7 @@ _TINY = float(np.finfo(float).tiny)
 # ones) and the condition below _CRAWL_MAX_CONDITION (a metric at the cap is
 # still stretching: the bent cigar). The population run that follows gets
 # _HELD_SHARE of the poll's evaluations to do better.
+_CRAWL_MIN_WINDOW = 30
 _CRAWL_RATIO = 10.0
 _CRAWL_CONDITION = 1.5
 _CRAWL_STEP = 1e-3
@@ -166,13 +168,21 @@ class LearnedMetricSpiral:
         the budget: a population run goes next, with half the poll's
         evaluations; if it does not go below the poll's cost by then, the
         poll resumes where it stopped (once; it is not suspended again). A
-        poll crawls when, over its last ``max(30, 4 n)`` periods, its gains
+        poll crawls when, over its last ``max(30, crawl_window n)`` periods, its gains
         fell by less than a tenth of what the fall of its largest step
         predicts for a converging run (the square), while the metric's
         condition grew by less than 1.5 and stays below 1e7, with its
         largest step below 1e-3 of the box. Default True: on BBOB at D = 20
         it gains the attractive sector and Schaffer's functions (figures in
         the BBOB results); a converging poll is left alone.
+    crawl_window : float
+        The crawl test's window in periods per dimension (at least 30
+        periods; default 2, so 40 at n = 20). The population run that a
+        crawling poll hands over to needs what is left of the budget: with
+        4 (the previous default) the poll could be suspended only after
+        ``8 n`` periods, two fifths of a ``1000 n`` budget at n = 20, and
+        the attractive sector's population runs ran out of budget
+        (figures in the BBOB results).
     extend_closing : bool
         With ``suspend_crawl``, let the population run go on past its half
         of the poll's evaluations while it is closing in on the poll's
@@ -227,6 +237,7 @@ class LearnedMetricSpiral:
     lazy_basis: bool = False
     suspend_crawl: bool = True
     unbiased_sigma: bool = True
+    crawl_window: float = 2.0
     extend_closing: bool = True
     max_condition: float | None = 1e8
     grow: float = 2.0
@@ -259,6 +270,9 @@ class LearnedMetricSpiral:
                     f"`max_condition` must be >= 1 or None; got {self.max_condition!r}"
                 )
             object.__setattr__(self, "max_condition", cap)
+        object.__setattr__(
+            self, "crawl_window", positive(self.crawl_window, "crawl_window")
+        )
         grow = positive(self.grow, "grow")
         if grow <= 1.0:
             raise ValueError(f"`grow` must be > 1; got {self.grow!r}")
@@ -500,7 +514,7 @@ class LearnedMetricSearch(SearchBase):
 
     def _crawling(self) -> bool:
         """Whether the poll crawls (see `suspend_crawl`)."""
-        w = max(30, 4 * self._lo.size)
+        w = max(_CRAWL_MIN_WINDOW, int(self.rule.crawl_window * self._lo.size))
         trail = self._trail
         if len(trail) <= 2 * w:
             return False
