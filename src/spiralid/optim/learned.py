@@ -46,7 +46,7 @@ metric they are taken in:
    evaluations goes next (BIPOP's rule).
    A poll that crawls (its gains fall far slower than its steps' squares)
    is suspended for a population run, and resumed if that run does no
-   better (``suspend_crawl``).
+   better (``suspend_crawl``, ``crawl_window``, ``extend_closing``).
 
 The search runs in the box scaled to the unit cube, so the basis starts as
 the box's own axes and the first poll steps are a quarter of its widths. A
@@ -166,23 +166,24 @@ class LearnedMetricSpiral:
     suspend_crawl : bool
         With restarts, suspend a poll that crawls instead of letting it spend
         the budget: a population run goes next, with half the poll's
-        evaluations; if it does not go below the poll's cost by then, the
-        poll resumes where it stopped (once; it is not suspended again). A
-        poll crawls when, over its last ``max(30, crawl_window n)`` periods, its gains
-        fell by less than a tenth of what the fall of its largest step
-        predicts for a converging run (the square), while the metric's
-        condition grew by less than 1.5 and stays below 1e7, with its
-        largest step below 1e-3 of the box. Default True: on BBOB at D = 20
-        it gains the attractive sector and Schaffer's functions (figures in
-        the BBOB results); a converging poll is left alone.
+        evaluations (or more, ``extend_closing``); if it does not go below
+        the poll's cost by then, the poll resumes where it stopped (once; it
+        is not suspended again). A poll crawls when, over its last
+        ``max(30, crawl_window n)`` periods, its gains fell by less than a
+        tenth of what the fall of its largest step predicts for a
+        converging run (the square), while the metric's condition grew by
+        less than 1.5 and stays below 1e7, with its largest step below 1e-3
+        of the box. Default True: on BBOB at D = 20 it gains the attractive
+        sector and Schaffer's functions (figures in the BBOB results); a
+        converging poll is left alone.
     crawl_window : float
         The crawl test's window in periods per dimension (at least 30
         periods; default 2, so 40 at n = 20). The population run that a
         crawling poll hands over to needs what is left of the budget: with
-        4 (the previous default) the poll could be suspended only after
-        ``8 n`` periods, two fifths of a ``1000 n`` budget at n = 20, and
-        the attractive sector's population runs ran out of budget
-        (figures in the BBOB results).
+        4 (the previous default) a poll could be suspended only after
+        ``8 n`` periods, a third of a ``1000 n`` budget at n = 20, and the
+        attractive sector's population runs ran out of budget (figures in
+        the BBOB results).
     extend_closing : bool
         With ``suspend_crawl``, let the population run go on past its half
         of the poll's evaluations while it is closing in on the poll's
