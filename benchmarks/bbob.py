@@ -17,7 +17,9 @@ every population run's step size with the mirrored pairs' bias;
 ``-fixed-share``: the population run after a suspended poll cut at half the
 poll's evaluations even while it closes in on the poll;
 ``-long-crawl-window``: the crawl test over ``max(30, 4 n)`` periods, not
-``max(30, 2 n)``); IPOP-CMA-ES
+``max(30, 2 n)``; ``-cma-path``: the step-size path in CMA-ES's fixed
+coordinates, an option added rather than an ingredient taken away);
+IPOP-CMA-ES
 and BIPOP-CMA-ES (pycma), SciPy's BFGS (finite differences) and
 Nelder-Mead restarted from uniform points, and uniform random search,
 through ``cocoex`` on the noiseless ``bbob`` suite at a
@@ -110,6 +112,7 @@ INGREDIENTS = {
     "learned-metric-mirror-biased": LearnedMetricSpiral(unbiased_sigma=False),
     "learned-metric-fixed-share": LearnedMetricSpiral(extend_closing=False),
     "learned-metric-long-crawl-window": LearnedMetricSpiral(crawl_window=4.0),
+    "learned-metric-cma-path": LearnedMetricSpiral(path_frame="cma"),
 }
 SPIRALS = (*RULES, *INGREDIENTS)
 REFERENCES = ("cma", "bipop-cma", "bfgs", "nelder-mead", "random")

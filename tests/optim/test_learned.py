@@ -342,6 +342,7 @@ def test_x0_seeds_the_first_poll():
         ({"unbiased_sigma": "yes"}, "`unbiased_sigma` must be True or False"),
         ({"extend_closing": 1}, "`extend_closing` must be True or False"),
         ({"crawl_window": 0}, "`crawl_window` must be a finite number > 0"),
+        ({"path_frame": "eigen"}, "`path_frame` must be one of"),
         ({"max_condition": 0.5}, "`max_condition` must be >= 1 or None"),
     ],
 )
@@ -518,6 +519,44 @@ def test_a_poll_stepped_past_its_steps_underflow_raises_nothing():
         search.step()
     assert np.all(search.steps == 0.0)
     assert search.fun == 0.0
+
+
+@pytest.mark.parametrize("frame", ["basis", "cma"])
+def test_the_step_size_path_is_taken_in_its_frame(frame):
+    # One generation from a zero path in a learned metric C: the path is the
+    # mean's step times sqrt(c_s (2 - c_s) mu_eff), whitened by C^-1/2
+    # (CMA-ES's, "cma") or by B^-1 (the latest basis's coordinates), which
+    # has the same length.
+    n = 4
+    search = LearnedMetricSearch(
+        _quadratic(np.diag([1.0, 10.0, 100.0, 1000.0])),
+        [(-1, 1)] * n,
+        LearnedMetricSpiral(path_frame=frame),
+        n_points=4,
+        rng=0,
+    )
+    search._start_population(8)
+    enc = search._encoding
+    rng = np.random.default_rng(1)
+    enc.learn(
+        rng.standard_normal(n),
+        3.0 * rng.standard_normal((enc.weights.size, n)),
+        normalise=False,
+    )
+    values, vectors = eigh(enc.covariance)
+    whiten = vectors @ np.diag(values**-0.5) @ vectors.T
+    sigma, before = search._sigma, (search._c - search._lo) / search._width
+    mu_eff, c_s, _, _ = search._csa
+    search._generation()
+    step = ((search._c - search._lo) / search._width - before) / sigma
+    expected = math.sqrt(c_s * (2.0 - c_s) * mu_eff) * (whiten @ step)
+    assert np.linalg.norm(search._path) == pytest.approx(
+        np.linalg.norm(expected), rel=1e-9
+    )
+    if frame == "cma":
+        np.testing.assert_allclose(search._path, expected, rtol=1e-9, atol=1e-12)
+    else:
+        assert not np.allclose(search._path, expected)
 
 
 @pytest.mark.parametrize(("window", "periods"), [(2.0, 40), (4.0, 80)])
