@@ -176,7 +176,7 @@ class LearnedMetricSpiral:
         m) / sigma`` (Hansen's tutorial, 2016), in fixed coordinates. On
         BBOB at D = 20 ``"cma"`` gains the sharp ridge (0.38 to 0.46 of the
         triples) and loses the step ellipsoid (0.90 to 0.58) and
-        Gallagher's functions: 0.559 against 0.569 in all (figures in the
+        Gallagher's functions: 0.560 against 0.569 in all (figures in the
         BBOB results), so the default keeps the moving frame.
     suspend_crawl : bool
         With restarts, suspend a poll that crawls instead of letting it spend
