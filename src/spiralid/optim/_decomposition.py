@@ -8,7 +8,7 @@ import numpy as np
 
 from spiralid.optim.encoding import AdaptiveEncoding
 from spiralid.optim.front import non_dominated, thin_front, weight_vectors
-from spiralid.optim.learned import LearnedMetricSpiral
+from spiralid.optim.learned_rule import LearnedMetricSpiral
 from spiralid.optim.rotation import rotate
 from spiralid.optim.rules import SpiralRule
 

@@ -72,7 +72,7 @@ from spiralid.optim.front import (
     thin_front,
     weight_vectors,
 )
-from spiralid.optim.learned import LearnedMetricSpiral
+from spiralid.optim.learned_rule import LearnedMetricSpiral
 from spiralid.optim.result import OptimiserResult
 from spiralid.optim.rules import SpiralRule
 from spiralid.optim.spiral import RULES, _parse_method
