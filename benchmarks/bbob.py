@@ -425,7 +425,9 @@ def _parse(argv):
         help="only tabulate the complete tasks already in OUTPUT",
     )
     parser.add_argument(
-        "--markdown", action="store_true", help="also print the README's tables"
+        "--markdown",
+        action="store_true",
+        help="also print the results' tables (by method, group and function)",
     )
     return parser.parse_args(argv)
 
@@ -493,6 +495,10 @@ def _summarise(args, out) -> dict:
                 "groups": {
                     group: fraction_reached(deltas, dim, functions)[0]
                     for group, functions in GROUPS.items()
+                },
+                "functions": {
+                    f"f{f}": fraction_reached(deltas, dim, [f])[0]
+                    for f in sorted(args.functions)
                 },
                 "problems": problems,
                 "wall_s": wall,
@@ -563,6 +569,14 @@ def _markdown(args, summary) -> None:
         if row is not None:
             cells = [format(row["groups"][g], ".3f") for g in GROUPS]
             print(f"| {method} | " + " | ".join(cells) + " |")
+    print(f"\nfraction by function, D = {largest}\n")
+    rows = [summary.get(f"{method} D={largest}") for method in args.methods]
+    shown = [(m, r) for m, r in zip(args.methods, rows, strict=True) if r]
+    print("| function | " + " | ".join(m for m, _ in shown) + " |")
+    print("|---|" + "---|" * len(shown))
+    for f in sorted(args.functions):
+        cells = [format(r["functions"][f"f{f}"], ".3f") for _, r in shown]
+        print(f"| f{f} | " + " | ".join(cells) + " |")
     walls = {
         d: sum(r["wall_s"] for r in summary.values() if r["dim"] == d) for d in dims
     }

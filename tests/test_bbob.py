@@ -74,7 +74,15 @@ def test_script_runs_at_reduced_size_and_cocopp_reads_its_data(tmp_path):
     args = ["--dims", "2", "--functions", "1", "8", "15", "--instances", "1"]
     env = dict(os.environ, MPLBACKEND="Agg")
     proc = subprocess.run(
-        [sys.executable, str(SCRIPT), *args, "--output", str(out), "--cocopp"],
+        [
+            sys.executable,
+            str(SCRIPT),
+            *args,
+            "--output",
+            str(out),
+            "--cocopp",
+            "--markdown",
+        ],
         capture_output=True,
         text=True,
         env=env,
@@ -90,6 +98,13 @@ def test_script_runs_at_reduced_size_and_cocopp_reads_its_data(tmp_path):
         assert 0.0 <= row["fraction"] <= 1.0
         assert 0 < row["evaluations"] <= 3 * 2000
         assert row["method"] in proc.stdout
+        # Per function, the fraction over that function's triples: the
+        # three functions' mean is the whole fraction (one instance each).
+        functions = row["functions"]
+        assert set(functions) == {"f1", "f8", "f15"}
+        assert sum(functions.values()) / 3 == pytest.approx(row["fraction"])
+    assert "fraction by function, D = 2" in proc.stdout
+    assert "| f15 | " in proc.stdout
     # IPOP-CMA-ES solves the 2-D sphere, Rosenbrock and Rastrigin here.
     assert summary["cma D=2"]["fraction"] > 0.9
     assert (out / "exdata" / "sda" / "D2" / "bbobexp_f8.info").is_file()
