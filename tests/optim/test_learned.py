@@ -478,17 +478,18 @@ def _trail(f, steps, conditions):
     ]
 
 
+def _search(H, rule):
+    """A search on the quadratic `H` in the box [-1, 1]^n, stepped by hand."""
+    return LearnedMetricSearch(
+        _quadratic(H), [(-1, 1)] * H.shape[0], rule, n_points=4, rng=0
+    )
+
+
 def test_the_crawl_test_tells_a_crawl_from_a_converging_poll():
     # n = 2: the window is 30 periods. A converging poll's gains shrink with
     # the square of its steps (f = s^2 on a quadratic); a crawl's gains stay
     # while its steps fall; a metric still growing its condition is spared.
-    search = LearnedMetricSearch(
-        _quadratic(np.eye(2)),
-        [(-1, 1)] * 2,
-        LearnedMetricSpiral(suspend_crawl=True),
-        n_points=4,
-        rng=0,
-    )
+    search = _search(np.eye(2), LearnedMetricSpiral(suspend_crawl=True))
     k = np.arange(61)
     steps = 0.5 * 0.9**k
     settled = np.full(k.size, 10.0)
@@ -528,12 +529,8 @@ def test_the_step_size_path_is_taken_in_its_frame(frame):
     # (CMA-ES's, "cma") or by B^-1 (the latest basis's coordinates), which
     # has the same length.
     n = 4
-    search = LearnedMetricSearch(
-        _quadratic(np.diag([1.0, 10.0, 100.0, 1000.0])),
-        [(-1, 1)] * n,
-        LearnedMetricSpiral(path_frame=frame),
-        n_points=4,
-        rng=0,
+    search = _search(
+        np.diag([1.0, 10.0, 100.0, 1000.0]), LearnedMetricSpiral(path_frame=frame)
     )
     search._start_population(8)
     enc = search._encoding
@@ -562,13 +559,7 @@ def test_the_step_size_path_is_taken_in_its_frame(frame):
 @pytest.mark.parametrize(("window", "periods"), [(2.0, 40), (4.0, 80)])
 def test_the_crawl_test_looks_back_crawl_window_periods_per_dimension(window, periods):
     # n = 20: a crawl is seen once the trail holds two windows and one.
-    search = LearnedMetricSearch(
-        _quadratic(np.eye(20)),
-        [(-1, 1)] * 20,
-        LearnedMetricSpiral(crawl_window=window),
-        n_points=4,
-        rng=0,
-    )
+    search = _search(np.eye(20), LearnedMetricSpiral(crawl_window=window))
     k = np.arange(2 * periods + 1)
     crawl = _trail(1.0 - 1e-3 * k, 0.5 * 0.9**k, np.full(k.size, 10.0))
     search._trail = crawl[:-1]
@@ -583,13 +574,7 @@ def test_a_population_run_closing_in_on_the_held_poll_goes_on(extend):
     # held poll is at 0.0; the run, at 1.0, gained 0.4 over the window: at
     # that rate it reaches 0.0 within 3 windows (1.2 >= 1.0), so it is not
     # cut at its share; having gained 0.3 (0.9 < 1.0), it is.
-    search = LearnedMetricSearch(
-        _quadratic(np.eye(2)),
-        [(-1, 1)] * 2,
-        LearnedMetricSpiral(extend_closing=extend),
-        n_points=4,
-        rng=0,
-    )
+    search = _search(np.eye(2), LearnedMetricSpiral(extend_closing=extend))
     search._start_population(8)
     search._held = (np.zeros(2), 0.0, None, None, 4)
     search._held_nfev = 10
