@@ -135,21 +135,38 @@ class _Timed:
         return out
 
 
+class _Spent(Exception):
+    """The budget is spent or the final target hit: ends a run from inside."""
+
+
 def _spiral(problem, objective, budget, rng, method, n_points):
+    """A spiral search, ended by its budget or, as BIPOP-CMA-ES is, by the
+    objective once the final target is hit (a callback would build the
+    search's result after every period, and that is not the optimiser's
+    time)."""
     name, restarts = method.removesuffix(RESTART), method.endswith(RESTART)
     bounds = np.column_stack([problem.lower_bounds, problem.upper_bounds])
-    minimize(
-        objective,
-        bounds,
-        INGREDIENTS.get(name, name),
-        n_points=n_points,
-        max_iter=budget,  # the evaluation budget binds first
-        max_nfev=budget,
-        rng=rng,
-        vectorized=True,
-        restarts=Restarts() if restarts else False,
-        callback=lambda _: problem.final_target_hit,
-    )
+
+    def until_target(X):
+        out = objective(X)
+        if problem.final_target_hit:
+            raise _Spent
+        return out
+
+    try:
+        minimize(
+            until_target,
+            bounds,
+            INGREDIENTS.get(name, name),
+            n_points=n_points,
+            max_iter=budget,  # the evaluation budget binds first
+            max_nfev=budget,
+            rng=rng,
+            vectorized=True,
+            restarts=Restarts() if restarts else False,
+        )
+    except _Spent:
+        pass
 
 
 def _cma(problem, objective, budget, rng, method, n_points):
@@ -181,10 +198,6 @@ def _cma(problem, objective, budget, rng, method, n_points):
             X = es.ask()
             es.tell(X, objective(np.array(X)).tolist())
         popsize = 2 * es.popsize
-
-
-class _Spent(Exception):
-    """The budget is spent: ends a reference optimiser's run from inside."""
 
 
 def _capped(problem, objective, budget):

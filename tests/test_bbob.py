@@ -118,3 +118,39 @@ def test_script_runs_at_reduced_size_and_cocopp_reads_its_data(tmp_path):
         check=False,
     )
     assert again.returncode != 0 and "not empty" in again.stderr
+
+
+class _SphereHitAt:
+    """A 3-D sphere that reports its final target hit from the `hit_at`-th
+    evaluation on, as COCO's problems do once f - f_opt <= 1e-8."""
+
+    dimension = 3
+    lower_bounds = np.full(3, -5.0)
+    upper_bounds = np.full(3, 5.0)
+
+    def __init__(self, hit_at):
+        self.hit_at = hit_at
+        self.evaluations = 0
+
+    @property
+    def final_target_hit(self):
+        return self.evaluations >= self.hit_at
+
+    def __call__(self, x):
+        self.evaluations += 1
+        return float(np.dot(x, x))
+
+
+@pytest.mark.parametrize("method", ["learned-metric+restarts", "ebsda"])
+def test_a_spiral_run_ends_at_the_objective_call_that_hits_the_target(method):
+    # Without a callback the search is ended from inside the objective; the
+    # run returns quietly with the evaluations counted up to that call.
+    bbob = _bbob()
+    problem = _SphereHitAt(hit_at=300)
+    objective = bbob._Timed(problem)
+    bbob._spiral(problem, objective, 5000, np.random.default_rng(0), method, 10)
+    # A call evaluates at most a population (ebsda: 9 moving points).
+    assert 300 <= problem.evaluations < 300 + 10
+    never = _SphereHitAt(hit_at=10**9)
+    bbob._spiral(never, bbob._Timed(never), 2000, np.random.default_rng(0), method, 10)
+    assert 2000 - 50 < never.evaluations <= 2000
