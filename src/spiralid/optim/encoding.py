@@ -169,7 +169,7 @@ class AdaptiveEncoding:
         # In rows, as numpy returns them: the products below then sum in the
         # same order.
         vectors = np.ascontiguousarray(vectors)
-        if info != 0 or not (np.all(np.isfinite(values)) and values[0] > 0.0):
+        if info != 0 or not (np.isfinite(values).all() and values[0] > 0.0):
             # Rounding broke positive definiteness: keep the last metric.
             self.condition = math.inf
             return

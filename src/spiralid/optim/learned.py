@@ -214,7 +214,9 @@ class LearnedMetricSearch(SearchBase):
         """Costs of the rows of `x`, non-finite as inf; keeps the best."""
         out = self._costs(x)
         self.nfev += x.shape[0]
-        out[~np.isfinite(out)] = math.inf
+        finite = np.isfinite(out)
+        if not finite.all():
+            out[~finite] = math.inf
         best = int(out.argmin())
         if out[best] < self._best[1] or self._best[0] is None:
             self._best = (x[best].copy(), float(out[best]))
@@ -431,12 +433,15 @@ class LearnedMetricSearch(SearchBase):
         best_x, best_f = self._best
         success = [False] * n
         model = [0.0] * n
+        costs = []
+        isfinite, inf = math.isfinite, math.inf
         evaluated = 0
+        # Every pair from the current centre at once; only a move recomputes
+        # the pairs after it (the same sums, one call instead of n).
+        np.add(c, signed, out=polled)
         try:
             for j in range(n):
-                pair = np.add(
-                    c, signed[2 * j : 2 * j + 2], out=polled[2 * j : 2 * j + 2]
-                )
+                pair = polled[2 * j : 2 * j + 2]
                 if bounded:
                     apply_bounds(pair, self._lo, self._hi, self.bounds_policy)
                 if vectorized:
@@ -451,19 +456,23 @@ class LearnedMetricSearch(SearchBase):
                     a = float(check_costs(fun(pair[0].copy()), (), _SCALAR))
                     b = float(check_costs(fun(pair[1].copy()), (), _SCALAR))
                 evaluated += 2
-                if not math.isfinite(a):
-                    a = math.inf
-                if not math.isfinite(b):
-                    b = math.inf
-                polled_f[2 * j] = a
-                polled_f[2 * j + 1] = b
-                better, side = (a, 0) if a <= b else (b, 1)
+                if not isfinite(a):
+                    a = inf
+                if not isfinite(b):
+                    b = inf
+                costs.append(a)
+                costs.append(b)
+                if a <= b:
+                    better, side = a, 0
+                else:
+                    better, side = b, 1
                 if better < best_f:
                     best_x, best_f = pair[side].copy(), better
                 curvature = a + b - 2.0 * fc
                 vertex = 0.5 * (b - a) / curvature if curvature > 0.0 else 0.0
                 if better < fc:
                     c, fc = pair[side].copy(), better
+                    np.add(c, signed[2 * j + 2 :], out=polled[2 * j + 2 :])
                     success[j] = True
                     # From the moved centre, the vertex is one step nearer.
                     vertex = (vertex - (1.0 if side == 0 else -1.0)) if vertex else 0.0
@@ -472,6 +481,7 @@ class LearnedMetricSearch(SearchBase):
             self.nfev += evaluated
             self._c, self._f = c, fc
             self._best = (best_x, best_f)
+        polled_f[:] = costs
         return success, model
 
     def _generation(self) -> None:
@@ -488,7 +498,9 @@ class LearnedMetricSearch(SearchBase):
         else:
             z = self._rng.standard_normal((half, n))
         steps = self._sigma * (z @ enc.basis.T)
-        u = np.concatenate([u_centre + steps, u_centre - steps])
+        u = np.empty((2 * half, n))
+        np.add(u_centre, steps, out=u[:half])
+        np.subtract(u_centre, steps, out=u[half:])
         x = self._lo + u * self._width
         if self.bounds_policy != "none":
             apply_bounds(x, self._lo, self._hi, self.bounds_policy)
@@ -506,7 +518,8 @@ class LearnedMetricSearch(SearchBase):
             if self.rule.unbiased_sigma and self._population_runs > 1
             else mu_eff
         )
-        move = enc.inverse @ (mean - u_centre) / self._sigma
+        shift = mean - u_centre
+        move = enc.inverse @ shift / self._sigma
         if self.rule.path_frame == "cma":
             move = (enc.basis / enc.lengths) @ move  # V D^-1 V^T
         self._path = (1.0 - c_s) * self._path + math.sqrt(
@@ -515,7 +528,7 @@ class LearnedMetricSearch(SearchBase):
         # numpy.linalg.norm's own sum for a vector, without its dispatch.
         norm = math.sqrt(float(self._path.dot(self._path)))
         enc.learn(
-            math.sqrt(mu_eff) * (mean - u_centre) / self._sigma,
+            math.sqrt(mu_eff) * shift / self._sigma,
             (selected - u_centre) / self._sigma,
             normalise=False,
         )
