@@ -413,7 +413,7 @@ class LearnedMetricSearch(SearchBase):
             best = np.argsort(self._polled_f, kind="stable")[:n]
             self._encoding.update((self._polled[best] - self._lo) / self._width)
 
-    def _pairs(self, signed: np.ndarray) -> tuple[list, list]:
+    def _pairs(self, signed: np.ndarray) -> tuple[np.ndarray, list]:
         """Poll the period's pairs ``x* + signed[2j : 2j + 2]`` (``x* +- s_j
         b_j``) in turn, moving the centre to the better of a pair when it
         improves on it. Returns, per pair, whether it did, and the minimum of
@@ -431,7 +431,8 @@ class LearnedMetricSearch(SearchBase):
         bounded = self.bounds_policy != "none"
         c, fc = self._c, self._f
         best_x, best_f = self._best
-        success = [False] * n
+        # An array: np.where reads a list of bools element by element.
+        success = np.zeros(n, dtype=bool)
         model = [0.0] * n
         costs = []
         isfinite, inf = math.isfinite, math.inf
