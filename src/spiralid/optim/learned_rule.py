@@ -182,14 +182,11 @@ class LearnedMetricSpiral:
         ):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"`{name}` must be True or False")
-        if self.path_frame not in _PATH_FRAMES:
-            raise ValueError(
-                f"`path_frame` must be one of {_PATH_FRAMES}; got {self.path_frame!r}"
-            )
-        if self.sampling not in _SAMPLINGS:
-            raise ValueError(
-                f"`sampling` must be one of {_SAMPLINGS}; got {self.sampling!r}"
-            )
+        for name, allowed in (("sampling", _SAMPLINGS), ("path_frame", _PATH_FRAMES)):
+            if getattr(self, name) not in allowed:
+                raise ValueError(
+                    f"`{name}` must be one of {allowed}; got {getattr(self, name)!r}"
+                )
         if self.max_condition is not None:
             cap = positive(self.max_condition, "max_condition")
             if cap < 1.0:
