@@ -58,10 +58,12 @@ from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
 from ..models.narx import NARX, PolynomialNARX
 from ..models.polynomials import integrator_count, with_integrator
+from . import margin_choice
 from . import narx as _narx
 from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS
+from .heldback import HOLDBACK
 from .margin import AUTO, max_radius
 from .options import (
     IDENTIFY_DEFAULTS,
@@ -324,7 +326,14 @@ def identify(
         del given["integrator"]
         return _identify_integrating(data, arx, count, dict(method=method, **given))
     problem, options = _problem(method, data, arx, given)
-    return _estimate(method, problem, options, t_start)
+    res = METHODS[method].estimate(problem, **options)
+    margin = None
+    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
+        # The default margin only: a time constant the user gave is kept.
+        chosen = margin_choice.choose(problem, res, _holdback(method, options))
+        if chosen is not None:
+            problem, res, margin = chosen
+    return _packaged(method, problem, res, t_start, margin)
 
 
 def _default_arx(data: IOData, arx: ARX, integrator: int, rng) -> np.ndarray:
@@ -392,14 +401,27 @@ def _problem(method: str, data: IOData, arx: ARX, given: dict):
     return problem, options
 
 
-def _estimate(
-    method: str, problem: Problem, options: dict, t_start: float
+def _holdback(method: str, options: dict) -> float:
+    """The share of the record the margin's choice holds back: the
+    recommended method's `holdback` (None or 0: choose by the cost alone,
+    which keeps the margin), :data:`~spiralid.sysid.estimation.heldback.
+    HOLDBACK` for the others."""
+    if method == DEFAULT_METHOD:
+        return options.get("holdback", HOLDBACK) or 0.0
+    return HOLDBACK
+
+
+def _packaged(
+    method: str,
+    problem: Problem,
+    res,
+    t_start: float,
+    margin: margin_choice.MarginChoice | None = None,
 ) -> IdentifiedModel:
-    """Run the method on the problem; the model with its covariance."""
+    """The method's result on the problem as a model with its covariance."""
     spec = METHODS[method]
     data, arx, cost = problem.data, problem.arx, problem.cost
     predictor, initial = problem.predictor, problem.initial
-    res = spec.estimate(problem, **options)
     refined = res.get("refine")
     t_refine = 0.0 if refined is None else refined.elapsed
     cancelled = res.get("cancelled") or []
@@ -442,6 +464,7 @@ def _estimate(
         noise_variance=s2,
         cancellations=tuple(cancelled),
         selection=None if res.get("selection") is None else res.selection.to_dict(),
+        margin=None if margin is None else margin.to_dict(),
         **data.provenance(),
     )
 

@@ -120,6 +120,15 @@ class IdentifiedModel(FittedModel):
         ``held_back_rms``, whole-record ``cost``), the ``chosen`` one, the
         ``lowest_cost`` one and a ``note`` in words; None when the method
         chose by the cost alone.
+    margin : dict or None
+        What the held-back end said of the default stability margin where it
+        bound a pole (:mod:`~spiralid.sysid.estimation.margin_choice`): the
+        margin's ``time_constant`` and the bound pole's (``slowest``, in
+        seconds), the ``holdback`` share and ``n_held`` samples, the
+        ``held_back_rms`` of the model with the margin and without
+        (``"margin"``, ``"free"``), whether it was ``lifted`` and a ``note``
+        in words; None when the margin did not bind, was given explicitly
+        or was off.
     """
 
     theta: np.ndarray
@@ -138,6 +147,7 @@ class IdentifiedModel(FittedModel):
     noise_variance: float = float("nan")
     cancellations: tuple = ()
     selection: dict | None = None
+    margin: dict | None = None
 
     def __post_init__(self) -> None:
         self._check_provenance()
@@ -376,6 +386,7 @@ class IdentifiedModel(FittedModel):
             "noise_variance": _finite_or_none(self.noise_variance),
             "cancellations": [dict(c) for c in self.cancellations],
             "selection": self.selection,
+            "margin": self.margin,
             "modes": self.modes.to_dict(),
         }
         if out["result"] is not None and self.refine_result is not None:
@@ -428,7 +439,8 @@ class IdentifiedModel(FittedModel):
                 if d.get("noise_variance") is not None
                 else math.nan,
                 cancellations=_cancellations_field(d),
-                selection=_selection_field(d),
+                selection=_note_field(d, "selection"),
+                margin=_note_field(d, "margin"),
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None
@@ -462,12 +474,13 @@ def _integrator_field(d: dict) -> int:
     return int(value)
 
 
-def _selection_field(d: dict) -> dict | None:
-    """The file's ``selection``: an object with a ``note``, or null."""
-    value = d.get("selection")
+def _note_field(d: dict, name: str) -> dict | None:
+    """The file's ``selection`` or ``margin``: an object with a ``note``, or
+    null (absent in files written before it)."""
+    value = d.get(name)
     if value is not None and not (isinstance(value, dict) and "note" in value):
         raise ValueError(
-            f"field 'selection' must be an object with a 'note' or null; got {value!r}"
+            f"field {name!r} must be an object with a 'note' or null; got {value!r}"
         )
     return value
 

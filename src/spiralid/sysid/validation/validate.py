@@ -262,10 +262,24 @@ def validate(
         fit_percent_measured=fit_from_measured(model, data),
         diverged=diverged,
         output_error=_fitted_error(model) == "simulation",
-        choice=(getattr(model, "selection", None) or {}).get("note"),
+        choice=_choice_notes(model),
         nonlinear=nonlinear,
         **extras,
     )
+
+
+def _choice_notes(model) -> str | None:
+    """What the estimate's held-back choices said (among minima, and of the
+    stability margin), in words; None when it made neither."""
+    notes = [
+        record["note"]
+        for record in (
+            getattr(model, "selection", None),
+            getattr(model, "margin", None),
+        )
+        if record
+    ]
+    return ". Then ".join(notes) or None
 
 
 def _fitted_error(model) -> str:
