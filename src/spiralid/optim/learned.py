@@ -87,6 +87,7 @@ _MAX_CONDITION = 1e14
 # IPOP-CMA-ES is run with on [-5, 5]^n).
 _SIGMA0 = 0.2
 _TINY = float(np.finfo(float).tiny)
+_FLOAT = np.dtype(np.float64)
 # suspend_crawl: a poll crawls when, over its last `w` periods (at least
 # _CRAWL_MIN_WINDOW, `crawl_window` n otherwise), its gains fell
 # by less than 1/_CRAWL_RATIO of the fall its steps' squares predict (a
@@ -204,6 +205,12 @@ class LearnedMetricSearch(SearchBase):
         self._resumed = False
         self._polled = np.empty((2 * n, n))
         self._polled_f = np.empty(2 * n)
+        # The poll's views of its pairs and of the rows after each, made once
+        # rather than sliced anew at every pair.
+        self._pair_views = [
+            (self._polled[2 * j : 2 * j + 2], self._polled[2 * j + 2 :])
+            for j in range(n)
+        ]
         self._start_poll(seed_points(x0, self._lo, self._hi, m), m)
         self.initial_nonfinite = not math.isfinite(self._f)
         self.history = Trace(self.fun)
@@ -434,29 +441,31 @@ class LearnedMetricSearch(SearchBase):
         # An array: np.where reads a list of bools element by element.
         success = np.zeros(n, dtype=bool)
         model = [0.0] * n
+        # Two costs per pair evaluated, so also the count of evaluations.
         costs = []
         isfinite, inf = math.isfinite, math.inf
-        evaluated = 0
         # Every pair from the current centre at once; only a move recomputes
         # the pairs after it (the same sums, one call instead of n).
         np.add(c, signed, out=polled)
         try:
-            for j in range(n):
-                pair = polled[2 * j : 2 * j + 2]
+            for j, (pair, after) in enumerate(self._pair_views):
                 if bounded:
                     apply_bounds(pair, self._lo, self._hi, self.bounds_policy)
                 if vectorized:
                     raw = fun(pair.copy())
                     out = np.asarray(raw)
-                    if out.shape != (2,) or out.dtype.kind not in "biuf":
-                        # Only now build the message.
-                        check_costs(raw, (2,), self._batch_shape(pair))
-                    a, b = out.tolist()
-                    a, b = float(a), float(b)
+                    if out.dtype is _FLOAT and out.shape == (2,):
+                        # Already Python floats: the common case's short cut.
+                        a, b = out.tolist()
+                    else:
+                        if out.shape != (2,) or out.dtype.kind not in "biuf":
+                            # Only now build the message.
+                            check_costs(raw, (2,), self._batch_shape(pair))
+                        a, b = out.tolist()
+                        a, b = float(a), float(b)
                 else:
                     a = float(check_costs(fun(pair[0].copy()), (), _SCALAR))
                     b = float(check_costs(fun(pair[1].copy()), (), _SCALAR))
-                evaluated += 2
                 if not isfinite(a):
                     a = inf
                 if not isfinite(b):
@@ -467,19 +476,23 @@ class LearnedMetricSearch(SearchBase):
                     better, side = a, 0
                 else:
                     better, side = b, 1
-                if better < best_f:
-                    best_x, best_f = pair[side].copy(), better
                 curvature = a + b - 2.0 * fc
                 vertex = 0.5 * (b - a) / curvature if curvature > 0.0 else 0.0
                 if better < fc:
+                    # The centre and the best point may share one array:
+                    # neither is ever written in place.
                     c, fc = pair[side].copy(), better
-                    np.add(c, signed[2 * j + 2 :], out=polled[2 * j + 2 :])
+                    if better < best_f:
+                        best_x, best_f = c, better
+                    np.add(c, signed[2 * j + 2 :], out=after)
                     success[j] = True
                     # From the moved centre, the vertex is one step nearer.
                     vertex = (vertex - (1.0 if side == 0 else -1.0)) if vertex else 0.0
+                elif better < best_f:
+                    best_x, best_f = pair[side].copy(), better
                 model[j] = vertex
         finally:
-            self.nfev += evaluated
+            self.nfev += len(costs)
             self._c, self._f = c, fc
             self._best = (best_x, best_f)
         polled_f[:] = costs
