@@ -229,6 +229,29 @@ class LearnedMetricSearch(SearchBase):
             self._best = (x[best].copy(), float(out[best]))
         return out
 
+    def _evaluate_one(self, x: np.ndarray) -> float:
+        """:meth:`_evaluate` for one point, `x` of shape ``(1, n)``, as a
+        float: the model step and a population's mean are evaluated every
+        period, and the general path's array calls cost more than a
+        cheap objective."""
+        if self.vectorized:
+            raw = self._fun(x.copy())
+            out = np.asarray(raw)
+            if out.dtype is _FLOAT and out.shape == (1,):
+                cost = out.item()
+            else:
+                if out.shape != (1,) or out.dtype.kind not in "biuf":
+                    check_costs(raw, (1,), self._batch_shape(x))
+                cost = float(out[0])
+        else:
+            cost = float(check_costs(self._fun(x[0].copy()), (), _SCALAR))
+        self.nfev += 1
+        if not math.isfinite(cost):
+            cost = math.inf
+        if cost < self._best[1] or self._best[0] is None:
+            self._best = (x[0].copy(), cost)
+        return cost
+
     # -- runs ------------------------------------------------------------------
     def _start_poll(self, seeds: np.ndarray, m: int) -> None:
         """Start a poll from the best of `m` points (`seeds` first)."""
@@ -260,7 +283,7 @@ class LearnedMetricSearch(SearchBase):
         n = self._lo.size
         u = self._rng.uniform(size=n)
         self._c = self._lo + u * self._width
-        self._f = float(self._evaluate(self._c[None, :])[0])
+        self._f = self._evaluate_one(self._c[None, :])
         self._lambda = size
         self._population_runs += 1
         self._sigma = _SIGMA0
@@ -409,7 +432,7 @@ class LearnedMetricSearch(SearchBase):
             trial = (self._c + np.asarray(model) @ directions)[None, :]
             if self.bounds_policy != "none":
                 apply_bounds(trial, self._lo, self._hi, self.bounds_policy)
-            cost = float(self._evaluate(trial)[0])
+            cost = self._evaluate_one(trial)
             if cost < self._f:
                 self._c, self._f = trial[0], cost
         self._period_best = self._f
@@ -548,7 +571,7 @@ class LearnedMetricSearch(SearchBase):
         )
         self._sigma *= math.exp(min(1.0, c_s / d_s * (norm / chi_n - 1.0)))
         self._c = self._lo + mean * self._width
-        self._f = float(self._evaluate(self._c[None, :])[0])
+        self._f = self._evaluate_one(self._c[None, :])
         self._period_best = min(self._f, float(f[order[0]]))
 
     def _orthogonal(self, count: int) -> np.ndarray:
