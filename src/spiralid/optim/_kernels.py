@@ -193,14 +193,19 @@ def covariance_update(
     gain = np.sqrt(c_p * (2.0 - c_p))
     for a in range(n):
         path[a] = (1.0 - c_p) * path[a] + gain * z[0, a]
-    # The rank-mu sum row by row of z, so the inner loop runs along memory.
+    # The rank-mu sum row by row of z, so the inner loop runs along memory,
+    # and over whole rows: a loop starting at the diagonal is not
+    # vectorised, and one of fixed length is twice as fast at n = 20-40 with
+    # twice the products. Only the upper triangle is read.
     rank_mu = np.zeros((n, n))
     for i in range(1, k):
         wi = weights[i - 1]
+        zi = z[i]
         for a in range(n):
-            wa = wi * z[i, a]
-            for b in range(a, n):
-                rank_mu[a, b] += wa * z[i, b]
+            wa = wi * zi[a]
+            row = rank_mu[a]
+            for b in range(n):
+                row[b] += wa * zi[b]
     keep = 1.0 - c_1 - c_mu
     out = np.empty((n, n))
     for a in range(n):
