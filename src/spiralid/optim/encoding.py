@@ -127,7 +127,12 @@ class AdaptiveEncoding:
             return
         old = self.mean
         self.mean = mean
-        self.learn(mean - old, x - old)
+        # The shift and the steps written straight into the rows the
+        # update takes (as learn() would copy them there).
+        z = np.empty((x.shape[0] + 1, self.n))
+        np.subtract(mean, old, out=z[0])
+        np.subtract(x, old, out=z[1:])
+        self._learn(z, self.weights, True)
 
     def learn(self, shift, steps, *, normalise: bool = True, weights=None) -> None:
         """Update the metric from the mean's `shift` (the path's step) and
@@ -146,6 +151,11 @@ class AdaptiveEncoding:
         z = np.empty((w.size + 1, self.n))
         z[0] = shift
         z[1:] = steps
+        self._learn(z, w, normalise)
+
+    def _learn(self, z: np.ndarray, w: np.ndarray, normalise: bool) -> None:
+        """:meth:`learn` from the shift (row 0 of `z`) and the steps (the
+        other rows) with weights `w`; `z` is overwritten."""
         C = covariance_update(
             self.covariance,
             self.path,
@@ -169,21 +179,24 @@ class AdaptiveEncoding:
         # In rows, as numpy returns them: the products below then sum in the
         # same order.
         vectors = np.ascontiguousarray(vectors)
-        if info != 0 or not (np.isfinite(values).all() and values[0] > 0.0):
+        # Python floats: n of them are checked faster than NumPy dispatches
+        # one call on the array.
+        listed = values.tolist()
+        low, high = listed[0], listed[-1]
+        if info != 0 or not (low > 0.0 and all(map(math.isfinite, listed))):
             # Rounding broke positive definiteness: keep the last metric.
             self.condition = math.inf
             return
-        if self.max_condition is not None and values[-1] > (
-            self.max_condition * values[0]
-        ):
+        if self.max_condition is not None and high > self.max_condition * low:
             # A direction every selected step favours grows without bound
             # in the normalised update (the bent cigar's, to 1e13); keep
             # the others' scale within reach of the poll's steps.
             values = np.maximum(values, values[-1] / self.max_condition)
             C = (vectors * values) @ vectors.T
+            low = float(values[0])
         self.covariance = C
         d = np.sqrt(values)
         self.lengths = d
         self.basis = vectors * d
         self._inverse = (vectors / d).T
-        self.condition = float(values[-1] / values[0])
+        self.condition = high / low
