@@ -438,10 +438,13 @@ class LearnedMetricSearch(SearchBase):
         self._period_best = self._f
         if not rule.success_steps:
             self._steps *= rule.delta ** (1.0 / self._k_max)
-        self._flat = bool(self._polled_f.min() == self._polled_f.max())
+        # One sort for both: its ends are the costs' minimum and maximum
+        # (no NaN, non-finite costs being inf).
+        f = self._polled_f
+        order = np.argsort(f, kind="stable")
+        self._flat = bool(f[order[0]] == f[order[-1]])
         if rule.basis:
-            best = np.argsort(self._polled_f, kind="stable")[:n]
-            self._encoding.update((self._polled[best] - self._lo) / self._width)
+            self._encoding.update((self._polled[order[:n]] - self._lo) / self._width)
 
     def _pairs(self, signed: np.ndarray) -> tuple[np.ndarray, list]:
         """Poll the period's pairs ``x* + signed[2j : 2j + 2]`` (``x* +- s_j
