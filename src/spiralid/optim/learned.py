@@ -221,9 +221,11 @@ class LearnedMetricSearch(SearchBase):
         """Costs of the rows of `x`, non-finite as inf; keeps the best."""
         out = self._costs(x)
         self.nfev += x.shape[0]
-        finite = np.isfinite(out)
-        if not finite.all():
-            out[~finite] = math.inf
+        # A sum of squares is finite only if every cost is (it is never
+        # NaN for finite costs, and an overflow only sends it to the mask,
+        # which then changes nothing): one call instead of two.
+        if not math.isfinite(out.dot(out)):
+            out[~np.isfinite(out)] = math.inf
         best = int(out.argmin())
         if out[best] < self._best[1] or self._best[0] is None:
             self._best = (x[best].copy(), float(out[best]))
@@ -441,7 +443,8 @@ class LearnedMetricSearch(SearchBase):
         # One sort for both: its ends are the costs' minimum and maximum
         # (no NaN, non-finite costs being inf).
         f = self._polled_f
-        order = np.argsort(f, kind="stable")
+        # The method, without np.argsort's dispatch.
+        order = f.argsort(kind="stable")
         self._flat = bool(f[order[0]] == f[order[-1]])
         if rule.basis:
             self._encoding.update((self._polled[order[:n]] - self._lo) / self._width)
@@ -546,7 +549,7 @@ class LearnedMetricSearch(SearchBase):
             apply_bounds(x, self._lo, self._hi, self.bounds_policy)
             u = (x - self._lo) / self._width
         f = self._evaluate(x)
-        order = np.argsort(f, kind="stable")[: enc.weights.size]
+        order = f.argsort(kind="stable")[: enc.weights.size]
         selected = u[order]
         # Selection among equal costs is blind: a plateau, as pycma's
         # tolflatfitness.
