@@ -183,6 +183,11 @@ def identify(
         (the paper's searches and ``"de"`` without ``refine``, ``"ls"``) is
         refused: they keep eq. (3)'s penalty as printed. A plant that
         integrates is ``integrator=True``, never a pole near ``z = 1``.
+        Where ``"auto"``'s margin holds a pole, it is lifted if the model
+        without it validates with less than half the error on the held-back
+        end of the record (``holdback`` of ``"spiral"``, 0.2 for the others;
+        :mod:`~spiralid.sysid.estimation.margin_choice`, ``model.margin``
+        says what happened); a number is never lifted.
     cancel : bool, optional
         After ``"spiral"`` and ``"oe"`` (their default, True), remove a pole
         and a zero closer than the record's frequency resolution (``|p - z|

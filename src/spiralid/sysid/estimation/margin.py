@@ -22,6 +22,9 @@ circle, as before). The paper's searches (``"sda"``, ``"ebsda"``,
 stability penalty exactly as printed and no margin; a value other than
 ``"auto"`` given to one of them without ``refine=True`` is refused, as it is
 for ``"ls"`` (see :func:`~spiralid.sysid.estimation.identify.identify`).
+Where the default margin holds a pole, the held-back end decides whether
+the data need it lifted (:mod:`~spiralid.sysid.estimation.margin_choice`);
+a time constant given explicitly is kept.
 
 A plant that integrates is not approximated by a pole near ``z = 1``: say
 so with ``integrator=True`` (or ``integrator=2`` for a double integrator,

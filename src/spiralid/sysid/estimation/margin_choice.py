@@ -19,7 +19,9 @@ kept. Otherwise the two models are judged on data neither was fitted to,
 as the recommended method judges its minima
 (:mod:`~spiralid.sysid.estimation.heldback`): each is refitted locally on
 the first ``1 - h`` of the record and scored by its simulation error on
-the held-back end. The margin is lifted only when the model without it
+the held-back end (the free one is output error's best without the margin
+from the released minimum and from its own starts). The margin is lifted
+only when the model without it
 validates there with less than :data:`LIFT` of the margined model's error:
 a drift can make the free model look a little better on a short held-back
 end (on ``benchmarks/drift.py``'s record at ARX(8, 8, 0), 2 of 10 seeds
@@ -36,7 +38,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import heldback
-from .local_estimators import _cancel, _polish
+from .local_estimators import _cancel, _polish, _standard_starts
 from .outputerror import local_polish
 from .parametrizations import make_parametrization
 from .problem import EstimatorResult, Problem
@@ -193,9 +195,12 @@ def choose(
     gain = float(cost(first.x) / cost(result.x))
     scores = unbound = None
     if gain < SCREEN:
-        # From the bound minimum again: continued from the screen's two
-        # steps, the polish ended in a worse minimum on one hub record.
-        unbound = _polish(free, {"released": bound}, "simulation", cost)
+        # From the bound minimum again (continued from the screen's two
+        # steps, the polish ended in a worse minimum on one hub record), and
+        # from output error's own starts, which found a lower minimum
+        # without the margin on the rig's hub angle at ARX(8, 8, 0).
+        starts = {"released": bound, **_standard_starts(free)}
+        unbound = _polish(free, starts, "simulation", cost)
         if free.cancel:
             _cancel(free, unbound, cost)
         gain = float(cost(unbound.x) / cost(result.x))
