@@ -126,7 +126,10 @@ class Validation:
     choice : str or None
         How the estimation chose among its distinct minima on the held-back
         end of its record (the ``note`` of
-        :attr:`~spiralid.sysid.IdentifiedModel.selection`), or None.
+        :attr:`~spiralid.sysid.IdentifiedModel.selection`), then whether it
+        kept or lifted the default stability margin where that held a pole
+        (the ``note`` of :attr:`~spiralid.sysid.IdentifiedModel.margin`),
+        or None when it did neither.
     nonlinear : NonlinearChecks or None
         A nonlinear model's own part: the Billings-Voon higher-order
         correlation tests and what the network added over its linear start
