@@ -181,29 +181,9 @@ def choose(
             problem.parametrization.name, problem.data, problem.arx, None
         ),
     )
-    # Released, the bound minimum's held-back pole moves out to where the
-    # data put it: a few steps tell whether it gains enough to ask the
-    # held-back end, and only then is it polished in full.
-    cost = free.simulation_cost()
-    first = _polish(
-        free,
-        {"released": bound},
-        "simulation",
-        cost,
-        SCREEN_NFEV * (free.arx.n_params + 1),
-    )
-    gain = float(cost(first.x) / cost(result.x))
-    scores = unbound = None
-    if gain < SCREEN:
-        # From the bound minimum again (continued from the screen's two
-        # steps, the polish ended in a worse minimum on one hub record), and
-        # from output error's own starts, which found a lower minimum
-        # without the margin on the rig's hub angle at ARX(8, 8, 0).
-        starts = {"released": bound, **_standard_starts(free)}
-        unbound = _polish(free, starts, "simulation", cost)
-        if free.cancel:
-            _cancel(free, unbound, cost)
-        gain = float(cost(unbound.x) / cost(result.x))
+    gain, unbound = _released(free, result, bound)
+    scores = None
+    if unbound is not None:
         scores = {
             "margin": _held_back_rms(problem, result.x, start),
             "free": _held_back_rms(free, unbound.x, start),
@@ -223,6 +203,31 @@ def choose(
     unbound.elapsed += result.elapsed
     unbound.message = f"{result.message} Then {choice.sentence()}."
     return free, unbound, choice
+
+
+def _released(
+    free: Problem, result: EstimatorResult, bound: np.ndarray
+) -> tuple[float, EstimatorResult | None]:
+    """The bound minimum released: the cost of output error's best without
+    the margin as a share of `result`'s, and that estimate (None when a
+    few steps show it gains too little to ask the held-back end)."""
+    cost = free.simulation_cost()
+    # Two steps tell whether the held-back pole, moving out to where the
+    # data put it, gains enough; only then is it polished in full.
+    cap = SCREEN_NFEV * (free.arx.n_params + 1)
+    first = _polish(free, {"released": bound}, "simulation", cost, cap)
+    gain = float(cost(first.x) / cost(result.x))
+    if gain >= SCREEN:
+        return gain, None
+    # From the bound minimum again (continued from the screen's two steps,
+    # the polish ended in a worse minimum on one hub record), and from
+    # output error's own starts, which found a lower minimum without the
+    # margin on the rig's hub angle at ARX(8, 8, 0).
+    starts = {"released": bound, **_standard_starts(free)}
+    unbound = _polish(free, starts, "simulation", cost)
+    if free.cancel:
+        _cancel(free, unbound, cost)
+    return float(cost(unbound.x) / cost(result.x)), unbound
 
 
 def _held_back_rms(problem: Problem, theta: np.ndarray, start: int) -> float:
