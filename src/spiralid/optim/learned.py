@@ -237,14 +237,7 @@ class LearnedMetricSearch(SearchBase):
         period, and the general path's array calls cost more than a
         cheap objective."""
         if self.vectorized:
-            raw = self._fun(x.copy())
-            out = np.asarray(raw)
-            if out.dtype is _FLOAT and out.shape == (1,):
-                cost = out.item()
-            else:
-                if out.shape != (1,) or out.dtype.kind not in "biuf":
-                    check_costs(raw, (1,), self._batch_shape(x))
-                cost = float(out[0])
+            (cost,) = self._listed(self._fun(x.copy()), x)
         else:
             cost = float(check_costs(self._fun(x[0].copy()), (), _SCALAR))
         self.nfev += 1
@@ -253,6 +246,19 @@ class LearnedMetricSearch(SearchBase):
         if cost < self._best[1] or self._best[0] is None:
             self._best = (x[0].copy(), cost)
         return cost
+
+    def _listed(self, raw, x: np.ndarray) -> list:
+        """A vectorised objective's costs `raw` for the rows of `x` as
+        Python floats, checked only when they are not already a float64
+        vector of the right length (the hot loops' common case)."""
+        out = np.asarray(raw)
+        k = x.shape[0]
+        if out.dtype is _FLOAT and out.shape == (k,):
+            return out.tolist()
+        if out.shape != (k,) or out.dtype.kind not in "biuf":
+            # Only now build the message.
+            check_costs(raw, (k,), self._batch_shape(x))
+        return [float(v) for v in out.tolist()]
 
     # -- runs ------------------------------------------------------------------
     def _start_poll(self, seeds: np.ndarray, m: int) -> None:
@@ -481,17 +487,7 @@ class LearnedMetricSearch(SearchBase):
                 if bounded:
                     apply_bounds(pair, self._lo, self._hi, self.bounds_policy)
                 if vectorized:
-                    raw = fun(pair.copy())
-                    out = np.asarray(raw)
-                    if out.dtype is _FLOAT and out.shape == (2,):
-                        # Already Python floats: the common case's short cut.
-                        a, b = out.tolist()
-                    else:
-                        if out.shape != (2,) or out.dtype.kind not in "biuf":
-                            # Only now build the message.
-                            check_costs(raw, (2,), self._batch_shape(pair))
-                        a, b = out.tolist()
-                        a, b = float(a), float(b)
+                    a, b = self._listed(fun(pair.copy()), pair)
                 else:
                     a = float(check_costs(fun(pair[0].copy()), (), _SCALAR))
                     b = float(check_costs(fun(pair[1].copy()), (), _SCALAR))

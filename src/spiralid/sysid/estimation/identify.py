@@ -64,7 +64,7 @@ from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS
 from .heldback import HOLDBACK
-from .margin import AUTO, max_radius
+from .margin import AUTO, is_auto, max_radius
 from .options import (
     IDENTIFY_DEFAULTS,
     _check_method,
@@ -333,7 +333,7 @@ def identify(
     problem, options = _problem(method, data, arx, given)
     res = METHODS[method].estimate(problem, **options)
     margin = None
-    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
+    if is_auto(max_time_constant):
         # The default margin only: a time constant the user gave is kept.
         chosen = margin_choice.choose(problem, res, _holdback(method, options))
         if chosen is not None:
@@ -480,7 +480,7 @@ def margin_options(method: str, data: IOData, refine, max_time_constant, cancel)
     at all is :func:`check_method_options`' rule; here their values."""
     spec = METHODS[method]
     applies = spec.margin or (spec.search and bool(refine))
-    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
+    if is_auto(max_time_constant):
         seconds = data.n * data.ts if applies else None
     else:
         seconds = _time_constant(max_time_constant, data.ts)

@@ -68,6 +68,7 @@ from ..models.polynomials import step_down, step_up
 
 __all__ = [
     "AUTO",
+    "is_auto",
     "max_radius",
     "powers",
     "project_denominator",
@@ -79,6 +80,12 @@ __all__ = [
 # identify()'s default of `max_time_constant`: the record's length for the
 # methods the margin applies to, off for the others.
 AUTO = "auto"
+
+
+def is_auto(max_time_constant) -> bool:
+    """Whether `max_time_constant` is the default, :data:`AUTO` (a value
+    that is no string, an array say, is not)."""
+    return isinstance(max_time_constant, str) and max_time_constant == AUTO
 
 
 def max_radius(ts: float, max_time_constant) -> float | None:

@@ -50,7 +50,7 @@ from ..data import IOData
 from ..models.arx import ARX
 from ..models.polynomials import is_stable_polynomial
 from ..models.shared import SharedDenominatorModel
-from .margin import AUTO, max_radius
+from .margin import AUTO, is_auto, max_radius
 from .modal import ModalParametrization
 from .varpro import ProjectedCost, gauss_newton_polish
 
@@ -361,7 +361,7 @@ def identify_shared(
 
 
 def _radius(data: IOData, max_time_constant) -> float | None:
-    if isinstance(max_time_constant, str) and max_time_constant == AUTO:
+    if is_auto(max_time_constant):
         return max_radius(data.ts, data.n * data.ts)
     if max_time_constant is None:
         return None
