@@ -12,6 +12,9 @@ periods; ``-orthogonal``: orthogonal instead of independent directions in
 the population periods, an option added rather than an ingredient taken
 away; ``-global-stall``: a run's stall counted from the best of all runs,
 not its own; ``-lazy``: the basis decomposed every ``n // 10`` periods;
+``-eager``: every period, population runs too (the default decomposes on
+pycma's ``purecma`` gap, every second period of the first population run
+at D = 40 and every period below);
 ``-uncapped``: the poll's metric's condition unbounded; ``-mirror-biased``:
 every population run's step size with the mirrored pairs' bias;
 ``-fixed-share``: the population run after a suspended poll cut at half the
@@ -106,7 +109,8 @@ INGREDIENTS = {
     "learned-metric-polls-only": LearnedMetricSpiral(populations=False),
     "learned-metric-orthogonal": LearnedMetricSpiral(sampling="orthogonal"),
     "learned-metric-global-stall": LearnedMetricSpiral(run_stall=False),
-    "learned-metric-lazy": LearnedMetricSpiral(lazy_basis=True),
+    "learned-metric-lazy": LearnedMetricSpiral(basis_gap="n/10"),
+    "learned-metric-eager": LearnedMetricSpiral(basis_gap="every"),
     "learned-metric-uncapped": LearnedMetricSpiral(max_condition=None),
     "learned-metric-no-suspend": LearnedMetricSpiral(suspend_crawl=False),
     "learned-metric-mirror-biased": LearnedMetricSpiral(unbiased_sigma=False),

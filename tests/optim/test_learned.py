@@ -24,7 +24,7 @@ from spiralid.optim import (
     minimize,
 )
 from spiralid.optim._kernels import orthonormal_rows
-from spiralid.optim.learned import paired_mu_eff
+from spiralid.optim.learned import default_population, paired_mu_eff
 
 
 def _quadratic(H):
@@ -337,7 +337,7 @@ def test_x0_seeds_the_first_poll():
         ({"populations": 1}, "`populations` must be True or False"),
         ({"run_stall": "yes"}, "`run_stall` must be True or False"),
         ({"sampling": "sobol"}, "`sampling` must be one of"),
-        ({"lazy_basis": 1}, "`lazy_basis` must be True or False"),
+        ({"basis_gap": "lazy"}, "`basis_gap` must be one of"),
         ({"suspend_crawl": 1}, "`suspend_crawl` must be True or False"),
         ({"unbiased_sigma": "yes"}, "`unbiased_sigma` must be True or False"),
         ({"extend_closing": 1}, "`extend_closing` must be True or False"),
@@ -434,20 +434,69 @@ def test_a_lazy_encoding_decomposes_every_k_updates():
         AdaptiveEncoding(3, 2, eigen_every=0)
 
 
-def test_lazy_basis_decomposes_every_n_over_10_periods():
-    n = 20
+def _bases_changed(rule, n, periods, populations=False):
+    """Whether the basis changed over each of a search's `periods` periods
+    (of population runs with `populations`)."""
     H = _rotated_ellipsoid(n, 1e4, 1)
-    search = LearnedMetricSearch(
-        _quadratic(H), [(-5, 5)] * n, LearnedMetricSpiral(lazy_basis=True), rng=0
-    )
-    bases = []
-    for _ in range(6):
+    search = LearnedMetricSearch(_quadratic(H), [(-5, 5)] * n, rule, rng=0)
+    if populations:
+        search._start_population(default_population(n))
+    bases = [search.basis]
+    for _ in range(periods):
         search.step()
         bases.append(search.basis)
-    # The first period sets the encoding's mean; it decomposes after every
-    # second update from then on (n // 10 = 2).
-    changed = [not np.array_equal(a, b) for a, b in itertools.pairwise(bases)]
-    assert changed == [False, True, False, True, False]
+    return [not np.array_equal(a, b) for a, b in itertools.pairwise(bases)]
+
+
+def test_lazy_basis_decomposes_every_n_over_10_periods():
+    # The first poll period sets the encoding's mean; it decomposes after
+    # every second update from then on (n // 10 = 2).
+    changed = _bases_changed(LearnedMetricSpiral(basis_gap="n/10"), 20, 6)
+    assert changed == [False, False, True, False, True, False]
+
+
+@pytest.mark.parametrize(
+    ("n", "mu", "gap"),
+    # By hand from the rates: n = 40, mu = 15 (lambda 30) has c_1 + c_mu =
+    # 0.00876, so 0.5 / (0.00876 * 40) = 1.43: every second update.
+    [(40, 40, None), (40, 15, 2), (20, 12, 1), (64, 16, 3), (10, 10, 1)],
+)
+def test_the_purecma_gap_from_the_learning_rates(n, mu, gap):
+    enc = (
+        AdaptiveEncoding(n, mu)
+        if gap is None
+        else AdaptiveEncoding.for_population(n, mu)
+    )
+    rates = enc.c_1 + enc.c_mu
+    # pycma's purecma: decompose once more than 0.5 n lam / (rates n^2)
+    # evaluations have passed, lam = 2 mu of them per update.
+    lam = 2 * mu
+    evals_gap = 0.5 * n * lam / rates / n**2
+    expected = next(k for k in range(1, 10) if k * lam > evals_gap)
+    assert enc.lazy_gap() == expected
+    if gap is not None:
+        assert expected == gap
+
+
+def test_the_default_basis_gap_is_every_period_up_to_n_20_and_lazier_at_40():
+    default, every = LearnedMetricSpiral(), LearnedMetricSpiral(basis_gap="every")
+    # Polls decompose every period at any n (after the mean's first update).
+    assert _bases_changed(default, 40, 4)[1:] == [True] * 3
+    # Population runs: every period at n = 20, every second at n = 40.
+    assert _bases_changed(default, 20, 4, populations=True) == [True] * 4
+    assert _bases_changed(default, 40, 4, populations=True) == [False, True] * 2
+    assert _bases_changed(every, 40, 4, populations=True) == [True] * 4
+    # Up to n = 20 the default is the eager search, bit for bit.
+    ends = []
+    for rule in (default, every):
+        search = LearnedMetricSearch(
+            _quadratic(_rotated_ellipsoid(20, 1e4, 1)), [(-5, 5)] * 20, rule, rng=1
+        )
+        search._start_population(default_population(20))
+        for _ in range(30):
+            search.step()
+        ends.append((search.fun, search.centre.tobytes()))
+    assert ends[0] == ends[1]
 
 
 def test_a_capped_metric_keeps_its_axes_and_raises_the_small_eigenvalues():
@@ -530,7 +579,10 @@ def test_the_step_size_path_is_taken_in_its_frame(frame):
     # has the same length.
     n = 4
     search = _search(
-        np.diag([1.0, 10.0, 100.0, 1000.0]), LearnedMetricSpiral(path_frame=frame)
+        np.diag([1.0, 10.0, 100.0, 1000.0]),
+        # Decomposed after every update: at this small population the
+        # default would wait one more.
+        LearnedMetricSpiral(path_frame=frame, basis_gap="every"),
     )
     search._start_population(8)
     enc = search._encoding

@@ -108,6 +108,22 @@ class AdaptiveEncoding:
         )
         return enc
 
+    def lazy_gap(self) -> int:
+        """Updates between decompositions by the lazy gap of Hansen's
+        reference CMA-ES (pycma's ``cma.purecma``: decompose once more than
+        ``0.5 n lambda / ((c_1 + c_mu) n^2)`` evaluations have passed,
+        ``lambda`` of them per update): the least integer above ``0.5 /
+        ((c_1 + c_mu) n)``.
+
+        Examples
+        --------
+        >>> AdaptiveEncoding(40, 40).lazy_gap()  # the poll's rates: every update
+        1
+        >>> AdaptiveEncoding.for_population(40, 15).lazy_gap()
+        2
+        """
+        return math.floor(0.5 / ((self.c_1 + self.c_mu) * self.n)) + 1
+
     @property
     def inverse(self) -> np.ndarray:
         """``B^-1``."""

@@ -270,12 +270,8 @@ class LearnedMetricSearch(SearchBase):
         self._c = x[best].copy()
         self._f = float(f[best])
         self._steps = np.full(n, 0.25)
-        self._encoding = AdaptiveEncoding(
-            n,
-            n,
-            eigen_every=self.rule.eigen_gap(n),
-            max_condition=self.rule.max_condition,
-        )
+        self._encoding = AdaptiveEncoding(n, n, max_condition=self.rule.max_condition)
+        self._encoding.eigen_every = self.rule.eigen_every(self._encoding)
         self._regime = "poll"
         self._flat = False
         self._m = m
@@ -296,9 +292,8 @@ class LearnedMetricSearch(SearchBase):
         self._population_runs += 1
         self._sigma = _SIGMA0
         self._path = np.zeros(n)
-        self._encoding = AdaptiveEncoding.for_population(
-            n, size // 2, eigen_every=self.rule.eigen_gap(n)
-        )
+        self._encoding = AdaptiveEncoding.for_population(n, size // 2)
+        self._encoding.eigen_every = self.rule.eigen_every(self._encoding)
         # Cumulative step-size adaptation's constants (Hansen's tutorial,
         # 2016): mu_eff, c_sigma, d_sigma and E|N(0, I)|.
         mu_eff = 1.0 / float(np.sum(self._encoding.weights**2))

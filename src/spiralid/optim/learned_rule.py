@@ -15,6 +15,7 @@ __all__ = ["LearnedMetricSpiral"]
 
 _SAMPLINGS = ("gaussian", "orthogonal")
 _PATH_FRAMES = ("basis", "cma")
+_BASIS_GAPS = ("purecma", "every", "n/10")
 
 
 @dataclass(frozen=True)
@@ -49,13 +50,23 @@ class LearnedMetricSpiral:
         Count a run's stall from its own best cost (default): a restarted
         run still converging is not cut short because an earlier run went
         lower. False counts it from the best cost of all runs.
-    lazy_basis : bool
-        Decompose the learned metric into the basis only every
-        ``max(1, n // 10)`` periods in dimension ``n``, as CMA-ES's lazy
-        update (the metric keeps learning in between; the poll keeps the
-        last basis). Off by default: it cut the optimiser's own time at
-        ``n = 40`` by a third but lost triples on BBOB (at D = 40 the
-        ellipsoids' metric learned too slowly; figures in the BBOB results).
+    basis_gap : {"purecma", "every", "n/10"}
+        When the learned metric is decomposed into the basis; in between
+        the metric keeps learning while the basis, its inverse and the
+        condition stay as they were (CMA-ES's lazy update).
+        ``"purecma"`` (default): the lazy gap of Hansen's reference CMA-ES
+        (pycma's ``cma.purecma``), after more than ``0.5 n lambda /
+        ((c_1 + c_mu) n^2)`` evaluations, that is every ``k``-th update
+        with ``k`` the least integer above ``0.5 / ((c_1 + c_mu) n)``. At
+        the poll's rates (``c_1 + c_mu = 1/n``) that is every period; in the
+        search's population runs (``lambda`` twice CMA-ES's default, then
+        doubled) every period up to ``n = 22`` (the same search as
+        ``"every"``) and every second period of the first population run
+        from ``n = 23`` (``n = 40``: ``lambda = 30``). ``"every"``: every
+        period. ``"n/10"``: every ``max(1, n // 10)`` periods, polls too; it
+        cut the optimiser's own time at ``n = 40`` by a third but lost
+        triples on BBOB (the ellipsoids' metric learned too slowly; figures
+        in the BBOB results).
     unbiased_sigma : bool
         Adapt the step size of every population run after the first
         without the bias that mirrored pairs give cumulative step-size
@@ -157,7 +168,7 @@ class LearnedMetricSpiral:
     sampling: str = "gaussian"
     path_frame: str = "basis"
     run_stall: bool = True
-    lazy_basis: bool = False
+    basis_gap: str = "purecma"
     suspend_crawl: bool = True
     unbiased_sigma: bool = True
     crawl_window: float = 2.0
@@ -175,14 +186,17 @@ class LearnedMetricSpiral:
             "model_step",
             "populations",
             "run_stall",
-            "lazy_basis",
             "suspend_crawl",
             "unbiased_sigma",
             "extend_closing",
         ):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"`{name}` must be True or False")
-        for name, allowed in (("sampling", _SAMPLINGS), ("path_frame", _PATH_FRAMES)):
+        for name, allowed in (
+            ("sampling", _SAMPLINGS),
+            ("path_frame", _PATH_FRAMES),
+            ("basis_gap", _BASIS_GAPS),
+        ):
             if getattr(self, name) not in allowed:
                 raise ValueError(
                     f"`{name}` must be one of {allowed}; got {getattr(self, name)!r}"
@@ -214,10 +228,14 @@ class LearnedMetricSpiral:
             raise ValueError(f"`crossover` must be in [0, 1]; got {self.crossover!r}")
         object.__setattr__(self, "crossover", crossover)
 
-    def eigen_gap(self, n: int) -> int:
-        """Periods between two decompositions of the metric in dimension
-        ``n``: ``max(1, n // 10)`` with ``lazy_basis``, otherwise 1."""
-        return max(1, n // 10) if self.lazy_basis else 1
+    def eigen_every(self, encoding) -> int:
+        """Updates of `encoding` (an :class:`AdaptiveEncoding`) between two
+        decompositions of its metric, as ``basis_gap`` says."""
+        if self.basis_gap == "every":
+            return 1
+        if self.basis_gap == "n/10":
+            return max(1, encoding.n // 10)
+        return encoding.lazy_gap()
 
     def poll_cost(self, n: int) -> int:
         """Evaluations of a poll period in dimension ``n``: ``2n`` polls and
