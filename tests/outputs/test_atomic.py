@@ -90,7 +90,9 @@ def test_stale_staging_of_a_killed_run_is_removed(tmp_path):
     stale = tmp_path / ".spiralid-staging-out-abc123"
     stale.mkdir()
     (stale / "half.png").write_bytes(b"x")
-    with OutputFolder(tmp_path / "out") as folder:
+    # The user is told what was removed and why.
+    told = pytest.warns(UserWarning, match=r"removed 1 file\(s\) .* was killed")
+    with told, OutputFolder(tmp_path / "out") as folder:
         assert not stale.exists()
         folder.commit()
 
