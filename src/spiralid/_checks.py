@@ -1,4 +1,5 @@
-"""Argument checks shared by optim and fms (private leaf).
+"""Argument checks shared across the package (private leaf): numbers,
+integers, arrays, boxes, a choice among names, options.
 
 Each raises a ``ValueError`` that starts with the argument's name in
 backticks, says what is allowed and shows what came in, so that bad input
@@ -69,6 +70,16 @@ def integer(value, name: str, minimum: int) -> int:
     if out < minimum:
         raise ValueError(f"`{name}` must be an integer >= {minimum}; got {value!r}")
     return out
+
+
+def one_of(value, name: str, choices) -> str:
+    """``value`` if it is one of the strings ``choices`` (a sequence, or a
+    mapping's keys); anything else, a non-string included, is refused with
+    the choices listed."""
+    allowed = tuple(choices)
+    if not isinstance(value, str) or value not in allowed:
+        raise ValueError(f"`{name}` must be one of {allowed}; got {value!r}")
+    return value
 
 
 def is_integer(value) -> bool:

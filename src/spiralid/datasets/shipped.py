@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from importlib import resources
 
+from spiralid._checks import one_of
 from spiralid.sysid.data import IOData
 
 __all__ = ["NAMES", "load", "robot_arm"]
@@ -45,6 +46,5 @@ NAMES = {"robot_arm": robot_arm}
 
 def load(name: str, ts: float | None = None) -> IOData:
     """A shipped data set by `name` (one of :data:`NAMES`); `ts` overrides its own."""
-    if name not in NAMES:
-        raise ValueError(f"`name` must be one of {sorted(NAMES)}; got {name!r}")
+    one_of(name, "name", sorted(NAMES))
     return NAMES[name]() if ts is None else NAMES[name](ts=ts)

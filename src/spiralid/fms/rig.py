@@ -33,6 +33,7 @@ from spiralid._checks import (
     generator,
     integer,
     nonneg,
+    one_of,
     positive,
     real_array,
 )
@@ -160,8 +161,7 @@ class Recording:
         names = list(name) if isinstance(name, list | tuple) else [name]
         known = self.output_names
         for one in names:
-            if not isinstance(one, str) or one not in known:
-                raise ValueError(f"`name` must be one of {known}; got {one!r}")
+            one_of(one, "name", known)
         if not names or len(set(names)) != len(names):
             raise ValueError(f"`name` must list each output once; got {name!r}")
         several = len(names) > 1

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _signal
 
-from spiralid._checks import generator, integer, is_integer, positive, real
+from spiralid._checks import generator, integer, is_integer, one_of, positive, real
 
 __all__ = ["bang_bang", "chirp", "multilevel", "prbs"]
 
@@ -169,8 +169,7 @@ def chirp(
         if not 0.0 <= v <= nyq:
             raise ValueError(f"`{name}` must be in [0, fs/2 = {nyq:g}] Hz; got {f!r}")
     methods = ("linear", "quadratic", "logarithmic", "hyperbolic")
-    if not isinstance(method, str) or method not in methods:
-        raise ValueError(f"`method` must be one of {methods}; got {method!r}")
+    one_of(method, "method", methods)
     if method in ("logarithmic", "hyperbolic") and (float(f0) <= 0 or float(f1) <= 0):
         raise ValueError(
             f"`f0` and `f1` must be > 0 for method={method!r}; got {f0!r}, {f1!r}"

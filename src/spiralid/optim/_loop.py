@@ -12,7 +12,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from spiralid._checks import positive, refuse_options
+from spiralid._checks import one_of, positive, refuse_options
 
 # Every stop message comes from here, so `message` is always one of these
 # (plus the notes below).
@@ -71,11 +71,7 @@ def check_objective(fun, vectorized) -> bool:
 
 
 def check_policy(bounds_policy) -> str:
-    if not isinstance(bounds_policy, str) or bounds_policy not in POLICIES:
-        raise ValueError(
-            f"`bounds_policy` must be one of {POLICIES}; got {bounds_policy!r}"
-        )
-    return bounds_policy
+    return one_of(bounds_policy, "bounds_policy", POLICIES)
 
 
 def apply_bounds(points: np.ndarray, lo, hi, policy: str) -> None:
@@ -96,8 +92,7 @@ def apply_bounds(points: np.ndarray, lo, hi, policy: str) -> None:
 def stop_report(status: str, fun: float, target, initial_nonfinite: bool) -> dict:
     """``status``, ``success`` and ``message`` of a search that stopped as
     `status` (a key of :data:`STOPS`) with best cost `fun`."""
-    if status not in STOPS:
-        raise ValueError(f"`status` must be one of {tuple(STOPS)}; got {status!r}")
+    one_of(status, "status", STOPS)
     finite = math.isfinite(fun)
     reached = target is None or (finite and fun <= target)
     notes = [STOPS[status]]

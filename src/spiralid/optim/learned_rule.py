@@ -9,7 +9,7 @@ holds the search that runs it (and the multi-objective search,
 import math
 from dataclasses import dataclass
 
-from spiralid._checks import positive
+from spiralid._checks import one_of, positive
 
 __all__ = ["LearnedMetricSpiral"]
 
@@ -197,10 +197,7 @@ class LearnedMetricSpiral:
             ("path_frame", _PATH_FRAMES),
             ("basis_gap", _BASIS_GAPS),
         ):
-            if getattr(self, name) not in allowed:
-                raise ValueError(
-                    f"`{name}` must be one of {allowed}; got {getattr(self, name)!r}"
-                )
+            one_of(getattr(self, name), name, allowed)
         if self.max_condition is not None:
             cap = positive(self.max_condition, "max_condition")
             if cap < 1.0:

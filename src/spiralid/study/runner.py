@@ -26,6 +26,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from spiralid._checks import one_of
+
 from .spec import StudySpec
 from .store import ResultStore
 from .tasks import Task, load_records, run_task, study_tasks
@@ -287,8 +289,7 @@ def execute(
         The row of :func:`~spiralid.study.run_task`, or the exception the run
         raised.
     """
-    if engine not in ENGINES:
-        raise ValueError(f"`engine` must be one of {ENGINES}; got {engine!r}")
+    one_of(engine, "engine", ENGINES)
     if scheduler is not None and engine != "dask":
         raise ValueError("`scheduler` needs engine='dask'")
     if workers is not None and (

@@ -52,7 +52,7 @@ import numba
 import numpy as np
 from scipy.signal import lfilter, lfiltic
 
-from spiralid._checks import nonneg, positive
+from spiralid._checks import nonneg, one_of, positive
 
 from ..data import IOData, single_output_record
 from ..models.arx import ARX, INITIAL_CONDITIONS
@@ -152,14 +152,8 @@ class PaperCost:
         if not isinstance(arx, ARX):
             raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
         single_output_record(data, "PaperCost")
-        if predictor not in _PREDICTORS:
-            raise ValueError(
-                f"`predictor` must be one of {_PREDICTORS}; got {predictor!r}"
-            )
-        if not isinstance(initial, str) or initial not in INITIAL_CONDITIONS:
-            raise ValueError(
-                f"`initial` must be one of {INITIAL_CONDITIONS}; got {initial!r}"
-            )
+        one_of(predictor, "predictor", _PREDICTORS)
+        one_of(initial, "initial", INITIAL_CONDITIONS)
         arx.check_length(data)
         pen = nonneg(penalty, "penalty")
         self.arx = arx

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spiralid._checks import is_default, refuse_options
+from spiralid._checks import is_default, one_of, refuse_options
 
 from ..models.arx import ARX
 from ..models.narx import NARX, PolynomialNARX
@@ -104,9 +104,7 @@ def _check_method(method) -> str:
     if isinstance(method, str):
         # As minimize and scipy.optimize.minimize: names in any case.
         method = method.lower()
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"`method` must be one of {tuple(METHODS)}; got {method!r}")
-    return method
+    return one_of(method, "method", METHODS)
 
 
 def refused_options(method: str, options: dict, structure=None) -> list[str]:

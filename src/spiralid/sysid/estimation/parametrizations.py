@@ -64,6 +64,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from spiralid._checks import one_of
 from spiralid.choices import PARAMETRIZATION_NAMES, require_names
 
 from ..data import IOData
@@ -318,10 +319,7 @@ def make_parametrization(
 ) -> Parametrization:
     """The parametrisation called `name` on this record and structure, with
     the stability margin `max_radius` (``"modal"`` and ``"reflection"``)."""
-    if not isinstance(name, str) or name not in PARAMETRIZATIONS:
-        raise ValueError(
-            f"`parametrization` must be one of {tuple(PARAMETRIZATIONS)}; got {name!r}"
-        )
+    one_of(name, "parametrization", PARAMETRIZATIONS)
     return PARAMETRIZATIONS[name](data, arx, max_radius)
 
 

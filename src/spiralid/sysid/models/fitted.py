@@ -31,6 +31,8 @@ from typing import Any
 
 import numpy as np
 
+from spiralid._checks import one_of
+
 from . import _fields
 from .arx import INITIAL_CONDITIONS
 
@@ -108,10 +110,7 @@ class Provenance:
     def _check_provenance(self) -> None:
         """The provenance's own checks (each model's ``__post_init__``
         calls it before its structure's)."""
-        if not isinstance(self.initial, str) or self.initial not in INITIAL_CONDITIONS:
-            raise ValueError(
-                f"`initial` must be one of {INITIAL_CONDITIONS}; got {self.initial!r}"
-            )
+        one_of(self.initial, "initial", INITIAL_CONDITIONS)
 
     def _provenance_dict(self) -> dict:
         """The provenance as a model file holds it (``to_dict`` adds the

@@ -8,6 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from spiralid._checks import one_of
+
 from ._narx_kernels import _mlp_free_run, _mlp_sensitivity
 from .narx_lags import Scaling, _integrators, _Lags, _order
 
@@ -81,11 +83,7 @@ class NARX(_Lags):
         object.__setattr__(
             self, "hidden", tuple(_order(h, "hidden[0]", 1) for h in hidden)
         )
-        if self.activation not in ACTIVATIONS:
-            raise ValueError(
-                f"`activation` must be one of {tuple(ACTIVATIONS)}; "
-                f"got {self.activation!r}"
-            )
+        one_of(self.activation, "activation", ACTIVATIONS)
         if not isinstance(self.linear, bool | np.bool_):
             raise ValueError(f"`linear` must be True or False; got {self.linear!r}")
         object.__setattr__(self, "linear", bool(self.linear))

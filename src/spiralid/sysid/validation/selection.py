@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spiralid._checks import nonneg
+from spiralid._checks import nonneg, one_of
 from spiralid.optim.front import knee_point
 
 from ..estimation.pareto import ParetoIdentification
@@ -66,8 +66,7 @@ def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int
             f"`front` must be a ParetoIdentification; got {type(front).__name__}"
         )
     names = front.names
-    if minimise not in names:
-        raise ValueError(f"`minimise` must be one of {names}; got {minimise!r}")
+    one_of(minimise, "minimise", names)
     ok = np.ones(len(front), bool)
     for key, bound in limits.items():
         name = key.removeprefix("max_")

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from spiralid._checks import refuse_options
+from spiralid._checks import one_of, refuse_options
 
 from ..estimation.cost import cost_of_errors
 from ..signals import check_pair
@@ -320,8 +320,5 @@ def _valid_inputs(model, data, lags, residuals, linear: bool):
         )
     check_sample_time(model, ts)
     predictor = getattr(model, "predictor", None) or "simulation"
-    if predictor not in _RESIDUALS:
-        raise ValueError(
-            f"`model.predictor` must be one of {_RESIDUALS}; got {predictor!r}"
-        )
+    one_of(predictor, "model.predictor", _RESIDUALS)
     return u, y, ts, lags, predictor
