@@ -33,7 +33,7 @@ not twice as good; a missing integrator does (the hub angle with
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -95,16 +95,8 @@ class MarginChoice:
     lifted: bool
 
     def to_dict(self) -> dict:
-        return {
-            "time_constant": self.time_constant,
-            "slowest": self.slowest,
-            "released_cost": self.released_cost,
-            "holdback": self.holdback,
-            "n_held": self.n_held,
-            "held_back_rms": self.held_back_rms,
-            "lifted": self.lifted,
-            "note": self.sentence(),
-        }
+        # Every field, in order, so a field added later is saved too.
+        return {**asdict(self), "note": self.sentence()}
 
     def sentence(self) -> str:
         """One line for a summary: the margin, and why it stayed or went."""
