@@ -124,7 +124,8 @@ class IdentifiedModel(FittedModel):
         What the held-back end said of the default stability margin where it
         bound a pole (:mod:`~spiralid.sysid.estimation.margin_choice`): the
         margin's ``time_constant`` and the bound pole's (``slowest``, in
-        seconds), the ``holdback`` share and ``n_held`` samples, the
+        seconds), the released minimum's ``released_cost`` as a share of
+        the margined one's, the ``holdback`` share and ``n_held`` samples, the
         ``held_back_rms`` of the model with the margin and without
         (``"margin"``, ``"free"``), whether it was ``lifted`` and a ``note``
         in words; None when the margin did not bind, was given explicitly
