@@ -23,7 +23,7 @@ from spiralid.optim import (
     SpiralSearch,
     minimize,
 )
-from spiralid.optim._kernels import orthonormal_rows
+from spiralid.optim._kernels import eigen_frame, orthonormal_rows, poll_offsets
 from spiralid.optim.learned import default_population, paired_mu_eff
 
 
@@ -233,6 +233,39 @@ def test_orthonormal_rows_match_lapack_qr():
     q, r = np.linalg.qr(g.T)
     expected = (q * np.sign(np.diag(r))).T
     np.testing.assert_allclose(orthonormal_rows(g.copy()), expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [1, 7, 40])
+def test_poll_offsets_round_as_the_numpy_expressions(n):
+    # Element-wise products and sums only: on one machine the compiled
+    # kernel and NumPy round every element alike.
+    rng = np.random.default_rng(n)
+    basis, steps = rng.normal(size=(n, n)), rng.uniform(1e-6, 1.0, n)
+    width, centre = rng.uniform(0.1, 10.0, n), rng.normal(size=n)
+    directions, signed = np.empty((n, n), order="F"), np.empty((2 * n, n))
+    polled = np.empty((2 * n, n))
+    poll_offsets(basis, steps, width, centre, directions, signed, polled)
+    expected = (basis.T * steps[:, None]) * width
+    np.testing.assert_array_equal(directions, expected)
+    np.testing.assert_array_equal(signed[0::2], expected)
+    np.testing.assert_array_equal(signed[1::2], -expected)
+    np.testing.assert_array_equal(polled[0::2], centre + expected)
+    np.testing.assert_array_equal(polled[1::2], centre - expected)
+
+
+@pytest.mark.parametrize("layout", ["F", "C"])
+def test_eigen_frame_is_the_square_root_basis_and_its_inverse(layout):
+    rng = np.random.default_rng(5)
+    a = rng.normal(size=(6, 9))
+    values, vectors = np.linalg.eigh(a @ a.T)
+    vectors = np.asarray(vectors, order=layout)
+    lengths, basis, inverse = eigen_frame(values, vectors)
+    np.testing.assert_array_equal(lengths, np.sqrt(values))
+    np.testing.assert_array_equal(basis, vectors * np.sqrt(values))
+    np.testing.assert_array_equal(inverse, (vectors / np.sqrt(values)).T)
+    assert basis.flags.c_contiguous and inverse.flags.f_contiguous
+    np.testing.assert_allclose(inverse @ basis, np.eye(6), atol=1e-12)
+    np.testing.assert_allclose(basis @ basis.T, a @ a.T, rtol=1e-12, atol=1e-12)
 
 
 def _first_population_batch(rule, n, seed):

@@ -214,3 +214,45 @@ def covariance_update(
             out[a, b] = v
             out[b, a] = v
     return out
+
+
+@numba.njit(cache=True, nogil=True)
+def eigen_frame(values, vectors):  # pragma: no cover - compiled
+    """The learned basis from a decomposition ``C = V diag(values) V^T``
+    (``vectors`` holds ``V``, in any layout): the lengths ``d = sqrt(values)``,
+    ``B = V D`` (C order) and ``B^-1 = (V / d)^T`` (a transposed C-order
+    array), element for element the products NumPy gives, in one call
+    instead of five."""
+    n = values.size
+    lengths = np.sqrt(values)
+    basis = np.empty((n, n))
+    inverse_t = np.empty((n, n))
+    for a in range(n):
+        for b in range(n):
+            v = vectors[a, b]
+            basis[a, b] = v * lengths[b]
+            inverse_t[a, b] = v / lengths[b]
+    return lengths, basis, inverse_t.T
+
+
+@numba.njit(cache=True, nogil=True)
+def poll_offsets(
+    basis, steps, width, centre, directions, signed, polled
+):  # pragma: no cover - compiled
+    """A poll period's directions and points, written in place.
+
+    ``directions[j] = (B[:, j] s_j) w`` in the problem's coordinates (``w``
+    the box's widths), ``signed`` the directions interleaved with their
+    opposites (rows ``2j`` and ``2j + 1``) and ``polled = centre + signed``:
+    the same roundings as the NumPy expressions, in one call instead of
+    five."""
+    n = steps.size
+    for j in range(n):
+        s = steps[j]
+        for i in range(n):
+            d = (basis[i, j] * s) * width[i]
+            directions[j, i] = d
+            signed[2 * j, i] = d
+            signed[2 * j + 1, i] = -d
+            polled[2 * j, i] = centre[i] + d
+            polled[2 * j + 1, i] = centre[i] + -d

@@ -11,7 +11,7 @@ import numpy as np
 from scipy.linalg import lapack
 
 from spiralid._checks import integer, positive
-from spiralid.optim._kernels import covariance_update
+from spiralid.optim._kernels import covariance_update, eigen_frame
 
 __all__ = ["AdaptiveEncoding"]
 
@@ -192,9 +192,6 @@ class AdaptiveEncoding:
         # calls it (the same numbers), without its wrapper's 7 us at n = 20:
         # one decomposition every period is most of the search's own time.
         values, vectors, info = lapack.dsyevd(C, lower=1)
-        # In rows, as numpy returns them: the products below then sum in the
-        # same order.
-        vectors = np.ascontiguousarray(vectors)
         # Python floats: n of them are checked faster than NumPy dispatches
         # one call on the array.
         listed = values.tolist()
@@ -208,11 +205,11 @@ class AdaptiveEncoding:
             # in the normalised update (the bent cigar's, to 1e13); keep
             # the others' scale within reach of the poll's steps.
             values = np.maximum(values, values[-1] / self.max_condition)
+            # In rows, as numpy.linalg.eigh returns them: the product then
+            # sums in the same order.
+            vectors = np.ascontiguousarray(vectors)
             C = (vectors * values) @ vectors.T
             low = float(values[0])
         self.covariance = C
-        d = np.sqrt(values)
-        self.lengths = d
-        self.basis = vectors * d
-        self._inverse = (vectors / d).T
+        self.lengths, self.basis, self._inverse = eigen_frame(values, vectors)
         self.condition = high / low

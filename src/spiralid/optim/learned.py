@@ -63,7 +63,7 @@ from collections.abc import Callable
 import numpy as np
 
 from spiralid._checks import integer
-from spiralid.optim._kernels import orthonormal_rows
+from spiralid.optim._kernels import orthonormal_rows, poll_offsets
 from spiralid.optim._loop import (
     Trace,
     apply_bounds,
@@ -424,10 +424,19 @@ class LearnedMetricSearch(SearchBase):
         n = self._lo.size
         # Directions in the problem's coordinates, one per row, interleaved
         # with their opposites: pair j is c + signed[2j : 2j + 2].
-        directions = (self._encoding.basis.T * self._steps[:, None]) * self._width
+        # Column-major, as NumPy made it from the basis's transpose: the
+        # model step's product then sums in the same order.
+        directions = np.empty((n, n), order="F")
         signed = np.empty((2 * n, n))
-        signed[0::2] = directions
-        np.negative(directions, out=signed[1::2])
+        poll_offsets(
+            self._encoding.basis,
+            self._steps,
+            self._width,
+            self._c,
+            directions,
+            signed,
+            self._polled,
+        )
         success, model = self._pairs(signed)
         if rule.success_steps:
             self._steps *= np.where(success, rule.grow, rule.shrink)
@@ -457,13 +466,17 @@ class LearnedMetricSearch(SearchBase):
         the parabola through the three costs in units of the direction from
         the (possibly moved) centre (0 if not convex).
 
+        The rows of ``self._polled`` hold every pair from the centre on
+        entry (:func:`~spiralid.optim._kernels.poll_offsets` wrote them);
+        only a move recomputes the pairs after it.
+
         The hot loop of the search, two evaluations an iteration: the state
         is held in local names and written back once (also if ``fun``
         raises), and the costs are read as floats without
         :meth:`_evaluate`'s array bookkeeping.
         """
         n = self._lo.size
-        polled, polled_f = self._polled, self._polled_f
+        polled_f = self._polled_f
         fun, vectorized = self._fun, self.vectorized
         bounded = self.bounds_policy != "none"
         c, fc = self._c, self._f
@@ -474,15 +487,21 @@ class LearnedMetricSearch(SearchBase):
         # Two costs per pair evaluated, so also the count of evaluations.
         costs = []
         isfinite, inf = math.isfinite, math.inf
-        # Every pair from the current centre at once; only a move recomputes
-        # the pairs after it (the same sums, one call instead of n).
-        np.add(c, signed, out=polled)
         try:
             for j, (pair, after) in enumerate(self._pair_views):
                 if bounded:
                     apply_bounds(pair, self._lo, self._hi, self.bounds_policy)
                 if vectorized:
-                    a, b = self._listed(fun(pair.copy()), pair)
+                    raw = fun(pair.copy())
+                    # _listed's common case inline: a call per pair costs.
+                    if (
+                        type(raw) is np.ndarray
+                        and raw.dtype is _FLOAT
+                        and raw.shape == (2,)
+                    ):
+                        a, b = raw.tolist()
+                    else:
+                        a, b = self._listed(raw, pair)
                 else:
                     a = float(check_costs(fun(pair[0].copy()), (), _SCALAR))
                     b = float(check_costs(fun(pair[1].copy()), (), _SCALAR))
