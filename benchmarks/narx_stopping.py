@@ -32,6 +32,8 @@ import warnings
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
+from _cli import seed_list
+
 from spiralid.fms import nonlinear_rig, paper_experiment
 from spiralid.sysid import ARX, NARX, fit_percent, identify
 from spiralid.sysid.estimation import narx as narx_mod
@@ -57,16 +59,9 @@ def parse_settings(text: str) -> dict[str, dict]:
     return out
 
 
-def seeds_of(text: str) -> list[int]:
-    if "-" in text:
-        lo, hi = text.split("-")
-        return list(range(int(lo), int(hi) + 1))
-    return [int(s) for s in text.split(",")]
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", default="4-7")
+    ap.add_argument("--seeds", type=seed_list, default="4-7")
     ap.add_argument("--record", default="nonlinear acc", choices=list(RECORDS))
     ap.add_argument(
         "--settings",
@@ -93,7 +88,7 @@ def main() -> None:
     print("| seed | setting | ARX fit % | NARX fit % | gain | target | met | start |")
     print("|---|---|---|---|---|---|---|---|")
     print("# columns after: best round, polish rounds per start, search s, train s")
-    for seed in seeds_of(args.seeds):
+    for seed in args.seeds:
         rig = nonlinear_rig() if nonlinear else None
         data = paper_experiment().run(rig=rig, rng=seed).iodata(out)
         est, val = data.split(2 / 3)

@@ -95,6 +95,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np
+from _cli import seed_list
 
 from spiralid.sysid import (
     ARX,
@@ -401,14 +402,6 @@ def run(rec: Record, methods, orders, seeds, lags=None) -> None:
             )
 
 
-def _seeds(text: str) -> list[int]:
-    """``"0-4"`` or ``"0,3"``."""
-    if "-" in text:
-        a, b = text.split("-")
-        return list(range(int(a), int(b) + 1))
-    return [int(x) for x in text.split(",")]
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--data", required=True, type=Path, help="folder of record files")
@@ -416,7 +409,10 @@ def main() -> None:
     ap.add_argument("--methods", default="arx,narx,poly,sipy,sipy-nn")
     ap.add_argument("--orders", default="1,2,3,4,6")
     ap.add_argument(
-        "--seeds", default="0", help="of the NARX and the neural peer: 0-4 or 0,3"
+        "--seeds",
+        type=seed_list,
+        default="0",
+        help="of the NARX and the neural peer: 0-4 or 0,3",
     )
     ap.add_argument("--silverbox-est", type=int, default=17384)
     ap.add_argument("--lags", default="", help='"record=n,k;..." instead of the choice')
@@ -437,7 +433,7 @@ def main() -> None:
         print(f"# load average at start: {fh.read().split()[:3]}")
     t0 = time.perf_counter()
     for rec in records:
-        run(rec, methods, orders, _seeds(args.seeds), given.get(rec.name))
+        run(rec, methods, orders, args.seeds, given.get(rec.name))
     print(f"\n# {time.perf_counter() - t0:.0f} s in all")
 
 
