@@ -205,10 +205,12 @@ class LearnedMetricSearch(SearchBase):
         self._resumed = False
         self._polled = np.empty((2 * n, n))
         self._polled_f = np.empty(2 * n)
-        # The poll's views of its pairs and of the rows after each, made once
+        # A poll period's offsets: pair j is c + signed[2j : 2j + 2].
+        self._signed = np.empty((2 * n, n))
+        # The poll's views of each pair's points and offsets, made once
         # rather than sliced anew at every pair.
         self._pair_views = [
-            (self._polled[2 * j : 2 * j + 2], self._polled[2 * j + 2 :])
+            (self._polled[2 * j : 2 * j + 2], self._signed[2 * j : 2 * j + 2])
             for j in range(n)
         ]
         self._start_poll(seed_points(x0, self._lo, self._hi, m), m)
@@ -423,21 +425,20 @@ class LearnedMetricSearch(SearchBase):
         rule = self.rule
         n = self._lo.size
         # Directions in the problem's coordinates, one per row, interleaved
-        # with their opposites: pair j is c + signed[2j : 2j + 2].
-        # Column-major, as NumPy made it from the basis's transpose: the
-        # model step's product then sums in the same order.
+        # with their opposites in `_signed`. Column-major, as NumPy made it
+        # from the basis's transpose: the model step's product then sums in
+        # the same order.
         directions = np.empty((n, n), order="F")
-        signed = np.empty((2 * n, n))
         poll_offsets(
             self._encoding.basis,
             self._steps,
             self._width,
             self._c,
             directions,
-            signed,
+            self._signed,
             self._polled,
         )
-        success, model = self._pairs(signed)
+        success, model = self._pairs()
         if rule.success_steps:
             self._steps *= np.where(success, rule.grow, rule.shrink)
         if rule.model_step and any(model):
@@ -459,16 +460,19 @@ class LearnedMetricSearch(SearchBase):
         if rule.basis:
             self._encoding.update((self._polled[order[:n]] - self._lo) / self._width)
 
-    def _pairs(self, signed: np.ndarray) -> tuple[np.ndarray, list]:
+    def _pairs(self) -> tuple[np.ndarray, list]:
         """Poll the period's pairs ``x* + signed[2j : 2j + 2]`` (``x* +- s_j
-        b_j``) in turn, moving the centre to the better of a pair when it
-        improves on it. Returns, per pair, whether it did, and the minimum of
-        the parabola through the three costs in units of the direction from
-        the (possibly moved) centre (0 if not convex).
+        b_j``, ``signed`` the offsets in ``self._signed``) in turn, moving
+        the centre to the better of a pair when it improves on it. Returns,
+        per pair, whether it did, and the minimum of the parabola through
+        the three costs in units of the direction from the (possibly moved)
+        centre (0 if not convex).
 
         The rows of ``self._polled`` hold every pair from the centre on
         entry (:func:`~spiralid.optim._kernels.poll_offsets` wrote them);
-        only a move recomputes the pairs after it.
+        after a move each later pair is recomputed from the new centre just
+        before it is evaluated (two rows, not all the rows left at each
+        move).
 
         The hot loop of the search, two evaluations an iteration: the state
         is held in local names and written back once (also if ``fun``
@@ -487,8 +491,11 @@ class LearnedMetricSearch(SearchBase):
         # Two costs per pair evaluated, so also the count of evaluations.
         costs = []
         isfinite, inf = math.isfinite, math.inf
+        moved = False
         try:
-            for j, (pair, after) in enumerate(self._pair_views):
+            for j, (pair, offsets) in enumerate(self._pair_views):
+                if moved:
+                    np.add(c, offsets, out=pair)
                 if bounded:
                     apply_bounds(pair, self._lo, self._hi, self.bounds_policy)
                 if vectorized:
@@ -523,7 +530,7 @@ class LearnedMetricSearch(SearchBase):
                     c, fc = pair[side].copy(), better
                     if better < best_f:
                         best_x, best_f = c, better
-                    np.add(c, signed[2 * j + 2 :], out=after)
+                    moved = True
                     success[j] = True
                     # From the moved centre, the vertex is one step nearer.
                     vertex = (vertex - (1.0 if side == 0 else -1.0)) if vertex else 0.0
