@@ -23,7 +23,12 @@ from spiralid.optim import (
     SpiralSearch,
     minimize,
 )
-from spiralid.optim._kernels import eigen_frame, orthonormal_rows, poll_offsets
+from spiralid.optim._kernels import (
+    add_rows,
+    eigen_frame,
+    orthonormal_rows,
+    poll_offsets,
+)
 from spiralid.optim.learned import default_population, paired_mu_eff
 
 
@@ -251,6 +256,11 @@ def test_poll_offsets_round_as_the_numpy_expressions(n):
     np.testing.assert_array_equal(signed[1::2], -expected)
     np.testing.assert_array_equal(polled[0::2], centre + expected)
     np.testing.assert_array_equal(polled[1::2], centre - expected)
+    # A pair from a moved centre.
+    moved = rng.normal(size=n)
+    pair = np.empty((2, n))
+    add_rows(moved, signed[:2], pair)
+    np.testing.assert_array_equal(pair, moved + signed[:2])
 
 
 @pytest.mark.parametrize("layout", ["F", "C"])

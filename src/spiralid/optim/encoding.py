@@ -86,7 +86,8 @@ class AdaptiveEncoding:
         self.covariance = np.eye(n)
         self.basis = np.eye(n)
         self.lengths = np.ones(n)
-        self._inverse = np.eye(n)
+        # Column-major, as every later B^-1 is: one compiled update, not two.
+        self._inverse = np.eye(n).T
         self.path = np.zeros(n)
         self.mean = None
         self.condition = 1.0
@@ -207,8 +208,8 @@ class AdaptiveEncoding:
             values = np.maximum(values, values[-1] / self.max_condition)
             # In rows, as numpy.linalg.eigh returns them: the product then
             # sums in the same order.
-            vectors = np.ascontiguousarray(vectors)
-            C = (vectors * values) @ vectors.T
+            rows = np.ascontiguousarray(vectors)
+            C = (rows * values) @ rows.T
             low = float(values[0])
         self.covariance = C
         self.lengths, self.basis, self._inverse = eigen_frame(values, vectors)
