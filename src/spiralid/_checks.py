@@ -82,6 +82,24 @@ def one_of(value, name: str, choices) -> str:
     return value
 
 
+def named_index(value, name: str, names) -> int:
+    """The 0-based position of `value` among `names` (an output's, say),
+    given as one of the names or as an index (a NumPy integer too)."""
+    names = tuple(names)
+    if isinstance(value, str):
+        if value not in names:
+            raise ValueError(f"`{name}` must be one of {names}; got {value!r}")
+        return names.index(value)
+    if is_integer(value):
+        if not 0 <= value < len(names):
+            raise ValueError(
+                f"`{name}` must be an index in [0, {len(names) - 1}] or one of "
+                f"{names}; got {value!r}"
+            )
+        return int(value)
+    raise ValueError(f"`{name}` must be an index or one of {names}; got {value!r}")
+
+
 def is_integer(value) -> bool:
     """True for Python and NumPy integers, False for bools and floats."""
     return isinstance(value, int | np.integer) and not isinstance(value, bool)

@@ -97,6 +97,7 @@ _USER_WORDS = {
     "input": "--input",
     "output": "--output",
     "fraction": "--fraction",
+    "integrator": "--integrator",
     "na": "--na",
     "nb": "--nb",
     "nk": "--nk",

@@ -39,6 +39,7 @@ noise realisations (one interval of zero width; the factor's varied by
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 
@@ -49,7 +50,7 @@ from spiralid._checks import generator, integer
 from ..data import IOData
 from ..models.arx import ARX
 from ..models.polynomials import is_stable_polynomial
-from ..models.shared import SharedDenominatorModel
+from ..models.shared import MOST_INTEGRATORS, SharedDenominatorModel
 from .margin import AUTO, is_auto, max_radius
 from .modal import ModalParametrization
 from .varpro import ProjectedCost, gauss_newton_polish
@@ -85,7 +86,15 @@ def _integrators(integrators, p: int) -> tuple[int, ...]:
             f"`integrator` must be one count or one per output ({p}); got "
             f"{integrators!r}"
         )
-    return tuple(integrator_count(v, 2) for v in values)
+    # Checked against the most a shared fit takes, not against a
+    # denominator's order: the shared A holds none of them.
+    counts = tuple(integrator_count(v, math.inf) for v in values)
+    if max(counts) > MOST_INTEGRATORS:
+        raise ValueError(
+            f"`integrator` must be at most {MOST_INTEGRATORS} known integrators per "
+            f"output; got {integrators!r}"
+        )
+    return counts
 
 
 def _summed(one: IOData, count: int) -> IOData:

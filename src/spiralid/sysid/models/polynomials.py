@@ -369,7 +369,7 @@ def random_stable_polynomial(n: int, size: int | None = None, rng=None) -> np.nd
     return a[0] if size is None else a
 
 
-def integrator_count(integrator, na: int) -> int:
+def integrator_count(integrator, na: float) -> int:
     """The number of known integrators that `integrator` asks for, checked
     against a denominator of order `na`: ``False``/``True`` are 0/1, an
     integer ``0 <= k <= na`` is ``k`` (``2`` for a double integrator); a

@@ -21,13 +21,16 @@ from dataclasses import KW_ONLY, dataclass, field
 import numpy as np
 from scipy import signal
 
+from spiralid._checks import named_index
+
+from . import _fields
 from .arx import ARX
 from .fitted import Provenance
 from .identified import IdentifiedModel, python_control
 from .modes import ModeTable, interval_format, mode_table
 from .polynomials import is_stable_polynomial, max_pole_radius, with_integrator
 
-__all__ = ["SharedDenominatorModel", "SharedModes"]
+__all__ = ["MOST_INTEGRATORS", "SharedDenominatorModel", "SharedModes"]
 
 
 @dataclass(frozen=True)
@@ -69,10 +72,12 @@ class SharedModes:
             return "no modes (no complex pole pair)"
         lo_f, hi_f = t.frequency_interval.T
         lo_z, hi_z = t.damping_interval.T
-        names = [n[:14] for n in self.output_names]
+        widths = [max(14, len(n)) for n in self.output_names]
         head = (
             f"{'mode':>4}  {'frequency (Hz) [95 %]':>30}  {'damping [95 %]':>30}  "
-            + "  ".join(f"{n:>14}" for n in names)
+            + "  ".join(
+                f"{n:>{w}}" for n, w in zip(self.output_names, widths, strict=True)
+            )
         )
         lines = [head]
         for i in range(len(t)):
@@ -80,14 +85,33 @@ class SharedModes:
             fd = interval_format((lo_z[i], hi_z[i]), "f")
             freq = f"{t.frequency[i]:{ff}} [{lo_f[i]:{ff}}, {hi_f[i]:{ff}}]"
             damp = f"{t.damping[i]:{fd}} [{lo_z[i]:{fd}}, {hi_z[i]:{fd}}]"
-            shares = "  ".join(f"{100 * s:13.1f}%" for s in self.share[i])
+            shares = "  ".join(
+                f"{100 * s:{w - 1}.1f}%"
+                for s, w in zip(self.share[i], widths, strict=True)
+            )
             lines.append(f"{i + 1:>4}  {freq:>30}  {damp:>30}  {shares}")
         return "\n".join(lines)
+
+
+def _one_per_output(values, p: int, name: str, default) -> tuple:
+    """`values` as a tuple of p entries of `default`'s type (p defaults
+    when empty)."""
+    kind = type(default)
+    values = tuple(kind(v) for v in values) or (default,) * p
+    if len(values) != p:
+        raise ValueError(
+            f"`{name}` must have one entry per output ({p}); got {len(values)}"
+        )
+    return values
 
 
 def _plain(value) -> float | None:
     return float(value) if np.isfinite(value) else None
 
+
+# Known integrators per output, outside the shared denominator: a hub
+# angle's double integrator at most (a torque drives an acceleration).
+MOST_INTEGRATORS = 2
 
 # Provenance fields this file writes as null for NaN.
 _NULLABLE = ("cost", "gain")
@@ -186,20 +210,38 @@ class SharedDenominatorModel(Provenance):
                 f"`a` and `b` must have shapes ({self.arx.na},) and (p, "
                 f"{self.arx.nb}) for {self.arx}; got {self.a.shape} and {self.b.shape}"
             )
+        if not (np.all(np.isfinite(self.a)) and np.all(np.isfinite(self.b))):
+            raise ValueError("`a` and `b` must be finite")
         self.output_names = tuple(self.output_names)
-        if len(self.output_names) != p:
+        if len(self.output_names) != p or len(set(self.output_names)) != p:
             raise ValueError(
-                f"`output_names` must name each of the {p} outputs; got "
+                f"`output_names` must name each of the {p} outputs once; got "
                 f"{self.output_names}"
             )
-        self.output_units = tuple(self.output_units) or ("",) * p
-        self.y_offsets = tuple(float(v) for v in self.y_offsets) or (0.0,) * p
-        self.integrators = tuple(int(k) for k in self.integrators) or (0,) * p
-        if len(self.integrators) != p or min(self.integrators) < 0:
+        self.output_units = _one_per_output(self.output_units, p, "output_units", "")
+        self.y_offsets = _one_per_output(self.y_offsets, p, "y_offsets", 0.0)
+        if not all(np.isfinite(self.y_offsets)):
+            raise ValueError(f"`y_offsets` must be finite; got {self.y_offsets}")
+        self.integrators = _one_per_output(self.integrators, p, "integrators", 0)
+        if not all(0 <= k <= MOST_INTEGRATORS for k in self.integrators):
             raise ValueError(
-                f"`integrators` must be {p} counts >= 0 (one per output); got "
-                f"{self.integrators}"
+                f"`integrators` must be counts in [0, {MOST_INTEGRATORS}], one per "
+                f"output; got {self.integrators}"
             )
+        for name, value in (("costs", self.costs), ("weights", self.weights)):
+            if value is not None and np.shape(value) != (p,):
+                raise ValueError(
+                    f"`{name}` must hold one number per output ({p}); got shape "
+                    f"{np.shape(value)}"
+                )
+        if self.covariance is not None:
+            self.covariance = np.asarray(self.covariance, dtype=float)
+            na = self.arx.na
+            if self.covariance.shape != (na, na) or np.isnan(self.covariance).any():
+                raise ValueError(
+                    f"`covariance` must be the ({na}, {na}) covariance of `a`; got "
+                    f"shape {self.covariance.shape}"
+                )
 
     @property
     def n_outputs(self) -> int:
@@ -229,7 +271,7 @@ class SharedDenominatorModel(Provenance):
         :class:`IdentifiedModel`, which :func:`~spiralid.sysid.validate`
         validates on that output (its covariance is not carried: the
         intervals belong to the shared modes)."""
-        i = which if isinstance(which, int) else self.output_names.index(which)
+        i = named_index(which, "which", self.output_names)
         return IdentifiedModel(
             self.theta(i),
             arx=self.output_arx(i),
@@ -342,18 +384,34 @@ class SharedDenominatorModel(Provenance):
 
     @classmethod
     def from_dict(cls, d: dict) -> SharedDenominatorModel:
-        """The model :meth:`to_dict` wrote."""
+        """The model :meth:`to_dict` wrote; a field that is missing, of the
+        wrong type or out of range raises a ValueError that names it."""
+        if not isinstance(d, dict):
+            raise ValueError(f"a model must be a JSON object; got {type(d).__name__}")
         # Files written before the field was called "model" name it "kind".
         kind = d.get("model", d.get("kind"))
         if kind != "shared-denominator":
             raise ValueError(
                 f"field 'model' must be 'shared-denominator'; got {kind!r}"
             )
-        s = d["structure"]
+        s = d.get("structure")
+        if not isinstance(s, dict):
+            raise ValueError(f"field 'structure' must be an object; got {s!r:.60}")
+        na, nb, nk = (
+            _fields.integer(
+                s, key, f"an integer >= {low}", low.__le__, where="structure."
+            )
+            for key, low in (("na", 1), ("nb", 1), ("nk", 0))
+        )
+        names = _fields.texts(d, "output_names")
+        p = len(names)
+        if not p:
+            raise ValueError("field 'output_names' must name at least one output")
 
-        def array(key):
-            value = d.get(key)
-            return None if value is None else np.asarray(value, dtype=float)
+        def optional(key, shape, null=None):
+            if d.get(key) is None:
+                return None
+            return _fields.numbers(d, key, shape, null=null)
 
         # Files written before the provenance was shared hold only its
         # method, cost, input name, unit and offset: the rest defaults. A
@@ -361,18 +419,25 @@ class SharedDenominatorModel(Provenance):
         # names what estimated it, nothing here depends on it).
         known = {k: v for k, v in d.items() if v is not None or k not in _NULLABLE}
         provenance = cls._provenance_fields({"method": "", **known}, None, penalty=0.0)
+        integrators = _fields.numbers(d, "integrators", (p,), [0] * p)
+        if not np.all(integrators == np.round(integrators)):
+            raise ValueError(
+                "field 'integrators' must be whole counts, one per output; got "
+                f"{d['integrators']!r:.60}"
+            )
         return cls(
-            a=np.asarray(d["a"], dtype=float),
-            b=np.asarray(d["b"], dtype=float),
-            arx=ARX(int(s["na"]), int(s["nb"]), int(s["nk"])),
-            ts=float(d["ts"]),
-            output_names=tuple(d["output_names"]),
-            output_units=tuple(d.get("output_units") or ()),
-            y_offsets=tuple(d.get("y_offsets") or ()),
-            costs=array("costs"),
-            weights=array("weights"),
-            covariance=array("covariance"),
-            integrators=tuple(d.get("integrators") or ()),
+            a=_fields.numbers(d, "a", (na,)),
+            b=_fields.numbers(d, "b", (p, nb)),
+            arx=ARX(na, nb, nk),
+            ts=_fields.number(d, "ts", "a number > 0", _fields.positive),
+            output_names=names,
+            output_units=_fields.texts(d, "output_units", p, [""] * p),
+            y_offsets=tuple(_fields.numbers(d, "y_offsets", (p,), [0.0] * p)),
+            costs=optional("costs", (p,), null=np.nan),
+            weights=optional("weights", (p,)),
+            # JSON has no infinity: an infinite variance is written as null.
+            covariance=optional("covariance", (na, na), null=np.inf),
+            integrators=tuple(int(k) for k in integrators),
             **provenance,
         )
 
