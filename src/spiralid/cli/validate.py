@@ -117,14 +117,36 @@ def _columns_of_the_model(args, model) -> None:
     if missing:
         kind = "column" if Path(args.data).suffix.lower() == ".csv" else "variable"
         plural = "s" if len(outputs) > 1 else ""
+        order = ", in the model's order" if len(outputs) > 1 else ""
         raise UsageError(
             f"the model was estimated on input {model.input_name!r} and "
             f"output{plural} {', '.join(map(repr, outputs))}, but {args.data!r} has "
-            f"no {kind} {' or '.join(map(repr, missing))}; give --input and --output"
+            f"no {kind} {' or '.join(map(repr, missing))}; give --input and "
+            f"--output with the {kind}s that hold them{order}"
         )
     args.input = args.input if not wanted["input"] else model.input_name
     if wanted["output"]:
         args.output = outputs if len(outputs) > 1 else outputs[0]
+
+
+def _outputs_as_the_model(data, model):
+    """`data`'s outputs in the model's order and under its names: matched
+    by name where the record carries the model's names (in any order), or
+    taken in the order --output gave them where the columns were renamed.
+    Every per-output field (offset, unit) then lines up with the model's."""
+    wanted = _outputs_of(model)
+    have = data.output_names
+    if len(wanted) == 1 == len(have):
+        return data
+    if set(wanted) <= set(have):
+        return data.select_outputs(wanted)
+    if len(have) == len(wanted) and not set(have) & set(wanted):
+        return data.select_outputs(have, rename=wanted)
+    raise UsageError(
+        f"--output must name the model's {len(wanted)} outputs "
+        f"({', '.join(wanted)}): by those names, or {len(wanted)} other columns "
+        f"in that order; got {', '.join(have)}"
+    )
 
 
 def _prepared_as_the_model(data, model, recorded: bool, args):
@@ -144,11 +166,6 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
 
     import numpy as np
 
-    if len(offsets) != data.n_outputs:
-        raise UsageError(
-            f"the model has {len(offsets)} output(s) and the data "
-            f"{data.n_outputs}; give --output with the model's outputs"
-        )
     y_offset = tuple(a + b for a, b in zip(data.y_offsets, offsets, strict=True))
     return replace(
         data,
@@ -174,10 +191,11 @@ def _figures(v) -> dict:
     its name, for several outputs)."""
     if not hasattr(v, "outputs"):
         return v.plot()
-    from spiralid.report.shared_output import output_stem
+    from spiralid.report.shared_output import output_stems
 
+    stems = output_stems(v.outputs)
     return {
-        f"{output_stem(name)}_{kind}": fig
+        f"{stems[name]}_{kind}": fig
         for name, one in v.outputs.items()
         for kind, fig in one.plot().items()
     }
@@ -192,7 +210,7 @@ def run(args, argv: list[str]) -> int:
         # The data's own sample time wins; validate() refuses one that
         # differs from the model's. Only a file without one borrows the
         # model's.
-        data = _load_data(args, default_ts=model.ts)
+        data = _outputs_as_the_model(_load_data(args, default_ts=model.ts), model)
         data = _prepared_as_the_model(data, model, recorded, args)
         if args.fraction is not None:
             warm, data = data.split(args.fraction)

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from spiralid._checks import positive
+from spiralid._checks import named_index, positive
 
 from .readers import (
     NoSampleTimeError,
@@ -60,6 +60,24 @@ def _per_output(value, p: int, name: str, kind):
             f"`{name}` must have one entry per output ({p}); got {len(values)}"
         )
     return values
+
+
+def _same_length(outputs: dict, path) -> None:
+    """Several output variables, each a vector, all of one length: a
+    one-line ValueError that names them otherwise."""
+    for key, y in outputs.items():
+        if y.ndim != 1:
+            raise ValueError(
+                f"`output` variable {key!r} of {str(path)!r} must be a vector to "
+                f"be one of several outputs; got shape {y.shape}"
+            )
+    lengths = {key: y.size for key, y in outputs.items()}
+    if len(set(lengths.values())) > 1:
+        listed = ", ".join(f"{key!r} {n}" for key, n in lengths.items())
+        raise ValueError(
+            f"`output` variables must have the same length; got {listed} samples "
+            f"in {str(path)!r}"
+        )
 
 
 def _label(name: str, unit: str) -> str:
@@ -200,23 +218,7 @@ class IOData:
         with its own name, unit and offset (the record itself when it has
         one output and `which` names it)."""
         names = self.output_names
-        if isinstance(which, str):
-            if which not in names:
-                raise ValueError(
-                    f"`which` must be one of the outputs {names}; got {which!r}"
-                )
-            k = names.index(which)
-        elif isinstance(which, int | np.integer) and not isinstance(which, bool):
-            if not 0 <= which < len(names):
-                raise ValueError(
-                    f"`which` must be an output index in [0, {len(names) - 1}]; "
-                    f"got {which!r}"
-                )
-            k = int(which)
-        else:
-            raise ValueError(
-                f"`which` must be an output's index or name; got {which!r}"
-            )
+        k = named_index(which, "which", names)
         if self.y.ndim == 1:
             return self
         return IOData(
@@ -229,6 +231,40 @@ class IOData:
             y_offset=self.y_offsets[k],
             input_unit=self.input_unit,
             output_unit=self.output_units[k],
+        )
+
+    def select_outputs(self, which, *, rename=None) -> IOData:
+        """The outputs `which` (names or 0-based indices) in that order, each
+        with its own unit and offset, optionally renamed to `rename` (one
+        name per output).
+
+        Examples
+        --------
+        >>> d = IOData([0.0, 1.0], [[1.0, 2.0], [3.0, 4.0]], ts=1.0,
+        ...            output_name=("vel", "acc"))
+        >>> d.select_outputs(["acc", "vel"]).outputs.tolist()
+        [[2.0, 1.0], [4.0, 3.0]]
+        >>> d.select_outputs([1], rename=["tip"]).output_names
+        ('tip',)
+        """
+        ones = [self.output(w) for w in which]
+        if not ones:
+            raise ValueError("`which` must name at least one output")
+        names = [o.output_name for o in ones] if rename is None else list(rename)
+        if len(names) != len(ones):
+            raise ValueError(
+                f"`rename` must have one name per output ({len(ones)}); got "
+                f"{len(names)}"
+            )
+        several = len(ones) > 1
+        return self._replace(
+            self.u,
+            np.column_stack([o.y for o in ones]) if several else ones[0].y,
+            output_name=tuple(names) if several else names[0],
+            y_offset=tuple(o.y_offset for o in ones) if several else ones[0].y_offset,
+            output_unit=tuple(o.output_unit for o in ones)
+            if several
+            else ones[0].output_unit,
         )
 
     def require_single_output(self, what: str) -> None:
@@ -546,6 +582,8 @@ class IOData:
 
         ys = [arr(key, "output") for key in keys]
         several = len(keys) > 1
+        if several:
+            _same_length(dict(zip(keys, ys, strict=True)), path)
         return cls(
             arr(input, "input"),
             np.column_stack(ys) if several else ys[0],
