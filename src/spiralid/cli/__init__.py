@@ -94,20 +94,29 @@ def main(argv: list[str] | None = None) -> int:
     prefix = f"spiralid {command}" if command else "spiralid"
     with _interrupts() as interrupted:
         with warnings.catch_warnings():
-            status = _run(argv, prefix)
+            status = _run(argv, prefix, interrupted)
         if interrupted() and status not in (130, 143):
             # Ctrl-C after the work was done (or swallowed on its way up):
             # still one line and the status a shell expects.
-            print(f"{prefix}: interrupted", file=sys.stderr)
-            status = 130
+            status = _say_interrupted(prefix, interrupted())
     return status
+
+
+def _say_interrupted(prefix: str, signum: int) -> int:
+    """The one line for an interrupt by `signum`, and its exit status."""
+    if signum == signal.SIGTERM:
+        print(f"{prefix}: terminated", file=sys.stderr)
+        return 143
+    print(f"{prefix}: interrupted", file=sys.stderr)
+    return 130
 
 
 @contextmanager
 def _interrupts():
     """SIGINT raises KeyboardInterrupt, SIGTERM `_Terminated`, and both are
     remembered, so that one arriving at any moment ends in one line and exit
-    status 130 (143); the previous handlers come back on leaving."""
+    status 130 (143); the previous handlers come back on leaving. It yields
+    a function that returns the first signal received (0 for none)."""
     received: list[int] = []
 
     def on_signal(signum, frame):
@@ -127,7 +136,7 @@ def _interrupts():
         except ValueError:  # not the main thread: leave the signals alone
             pass
     try:
-        yield lambda: bool(received)
+        yield lambda: received[0] if received else 0
     finally:
         for signum, handler in previous.items():
             if received:
@@ -138,7 +147,7 @@ def _interrupts():
             signal.signal(signum, handler)
 
 
-def _run(argv: list[str], prefix: str) -> int:
+def _run(argv: list[str], prefix: str, interrupted=lambda: 0) -> int:
     try:
         # Inside the try: building the parser imports the library, and a
         # Ctrl-C during that import is one line like any other.
@@ -150,14 +159,16 @@ def _run(argv: list[str], prefix: str) -> int:
             return 2
         return args.run(args, argv)
     except Exception as exc:
+        if interrupted():
+            # The interrupt landed inside a library's call, which turned it
+            # into an error of its own (a compiled kernel's SystemError):
+            # it is the interrupt, not a bug nor the user's mistake.
+            return _say_interrupted(prefix, interrupted())
         if is_user_error(exc):
             print(f"{prefix}: error: {_user_message(exc)}", file=sys.stderr)
             return 2
         report_bug(prefix, exc, debug="--debug" in argv)
         return 1
-    except _Terminated:
-        print(f"{prefix}: terminated", file=sys.stderr)
-        return 143
-    except KeyboardInterrupt:
-        print(f"{prefix}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        terminated = isinstance(exc, _Terminated)
+        return _say_interrupted(prefix, signal.SIGTERM if terminated else signal.SIGINT)
