@@ -30,7 +30,7 @@ __all__ = [
     "fit_percents_table",
     "fits_table",
     "modes_table",
-    "output_stem",
+    "output_stems",
     "shared_report",
     "write_shared_report",
 ]
@@ -254,42 +254,70 @@ _FIGURE_CAPTIONS = {
 }
 
 
-def _figures(v_val, diagram, data) -> dict[str, tuple[str, bytes, str]]:
-    """Every figure as ``stem -> (title, PNG, caption)``: the stabilisation
-    diagram first, then each output's validation figures."""
-    out = {}
+def _figures(v_val, diagram, data):
+    """The stabilisation diagram's figure (None without one) and each
+    output's validation figures, by output name, each figure as ``stem ->
+    (title, PNG, caption)``."""
+    diagram_figure = None
     if diagram is not None:
         from spiralid.sysid.validation.mode_plots import plot_stabilisation
 
         orders = ", ".join(str(n) for n in diagram.orders)
-        out["stabilisation"] = (
+        diagram_figure = (
             "Each order's modes over the record's spectra",
             png(plot_stabilisation(diagram, data)),
             f"Orders na = {orders}.",
         )
-    for name, v in v_val.outputs.items():
-        for kind, fig in v.plot().items():
-            stem = f"validation_{output_stem(name)}_{kind}"
-            title = f"{name}: {kind.replace('_', '-')}"
-            out[stem] = (title, png(fig), _FIGURE_CAPTIONS.get(kind, ""))
-    return out
+    stems = output_stems(v_val.outputs)
+    by_output = {
+        name: {
+            f"validation_{stems[name]}_{kind}": (
+                f"{name}: {kind.replace('_', '-')}",
+                png(fig),
+                _FIGURE_CAPTIONS.get(kind, ""),
+            )
+            for kind, fig in v.plot().items()
+        }
+        for name, v in v_val.outputs.items()
+    }
+    return diagram_figure, by_output
 
 
-def output_stem(name: str) -> str:
-    """An output's name as a file-name part (letters, digits, _ and -): how
-    its figures are named, by ``identify --output`` and ``validate``.
+def output_stems(names) -> dict[str, str]:
+    """Each output's name as a file-name part (letters, digits, _ and -),
+    one per name and told apart: how its figures are named, by ``identify
+    --output`` and ``validate``.
+
+    Two names that become the same part ("acc x" and "acc.x", or two that
+    differ only in case, which some file systems do not tell apart) get
+    ``-2``, ``-3``... after the later ones.
 
     Parameters
     ----------
-    name : str
-        The output's name.
+    names : iterable of str
+        The outputs' names, each once.
 
     Returns
     -------
-    str
+    dict of str to str
+        Each name's part, in the order of `names`.
+
+    Examples
+    --------
+    >>> output_stems(["acc x", "acc.x", "tip"])
+    {'acc x': 'acc_x', 'acc.x': 'acc_x-2', 'tip': 'tip'}
     """
-    kept = "".join(c if c.isalnum() or c in "_-" else "_" for c in name)
-    return kept or "output"
+    out: dict[str, str] = {}
+    taken: set[str] = set()
+    for name in names:
+        kept = "".join(c if c.isalnum() or c in "_-" else "_" for c in name)
+        stem, k = kept or "output", 1
+        while stem.casefold() in taken:
+            k += 1
+            stem = f"{kept or 'output'}-{k}"
+        taken.add(stem.casefold())
+        out[name] = stem
+    return out
 
 
 def shared_report(
@@ -329,7 +357,7 @@ def shared_report(
         Each figure as PNG, by file-name stem.
     """
     e = html.escape
-    figures = _figures(v_val, diagram, data)
+    diagram_figure, by_output = _figures(v_val, diagram, data)
     m_head, m_rows = modes_table(model.modes)
     f_head, f_rows = fits_table(v_est, v_val)
     integrators = ", ".join(
@@ -357,8 +385,8 @@ def shared_report(
         "fit_i / 100)<sup>2</sup>)).</p>",
         table(f_head, f_rows, "html"),
     ]
-    if "stabilisation" in figures:
-        title, data_png, caption = figures["stabilisation"]
+    if diagram_figure is not None:
+        title, data_png, caption = diagram_figure
         note = stabilisation_note or caption
         parts.append(
             "<h2>Stabilisation diagram</h2>"
@@ -370,13 +398,12 @@ def shared_report(
                 f"{100 * diagram.damping_tolerance:g} % in damping.",
             )
         )
-    for name in v_val.outputs:
+    images = {} if diagram_figure is None else {"stabilisation": diagram_figure[1]}
+    for name, figures in by_output.items():
         parts.append(f"<h2>Validation of {e(name)}</h2>")
-        prefix = f"validation_{output_stem(name)}_"
         for stem, (title, data_png, caption) in figures.items():
-            if stem.startswith(prefix):
-                parts.append(figure(title, data_png, caption))
-    images = {stem: data_png for stem, (_, data_png, _) in figures.items()}
+            parts.append(figure(title, data_png, caption))
+            images[stem] = data_png
     return page(headline, parts), images
 
 
