@@ -19,6 +19,15 @@ from spiralid.sysid import ARX, NARX, IOData, NARXModel, identify
 from spiralid.sysid.models.narx import Scaling
 
 
+@pytest.fixture(autouse=True)
+def _no_progress_lines(monkeypatch):
+    """These cases read the one line a run says: progress lines come after
+    PLAIN_DELAY seconds, which a loaded machine can reach."""
+    from spiralid.outputs import progress
+
+    monkeypatch.setattr(progress, "PLAIN_DELAY", 1e9)
+
+
 def _csv(path, columns: dict, encoding="utf-8"):
     names = list(columns)
     rows = zip(*columns.values(), strict=True)
@@ -809,7 +818,7 @@ def test_a_partial_store_is_reported_with_what_is_missing(stores, capsys):
     assert err.strip().splitlines() == [
         "spiralid study-report: warning: the store holds 3 of the study's 4 runs "
         "(1 missing: the study stopped early or runs failed); this report covers "
-        "the stored runs only; rerun the study to compute the rest"
+        "what the store holds only; rerun the study to compute the rest"
     ]
     assert out.startswith("Partial study: the store holds 3 of the study's 4 runs")
     results = json.loads((stores / "rep" / "results.json").read_text())
@@ -854,3 +863,236 @@ def test_library_errors_of_round_3_name_the_argument(files):
     with pytest.raises(ValueError, match="the variable 'ts'"):
         read_record(files / "negts.npz", default_ts=0.5)
     assert read_record(files / "nots.npz", default_ts=0.5).ts == 0.5
+
+
+# -- fourth fault round: several outputs and their model files -----------------
+
+
+def _two_outputs(tmp_path):
+    """bias.csv: one input, outputs vel and acc with offsets (5 and -3), as
+    a rig's velocity and accelerometer; the same with renamed columns; and
+    an NPZ whose second output is half as long."""
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(900)
+    den = np.poly([0.9 * np.exp(0.5j), 0.9 * np.exp(-0.5j)]).real
+    vel = lfilter([0.0, 1.0, 0.3], den, u) + 5.0 + 0.01 * rng.standard_normal(900)
+    acc = lfilter([0.0, 0.2, -0.4], den, u) - 3.0 + 0.01 * rng.standard_normal(900)
+    t = [i * 0.01 for i in range(900)]
+    _csv(tmp_path / "bias.csv", {"time_s": t, "u": list(u), "vel": list(vel),
+                                 "acc": list(acc)})  # fmt: skip
+    _csv(tmp_path / "renamed.csv", {"time_s": t, "u": list(u), "v2": list(vel),
+                                    "a2": list(acc)})  # fmt: skip
+    np.savez(tmp_path / "y2d.npz", u=u, vel=vel, accshort=acc[:450], ts=0.01)
+
+
+@pytest.fixture(scope="module")
+def shared_files(tmp_path_factory):
+    """A folder with the records of `_two_outputs`, and a shared-denominator
+    model identified on bias.csv by the command line with --detrend (its
+    file records each output's offset), with hand-edited copies."""
+    folder = tmp_path_factory.mktemp("fourth")
+    _two_outputs(folder)
+    argv = ["identify", str(folder / "bias.csv"), "--output", "vel,acc", "--detrend",
+            "--method", "ls", "--na", "2", "--nb", "2", "--nk", "1", "--quiet",
+            "--out", str(folder / "o")]  # fmt: skip
+    assert cli.main(argv) == 0
+    model = json.loads((folder / "o" / "model.json").read_text())
+    for name, change in {
+        "units_short.json": {"output_units": [""]},
+        "integrators_text.json": {"integrators": "20"},
+        "integrators_half.json": {"integrators": [0.5, 0]},
+        "integrators_three.json": {"integrators": [3, 0]},
+        "nk_half.json": {"structure": {**model["structure"], "nk": 1.5}},
+        "covariance_small.json": {"covariance": [[1.0]]},
+        "ts_text.json": {"ts": "0.002"},
+        "ts_negative.json": {"ts": -0.01},
+        "b_text.json": {"b": [["1", 0.0], [0.0, 1.0]]},
+        "offsets_short.json": {"y_offsets": [5.0]},
+        "names_twice.json": {"output_names": ["vel", "vel"]},
+    }.items():
+        (folder / name).write_text(json.dumps({**model, **change}))
+    return folder
+
+
+FOURTH_ROUND = [
+    ("identify y2d.npz --output vel,accshort", "must have the same length"),
+    ("validate o/model.json y2d.npz --output vel,accshort", "'accshort' 450"),
+    ("validate units_short.json bias.csv", "field 'output_units' must be a list of 2"),
+    ("validate integrators_text.json bias.csv", "field 'integrators' must be a list"),
+    ("validate integrators_half.json bias.csv", "field 'integrators' must be whole"),
+    ("validate integrators_three.json bias.csv", "must be counts in [0, 2]"),
+    ("validate nk_half.json bias.csv", "field 'structure.nk' must be an integer"),
+    ("validate covariance_small.json bias.csv", "field 'covariance' must be an array"),
+    ("validate ts_text.json bias.csv", "field 'ts' must be a number > 0; got '0.0"),
+    ("validate ts_negative.json bias.csv", "field 'ts' must be a number > 0; got -0"),
+    ("validate b_text.json bias.csv", "field 'b' must be an array of 2 x 2 numbers"),
+    ("validate offsets_short.json bias.csv", "field 'y_offsets' must be a list of 2"),
+    ("validate names_twice.json bias.csv", "must name each of the 2 outputs once"),
+    ("validate o/model.json bias.csv --output acc", "must name the model's 2 outputs"),
+    ("validate o/model.json renamed.csv", "in the model's order"),
+    ("export o/model.json", "is a model of 2 outputs (vel, acc) with one denominator"),
+    ("identify bias.csv --output vel,acc --integrator 3,1 --na 4",
+     "--integrator must be at most 2 known integrators per output; got (3, 1)"),
+    ("identify bias.csv --output vel,acc --refine",
+     "--refine does not apply to --method spiral on 2 outputs"),
+    ("identify bias.csv --output vel,acc --method ebsda", "--method ebsda takes one"),
+    ("pareto bias.csv --output vel,acc", "this command takes one output"),
+    ("reproduce --data bias.csv --output vel,acc", "this command takes one output"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("line, words", FOURTH_ROUND, ids=[c[0] for c in FOURTH_ROUND])
+def test_fourth_round_faults_end_in_one_line(
+    shared_files, capsys, monkeypatch, line, words
+):
+    monkeypatch.chdir(shared_files)
+    argv = line.split()
+    if argv[0] in ("identify", "validate", "pareto", "reproduce"):
+        argv += ["--out", "out"]
+    before = _state(shared_files)
+    assert cli.main(argv) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and words in lines[0], err
+    assert lines[0].startswith(f"spiralid {argv[0]}: error: ")
+    assert not re.search(r"`|Traceback|internal error|weights", err)
+    assert out == ""
+    assert _state(shared_files) == before
+
+
+def _fits(folder) -> dict:
+    report = json.loads((folder / "validation.json").read_text())
+    return {name: v["fit_percent"] for name, v in report["outputs"].items()}
+
+
+def test_offsets_and_outputs_are_matched_by_name(shared_files, monkeypatch):
+    """The offsets a model file records follow the outputs' names, not the
+    columns' order (`--output acc,vel` scored vel at -5320 %), and renamed
+    columns are taken in the order --output gives them."""
+    monkeypatch.chdir(shared_files)
+    model = json.loads((shared_files / "o" / "model.json").read_text())
+    assert model["fraction"] == pytest.approx(2 / 3)
+    assert model["y_offsets"][0] > 4 and model["y_offsets"][1] < -2
+    runs = {
+        "plain": [],
+        "swapped": ["--output", "acc,vel"],
+        "renamed": ["--output", "v2,a2"],
+    }
+    fits = {}
+    for name, extra in runs.items():
+        data = "renamed.csv" if name == "renamed" else "bias.csv"
+        argv = ["validate", "o/model.json", data, *extra, "--quiet", "--out", name]
+        assert cli.main(argv) == 0
+        fits[name] = _fits(shared_files / name)
+    assert fits["plain"]["vel"] > 95 and fits["plain"]["acc"] > 95
+    assert fits["swapped"] == fits["plain"] == fits["renamed"]
+
+
+def test_outputs_whose_names_become_one_file_name_keep_their_figures(
+    tmp_path, monkeypatch
+):
+    """'acc x' and 'acc.x' both made acc_x: half the figures were lost and
+    the report showed one output's twice."""
+    monkeypatch.chdir(tmp_path)
+    _two_outputs(tmp_path)
+    text = (tmp_path / "bias.csv").read_text().replace("vel,acc", "acc x,acc.x", 1)
+    (tmp_path / "names.csv").write_text(text)
+    argv = ["identify", "names.csv", "--output", "acc x,acc.x", "--method", "ls",
+            "--na", "2", "--nb", "2", "--nk", "1", "--quiet", "--out", "o"]  # fmt: skip
+    assert cli.main(argv) == 0
+    figures = sorted(p.name for p in (tmp_path / "o").glob("validation_acc_x*.png"))
+    kinds = [f.removeprefix("validation_acc_x_") for f in figures if "-2_" not in f]
+    assert len(kinds) >= 4
+    assert figures == sorted(
+        [f"validation_acc_x_{k}" for k in kinds]
+        + [f"validation_acc_x-2_{k}" for k in kinds]
+    )
+    page = (tmp_path / "o" / "report.html").read_text(encoding="utf-8")
+    assert page.count("<img") == 2 * len(kinds) + 1  # and the diagram
+    argv = ["validate", "o/model.json", "names.csv", "--quiet", "--out", "v"]
+    assert cli.main(argv) == 0
+    assert len(list((tmp_path / "v").glob("*.png"))) == 2 * len(kinds)
+
+
+def test_the_modes_table_shows_whole_output_names():
+    from spiralid.sysid.models.shared import SharedDenominatorModel
+
+    names = ("end_point_acceleration_x", "end_point_acceleration_y")
+    model = SharedDenominatorModel(
+        a=np.poly([0.9 * np.exp(0.5j), 0.9 * np.exp(-0.5j)]).real[1:],
+        b=[[1.0, 0.3], [0.2, -0.4]],
+        arx=ARX(2, 2, 1),
+        ts=0.01,
+        output_names=names,
+    )
+    head, row = str(model.modes).splitlines()
+    assert all(n in head for n in names)
+    assert len(row) == len(head)
+
+
+def test_mode_shares_do_not_move_with_output_units():
+    """residuez's absolute tolerances moved the shares of an output in
+    1e-9 units (78.7/21.3 % against 73.7/26.3 %); a share is a ratio."""
+    from spiralid.sysid.models.modes import mode_table
+
+    poles = [0.95 * np.exp(0.3j), 0.9 * np.exp(1.0j)]
+    a = np.poly([*poles, *np.conj(poles)]).real[1:]
+    b = np.array([0.0, 1.0, 0.3, -0.2, 0.1])
+    unit = mode_table(a, b, 0.01).share
+    for scale in (1e-9, 3e-8, 1e6):
+        np.testing.assert_allclose(
+            mode_table(a, b * scale, 0.01).share, unit, rtol=1e-9
+        )
+
+
+def test_an_interrupt_turned_into_another_error_is_an_interrupt(monkeypatch, capsys):
+    """A Ctrl-C inside a compiled kernel came back as a SystemError, which
+    the command reported as a bug."""
+    import os
+    import signal
+    import time
+
+    from spiralid.cli import validate
+
+    def run(args, argv):
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        except KeyboardInterrupt:
+            raise SystemError("returned a result with an exception set") from None
+        return 0
+
+    monkeypatch.setattr(validate, "run", run)
+    # As a shell starts the command: an earlier in-process interrupt left
+    # SIGINT ignored (the command's exit keeps late signals out).
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert cli.main(["validate", "m.json", "d.csv"]) == 130
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    out, err = capsys.readouterr()
+    assert err.strip().splitlines() == ["spiralid validate: interrupted"]
+    assert out == ""
+
+
+def test_library_errors_of_round_4_name_the_argument():
+    from spiralid.sysid import identify_pareto
+    from spiralid.sysid.models.shared import SharedDenominatorModel
+
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(300)
+    data = IOData(u, lfilter([0.0, 1.0], [1.0, -0.5], u), ts=0.01)
+    with pytest.raises(
+        ValueError, match=r"`nk` builds .* has its own nk = 1; got nk = 3"
+    ):
+        identify_pareto(data, ARX(2, 2, 1), nk=3)
+    model = SharedDenominatorModel(
+        a=[-0.5], b=[[1.0], [2.0]], arx=ARX(1, 1, 1), ts=0.01, output_names=("a", "b")
+    )
+    np.testing.assert_array_equal(
+        model.output_model(np.int64(1)).theta, model.output_model("b").theta
+    )
+    with pytest.raises(ValueError, match=r"`which` must be an index in \[0, 1\]"):
+        model.output_model(2)
+    with pytest.raises(ValueError, match="`which` must be one of"):
+        model.output_model("c")

@@ -10,7 +10,12 @@ import pytest
 
 import spiralid.study.modes as modes_module
 from spiralid.fms import FlexibleManipulator
-from spiralid.report.study_output import _html, study_results_dict, study_summary
+from spiralid.report.study_output import (
+    _html,
+    partial_note,
+    study_results_dict,
+    study_summary,
+)
 from spiralid.study import (
     ResultStore,
     analyse,
@@ -169,6 +174,19 @@ def test_a_store_without_modes_reads_as_before(tmp_path):
     assert "modes_from_every_sensor" not in study_results_dict(res, "")
     assert "Modes from every sensor" not in _html(res, {}, "", None)
     assert "Modes from every sensor" not in study_summary(res)
+
+
+def test_a_store_stopped_before_the_fit_says_what_is_missing(studied, results):
+    """A store interrupted after its runs but before its fit from every
+    sensor: the report said nothing of the section it left out."""
+    spec, store, _ = studied
+    assert results.missing_modes == () and partial_note(results) == ""
+    with ResultStore.open(store, readonly=True) as db:
+        res = analyse(db.rows(), spec, modes={})
+    assert res.missing_runs == 0 and res.missing_modes == ("rig",)
+    note = partial_note(res)
+    assert "no modes from every sensor of 'rig'" in note
+    assert study_summary(res).startswith(f"Partial study: {note}.")
 
 
 # -- the report ----------------------------------------------------------------

@@ -51,7 +51,7 @@ def test_default_names_are_numbered_and_bad_ones_refused():
     y[2, 1] = np.nan
     with pytest.raises(ValueError, match=r"`y\[:, 1\]` must be finite.*sample 2"):
         IOData(np.ones(4), y, ts=1.0)
-    with pytest.raises(ValueError, match="`which` must be one of the outputs"):
+    with pytest.raises(ValueError, match=r"`which` must be one of \(.a., .b.\)"):
         _two().output("c")
 
 

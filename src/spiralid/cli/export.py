@@ -48,17 +48,26 @@ class _Formatter(argparse.RawDescriptionHelpFormatter, _HelpFormatter):
 
 
 def _model(name: str):
-    """The ARX model in `name`; a NARX model has no transfer function."""
+    """The ARX model in `name`: a NARX model has no transfer function, and
+    one of several outputs has one per output."""
     from .validate import _read_model
 
     model, _, _ = _read_model(name)
-    if not hasattr(model, "to_dlti"):
+    if hasattr(model, "to_dlti"):
+        return model
+    takes = (
+        "export takes the single-output ARX models of `spiralid identify` and "
+        "`spiralid pareto`"
+    )
+    if hasattr(model, "output_model"):
         raise UsageError(
-            f"{name!r} is a NARX model: it has no transfer function to export "
-            "(export takes the ARX models of `spiralid identify` and "
-            "`spiralid pareto`)"
+            f"{name!r} is a model of {model.n_outputs} outputs "
+            f"({', '.join(model.output_names)}) with one denominator; {takes} (in "
+            "Python, SharedDenominatorModel.output_model(name) gives each output's)"
         )
-    return model
+    raise UsageError(
+        f"{name!r} is a NARX model: it has no transfer function to export ({takes})"
+    )
 
 
 def transfer_function(model) -> dict:

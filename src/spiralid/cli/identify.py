@@ -306,6 +306,7 @@ def _run_shared(args, progress, arx, est, val, options, argv) -> int:
     with _open_folder(args.out, args.force) as folder:
         progress.phase("estimation", f"estimating {arx} for {est.n_outputs} outputs")
         model = identify(est, arx, method=args.method, **options)
+        model.fraction = args.fraction
         progress.phase("validation", "validating every output on both parts")
         v_est = validate_outputs(model, est, label=f"{args.method} (estimation)")
         v_val = validate_outputs(
@@ -497,6 +498,29 @@ def _check_candidates(args) -> None:
         raise UsageError("--lags replaces --na and --nb (each lag count n is n, n)")
 
 
+def _check_shared_options(args, est) -> None:
+    """The method and typed flags a fit of several outputs takes (the
+    library's table, shared_options), refused by their flags."""
+    from spiralid.sysid.estimation.identify import shared_options
+    from spiralid.sysid.estimation.shared import SHARED_METHODS
+
+    outputs = f"{est.n_outputs} outputs (one shared denominator)"
+    if args.method not in SHARED_METHODS:
+        raise UsageError(
+            f"--method {args.method} takes one output; a record of {outputs} is "
+            f"identified by --method {' or '.join(SHARED_METHODS)}"
+        )
+    takes = shared_options(args.method)
+    refused = [f for f in _given(args, *_OPTION_FLAGS) if _OPTION_FLAGS[f] not in takes]
+    if refused:
+        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
+        verb = "does" if len(refused) == 1 else "do"
+        raise UsageError(
+            f"{', '.join(refused)} {verb} not apply to --method {args.method} on "
+            f"{outputs}; the options that do: {', '.join(able)}"
+        )
+
+
 def _check_options(args) -> None:
     """Refuse, before any data is read, what the model and method cannot
     do, and every typed option identify() would refuse from Python for this
@@ -550,6 +574,7 @@ def run(args, argv: list[str]) -> int:
         # The budget rule is identify()'s (searches.search_options).
         options = _identify_options(args, arx)
         if est.n_outputs > 1:
+            _check_shared_options(args, est)
             return _run_shared(args, progress, arx, est, val, options, argv)
         with _open_folder(args.out, args.force) as folder:
             steps = _search_steps(args)

@@ -127,7 +127,19 @@ def _add_initial_option(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _add_data_options(p: argparse.ArgumentParser) -> None:
+def _one_column(value: str) -> str | int:
+    """--output of a command that models one output."""
+    if "," in value:
+        raise argparse.ArgumentTypeError(
+            f"this command takes one output; got {value!r} (`spiralid identify "
+            "--output a,b` fits one model of several outputs)"
+        )
+    return _column(value)
+
+
+def _add_data_options(p: argparse.ArgumentParser, several_outputs: bool = True) -> None:
+    """--input, --output (several only where the command models several),
+    --ts and the units."""
     p.add_argument(
         "--input",
         type=_column,
@@ -137,11 +149,15 @@ def _add_data_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--output",
-        type=_columns,
+        type=_columns if several_outputs else _one_column,
         default=None,
         help="output column or variable; default 'y', or "
-        "'end_acceleration_m_s2' in files written by `spiralid simulate`; "
-        "several separated by commas (a,b,c) for one model of every output",
+        "'end_acceleration_m_s2' in files written by `spiralid simulate`"
+        + (
+            "; several separated by commas (a,b,c) for one model of every output"
+            if several_outputs
+            else ""
+        ),
     )
     p.add_argument(
         "--ts",

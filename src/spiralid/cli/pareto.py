@@ -271,7 +271,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
     )
-    _add_data_options(p)
+    _add_data_options(p, several_outputs=False)
     p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
     p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
     p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")

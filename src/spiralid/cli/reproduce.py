@@ -99,7 +99,7 @@ def add_parser(sub) -> None:
         help="your own CSV/NPZ/MAT record, or 'robot_arm' (the shipped DaISy arm) "
         "(default: the simulated rig's paper experiment)",
     )
-    _add_data_options(p)
+    _add_data_options(p, several_outputs=False)
     _add_initial_option(p)
     p.add_argument(
         "--all-outputs",

@@ -145,8 +145,9 @@ def _study_report(
     res = analyse(rows, spec, modes=modes)
     # Before anything is written, so that a failure here writes nothing.
     summary = study_summary(res)
-    if warn and res.missing_runs:
-        warnings.warn(partial_note(res), stacklevel=1)
+    note = partial_note(res)
+    if warn and note:
+        warnings.warn(note, stacklevel=1)
     progress.phase("writing", "writing the report")
     written = write_study_report(
         res,

@@ -187,15 +187,26 @@ def anytime_summary(res: StudyResults) -> str:
 
 
 def partial_note(res: StudyResults) -> str:
-    """What a report of a partly run study covers; empty when no run is
-    missing."""
-    if not res.missing_runs:
+    """What a report of a partly run study covers; empty when no run and
+    no fit from every sensor is missing."""
+    missing = []
+    if res.missing_runs:
+        missing.append(
+            f"the store holds {res.stored_runs} of the study's {res.expected_runs} "
+            f"runs ({res.missing_runs} missing: the study stopped early or runs "
+            "failed)"
+        )
+    if res.missing_modes:
+        missing.append(
+            "it holds no modes from every sensor of "
+            f"{', '.join(map(repr, res.missing_modes))} (the study stopped before "
+            "that fit)"
+        )
+    if not missing:
         return ""
     return (
-        f"the store holds {res.stored_runs} of the study's {res.expected_runs} "
-        f"runs ({res.missing_runs} missing: the study stopped early or runs "
-        "failed); this report covers the stored runs only; rerun the study "
-        "to compute the rest"
+        f"{'; '.join(missing)}; this report covers what the store holds only; "
+        "rerun the study to compute the rest"
     )
 
 

@@ -63,6 +63,9 @@ class StudyResults:
     modes : dict of str to SharedModesFit
         Per rig record with ``all_outputs``, its modes from every sensor
         (empty without).
+    missing_modes : tuple of str
+        Rig records with ``all_outputs`` whose modes from every sensor the
+        store does not hold (the study stopped before their fit).
     """
 
     readings: list[Reading]
@@ -76,6 +79,7 @@ class StudyResults:
     stored_runs: int = 0
     expected_runs: int | None = None
     modes: dict[str, SharedModesFit] = field(default_factory=dict)
+    missing_modes: tuple[str, ...] = ()
 
     @property
     def missing_runs(self) -> int:
@@ -190,6 +194,11 @@ def analyse(
         stored_runs=len(rows),
         expected_runs=None if spec is None else spec.n_runs,
         modes=_shared_modes(modes),
+        missing_modes=tuple(
+            d.name
+            for d in ([] if spec is None else spec.data)
+            if d.all_outputs and d.name not in (modes or {})
+        ),
     )
     tested = [
         rd for rd in readings if (rd, claim[0]) in cells and (rd, claim[1]) in cells

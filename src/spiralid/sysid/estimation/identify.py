@@ -515,6 +515,14 @@ def _time_constant(value, ts: float) -> float | None:
     return seconds
 
 
+def shared_options(method: str) -> tuple[str, ...]:
+    """The options `identify` takes with `method` on a record of several
+    outputs (one shared denominator)."""
+    from .shared import SHARED_METHODS
+
+    return ("rng", "predictor", "initial", "integrator", *SHARED_METHODS[method])
+
+
 def _identify_shared(data: IOData, arx: ARX, method, given: dict):
     """`identify` on a record of several outputs: one denominator for all
     (:func:`~spiralid.sysid.estimation.shared.identify_shared`) by the
@@ -533,7 +541,7 @@ def _identify_shared(data: IOData, arx: ARX, method, given: dict):
             "a record of several outputs is fitted to its simulation error from "
             f"rest; got predictor={given['predictor']!r}, initial={given['initial']!r}"
         )
-    takes = ("rng", "predictor", "initial", "integrator", *SHARED_METHODS[method])
+    takes = shared_options(method)
     refuse_options(
         given,
         takes,

@@ -156,9 +156,15 @@ class ParetoIdentification:
         )
 
 
-def _structures(orders, nk: int) -> list[ARX]:
+def _structures(orders, nk: int | None) -> list[ARX]:
     if isinstance(orders, ARX):
+        if nk is not None and nk != orders.nk:
+            raise ValueError(
+                f"`nk` builds structures from orders given as numbers; {orders} "
+                f"has its own nk = {orders.nk}; got nk = {nk!r}"
+            )
         return [orders]
+    nk = 0 if nk is None else nk
     if isinstance(orders, int | np.integer) and not isinstance(orders, bool):
         orders = [orders]
     if isinstance(orders, str) or not isinstance(orders, Iterable):
@@ -256,7 +262,7 @@ def identify_pareto(
     method: str = "ebsda",
     *,
     rng=None,
-    nk: int = 0,
+    nk: int | None = None,
     initial: str = "rest",
     gain: str | float = "auto",
     penalty: float = 1e6,
@@ -286,8 +292,10 @@ def identify_pareto(
         :func:`~spiralid.optim.pareto.minimize_pareto` takes.
     rng : None, int or numpy.random.Generator
         Seed of the searches (one generator, orders in the given order).
-    nk : int, default 0
-        Input delay of the structures built from `orders`.
+    nk : int, optional
+        Input delay of the structures built from `orders` given as numbers
+        (default 0); an ARX carries its own, and a different `nk` beside it
+        is refused.
     initial : {"rest", "measured"}
         Initial condition of the simulation error (see ``identify``).
     gain, penalty

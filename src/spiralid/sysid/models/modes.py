@@ -330,6 +330,12 @@ def _peak_shares(b: np.ndarray, den: np.ndarray, upper: np.ndarray) -> np.ndarra
     pole's (a complex pair counted once)."""
     if not upper.size:
         return np.zeros(0)
+    # The shares are ratios, whatever the output's unit; residuez is not:
+    # its tolerances are absolute, so a numerator of order 1e-8 (an output
+    # in small units) would move them. In the numerator's own scale it
+    # sees every unit alike.
+    scale = np.max(np.abs(b), initial=0.0)
+    b = b / scale if scale > 0 else b
     with np.errstate(all="ignore"):
         residues, poles, _ = signal.residuez(b, den)
         peaks = np.abs(residues) / np.abs(1.0 - np.abs(poles))
