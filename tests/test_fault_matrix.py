@@ -854,3 +854,115 @@ def test_library_errors_of_round_3_name_the_argument(files):
     with pytest.raises(ValueError, match="the variable 'ts'"):
         read_record(files / "negts.npz", default_ts=0.5)
     assert read_record(files / "nots.npz", default_ts=0.5).ts == 0.5
+
+
+# -- fourth fault round: NARX selection ---------------------------------------
+
+
+@pytest.fixture
+def narx_files(files):
+    """nl.csv: a second-order system behind a saturating input map (true
+    lags 2), 900 samples at ts 1 s."""
+    rng = np.random.default_rng(7)
+    u = rng.uniform(-1.0, 1.0, 900)
+    y = np.zeros_like(u)
+    for t in range(2, u.size):
+        y[t] = 1.2 * y[t - 1] - 0.5 * y[t - 2] + np.tanh(u[t - 1]) + 0.2 * u[t - 2]
+    _csv(files / "nl.csv", {"u": [float(v) for v in u], "y": [float(v) for v in y]})
+    return files
+
+
+def _candidate_lines(out: str) -> list[str]:
+    """The lines of --by-fit's list: one per candidate, indented."""
+    head = out.index("chosen by validation fit")
+    block = out[head:].split("\n\n", 1)[0]
+    return [line for line in block.splitlines()[1:] if line.startswith("  ")]
+
+
+@pytest.mark.parametrize(
+    "flags, structures",
+    [
+        # Three lags, ten terms each: one size, which hid two of them.
+        (
+            "--model polynomial --degree 2 --terms 10 --lags 2,3,4",
+            [("polynomial", n, None) for n in (2, 3, 4)],
+        ),
+        # NARX(1, 1, 0, hidden=(5,)) and NARX(3, 3, 0, hidden=(2,)) share
+        # 23 parameters.
+        (
+            "--model narx --lags 1,3 --hidden 2,5",
+            [("narx", n, h) for n in (1, 3) for h in (2, 5)],
+        ),
+    ],
+    ids=["polynomial", "narx"],
+)
+def test_by_fit_lists_and_validates_every_candidate(
+    narx_files, capsys, flags, structures
+):
+    """Every candidate is listed with its validation fit, worked out here by
+    fitting and validating each one; the chosen one is the smallest within
+    the tolerance of the best, the best-fitting of its size."""
+    from spiralid.sysid import PolynomialNARX, validate
+
+    argv = ["identify", "nl.csv", *flags.split(), "--nk", "0", "--method", "ls",
+            "--by-fit", "1", "--ts", "1", "--seed", "0", "--out", "m"]  # fmt: skip
+    assert cli.main(argv) == 0
+    out = capsys.readouterr().out
+    est, val = IOData.from_csv(narx_files / "nl.csv", ts=1.0).split(2 / 3)
+    models = [
+        identify(est, NARX(n, n, 0, hidden=(h,)), method="ls", rng=0)
+        if kind == "narx"
+        else identify(est, PolynomialNARX(n, n, 0, degree=2, n_terms=10), method="ls")
+        for kind, n, h in structures
+    ]
+    fits = [validate(m, val, warmup=est).fit_percent for m in models]
+    sizes = [m.params.size for m in models]
+    assert len(set(sizes)) < len(sizes), "the case must hold candidates of one size"
+    listed = _candidate_lines(out)
+    assert len(listed) == len(models), out
+    for m, size, fit in zip(models, sizes, fits, strict=True):
+        line = f"  {m.structure}: {size} parameters, validation fit {fit:.2f} %"
+        assert any(row.startswith(line) for row in listed), (line, listed)
+    ok = [i for i, f in enumerate(fits) if f >= max(fits) - 1.0]
+    smallest = min(sizes[i] for i in ok)
+    want = max((i for i in ok if sizes[i] == smallest), key=lambda i: fits[i])
+    chosen = [row for row in listed if row.endswith("  <- chosen")]
+    assert len(chosen) == 1 and chosen[0].startswith(f"  {models[want].structure}:")
+    if len(set(sizes)) == 1:
+        # One size: the choice is the best validation fit.
+        assert fits[want] == max(fits)
+    saved = json.loads((narx_files / "m" / "model.json").read_text())
+    assert NARXModel.from_dict(saved).structure == models[want].structure
+
+
+def _two_of_one_size(files):
+    """Two ARX(2, 2, 1) models, 4 parameters each: one fitted on ok.csv's
+    estimation part (a little noise), one on a noiseless record of another
+    second-order system (which it fits exactly: the lower estimation
+    cost)."""
+    data = IOData.from_csv(files / "ok.csv", ts=0.01)
+    est, val = data.split(2 / 3)
+    u = np.random.default_rng(5).standard_normal(400)
+    y = lfilter([0.0, 0.3, 0.2], [1.0, 0.4, 0.3], u)
+    other = identify(IOData(u, y, ts=0.01), ARX(2, 2, 1), method="ls")
+    right = identify(est, ARX(2, 2, 1), method="ls")
+    return [other, right], est, val
+
+
+def test_choose_order_validates_every_model_of_one_size(files):
+    from spiralid.sysid import choose_order, fits_by_order, validate, validation_fits
+
+    models, est, val = _two_of_one_size(files)
+    assert models[0].params.size == models[1].params.size
+    assert models[0].cost < 1e-6 * models[1].cost
+    fits = [validate(m, val, warmup=est).fit_percent for m in models]
+    assert fits[1] > 95 > fits[0] + 50
+    assert validation_fits(models, val, warmup=est) == [
+        (4, 0, fits[0]),
+        (4, 1, fits[1]),
+    ]
+    # Not the lower estimation cost: the better validation fit.
+    assert choose_order(models, val, warmup=est, tolerance=1.0) == 1
+    # A dict keyed by size cannot hold both: refused, not one dropped.
+    with pytest.raises(ValueError, match=r"`front` holds 2 models of 4 parameters"):
+        fits_by_order(models, val, warmup=est)
