@@ -9,6 +9,7 @@ itself under signals and concurrency.
 
 import json
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -966,3 +967,72 @@ def test_choose_order_validates_every_model_of_one_size(files):
     # A dict keyed by size cannot hold both: refused, not one dropped.
     with pytest.raises(ValueError, match=r"`front` holds 2 models of 4 parameters"):
         fits_by_order(models, val, warmup=est)
+
+
+def _narx_record(n=300, constant_end=0):
+    u = np.random.default_rng(0).standard_normal(n)
+    y = np.tanh(lfilter([0.0, 0.5], [1.0, -0.8], u))
+    if constant_end:
+        y[-constant_end:] = 1.0
+    return IOData(u, y, ts=0.01)
+
+
+SMALL_BOX = dict(lags=(1, 2), hidden=(1, 2), n_points=3, rng=0)
+
+
+@pytest.mark.parametrize(
+    "data, kwargs, words",
+    [
+        # round(0.001 * 300) = 0 samples held back: the fit was nan.
+        (_narx_record(), dict(holdback=0.001, budget=2),
+         "`holdback` = 0.001 holds back 0 of the 300 samples of `data`: too few"),
+        (_narx_record(), dict(holdback=1 / 300, budget=2),
+         "holds back 1 of the 300 samples"),
+        # A constant held-back output: the fit was -inf.
+        (_narx_record(constant_end=75), dict(budget=2),
+         "the held-back output (the last 75 samples of `data`, `holdback` = 0.25) "
+         "is constant, every sample 1.0: no variance"),
+    ],
+)  # fmt: skip
+def test_choose_narx_refuses_what_it_cannot_score_in_one_line(data, kwargs, words):
+    from spiralid.sysid import choose_narx
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError) as err:
+            choose_narx(data, **{**SMALL_BOX, **kwargs})
+    message = str(err.value)
+    assert words in message and "\n" not in message, message
+    assert "np.float" not in message
+
+
+def test_choose_narx_with_a_budget_of_one_trains_one_choice(monkeypatch):
+    """budget=1 is one training (and the refit): the search's first point,
+    scored here again from the model it trained by fit_percent."""
+    from spiralid.sysid import choose_narx, fit_percent
+    from spiralid.sysid.estimation import narx_choice
+
+    trained = []
+
+    def recording(data, structure, **options):
+        model = identify(data, structure, **options)
+        trained.append((data.n, structure, options["decay"], model))
+        return model
+
+    monkeypatch.setattr(narx_choice, "identify", recording)
+    data = _narx_record()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = choose_narx(data, **{**SMALL_BOX, "budget": 1})
+    assert res.success and res.nfev == 1 and len(res.trials) == 1
+    assert res.message == "The budget of 1 training was spent."
+    # One training on the first 225 samples, then the refit on all 300.
+    (n_train, st, decay, model), (n_all, refit_st, refit_decay, refit) = trained
+    assert (n_train, n_all) == (225, 300)
+    assert st == refit_st == res.structure and decay == refit_decay == res.decay
+    assert refit is res.model
+    held = fit_percent(data.y[225:], model.simulate(data.u)[225:])
+    assert np.isfinite(held) and res.fit == pytest.approx(held, abs=1e-9)
+    n, h, d = res.trials[0][:3]
+    assert res.trials[0][3] == res.fit and tuple(res.x) == (n, h, d)
+    assert st == NARX(n, n, 1, hidden=(h,)) and res.fun == pytest.approx(100 - res.fit)
