@@ -992,6 +992,13 @@ SMALL_BOX = dict(lags=(1, 2), hidden=(1, 2), n_points=3, rng=0)
         (_narx_record(constant_end=75), dict(budget=2),
          "the held-back output (the last 75 samples of `data`, `holdback` = 0.25) "
          "is constant, every sample 1.0: no variance"),
+        # NARX(4, 4, 1, hidden=(8,)): 8 x 8 input weights, 8 biases, 8 output
+        # weights, 1 bias and 8 linear terms are 89 parameters, after 4
+        # initial samples; 80 * 3/4 leave 60.
+        (_narx_record(80), dict(lags=(1, 4), hidden=(1, 8), budget=2),
+         "needs at least 94 samples (89 parameters after 4 initial samples, plus "
+         "one); got 60 before the held-back part (`holdback` = 0.25), for the "
+         "largest choice of `lags` and `hidden`"),
     ],
 )  # fmt: skip
 def test_choose_narx_refuses_what_it_cannot_score_in_one_line(data, kwargs, words):

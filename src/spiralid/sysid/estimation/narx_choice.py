@@ -173,6 +173,15 @@ def choose_narx(
         ``n_calls`` (the search's evaluations, repeats included),
         ``elapsed``.
 
+    Raises
+    ------
+    ValueError
+        Before any training, for an argument out of its range, a held-back
+        part of fewer than 2 samples or with a constant output (no fit can
+        be scored on it), or ranges whose largest choice,
+        ``NARX(lags[1], lags[1], nk, hidden=(hidden[1],))``, is too large
+        for the samples before the held-back part.
+
     Examples
     --------
     >>> import numpy as np
@@ -218,6 +227,17 @@ def choose_narx(
 
     def structure(n: int, h: int) -> NARX:
         return NARX(n, n, nk, hidden=(h,), integrator=integrator)
+
+    # Any choice in the ranges may be trained: the largest must fit before
+    # the search starts, not fail at whichever point first reaches it.
+    try:
+        structure(lags[1], hidden[1]).check_length(train, "data")
+    except ValueError as e:
+        raise ValueError(
+            f"{e} before the held-back part (`holdback` = {share!r}), for the "
+            "largest choice of `lags` and `hidden`: narrow them, lower "
+            "`holdback` or give a longer record"
+        ) from None
 
     trials: dict[tuple, float] = {}
     calls = [0]
