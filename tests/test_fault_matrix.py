@@ -9,6 +9,7 @@ itself under signals and concurrency.
 
 import json
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -1096,3 +1097,191 @@ def test_library_errors_of_round_4_name_the_argument():
         model.output_model(2)
     with pytest.raises(ValueError, match="`which` must be one of"):
         model.output_model("c")
+
+
+# -- fourth fault round: NARX selection ---------------------------------------
+
+
+@pytest.fixture
+def narx_files(files):
+    """nl.csv: a second-order system behind a saturating input map (true
+    lags 2), 900 samples at ts 1 s."""
+    rng = np.random.default_rng(7)
+    u = rng.uniform(-1.0, 1.0, 900)
+    y = np.zeros_like(u)
+    for t in range(2, u.size):
+        y[t] = 1.2 * y[t - 1] - 0.5 * y[t - 2] + np.tanh(u[t - 1]) + 0.2 * u[t - 2]
+    _csv(files / "nl.csv", {"u": [float(v) for v in u], "y": [float(v) for v in y]})
+    return files
+
+
+def _candidate_lines(out: str) -> list[str]:
+    """The lines of --by-fit's list: one per candidate, indented."""
+    head = out.index("chosen by validation fit")
+    block = out[head:].split("\n\n", 1)[0]
+    return [line for line in block.splitlines()[1:] if line.startswith("  ")]
+
+
+@pytest.mark.parametrize(
+    "flags, structures",
+    [
+        # Three lags, ten terms each: one size, which hid two of them.
+        (
+            "--model polynomial --degree 2 --terms 10 --lags 2,3,4",
+            [("polynomial", n, None) for n in (2, 3, 4)],
+        ),
+        # NARX(1, 1, 0, hidden=(5,)) and NARX(3, 3, 0, hidden=(2,)) share
+        # 23 parameters.
+        (
+            "--model narx --lags 1,3 --hidden 2,5",
+            [("narx", n, h) for n in (1, 3) for h in (2, 5)],
+        ),
+    ],
+    ids=["polynomial", "narx"],
+)
+def test_by_fit_lists_and_validates_every_candidate(
+    narx_files, capsys, flags, structures
+):
+    """Every candidate is listed with its validation fit, worked out here by
+    fitting and validating each one; the chosen one is the smallest within
+    the tolerance of the best, the best-fitting of its size."""
+    from spiralid.sysid import PolynomialNARX, validate
+
+    argv = ["identify", "nl.csv", *flags.split(), "--nk", "0", "--method", "ls",
+            "--by-fit", "1", "--ts", "1", "--seed", "0", "--out", "m"]  # fmt: skip
+    assert cli.main(argv) == 0
+    out = capsys.readouterr().out
+    est, val = IOData.from_csv(narx_files / "nl.csv", ts=1.0).split(2 / 3)
+    models = [
+        identify(est, NARX(n, n, 0, hidden=(h,)), method="ls", rng=0)
+        if kind == "narx"
+        else identify(est, PolynomialNARX(n, n, 0, degree=2, n_terms=10), method="ls")
+        for kind, n, h in structures
+    ]
+    fits = [validate(m, val, warmup=est).fit_percent for m in models]
+    sizes = [m.params.size for m in models]
+    assert len(set(sizes)) < len(sizes), "the case must hold candidates of one size"
+    listed = _candidate_lines(out)
+    assert len(listed) == len(models), out
+    for m, size, fit in zip(models, sizes, fits, strict=True):
+        line = f"  {m.structure}: {size} parameters, validation fit {fit:.2f} %"
+        assert any(row.startswith(line) for row in listed), (line, listed)
+    ok = [i for i, f in enumerate(fits) if f >= max(fits) - 1.0]
+    smallest = min(sizes[i] for i in ok)
+    want = max((i for i in ok if sizes[i] == smallest), key=lambda i: fits[i])
+    chosen = [row for row in listed if row.endswith("  <- chosen")]
+    assert len(chosen) == 1 and chosen[0].startswith(f"  {models[want].structure}:")
+    if len(set(sizes)) == 1:
+        # One size: the choice is the best validation fit.
+        assert fits[want] == max(fits)
+    saved = json.loads((narx_files / "m" / "model.json").read_text())
+    assert NARXModel.from_dict(saved).structure == models[want].structure
+
+
+def _two_of_one_size(files):
+    """Two ARX(2, 2, 1) models, 4 parameters each: one fitted on ok.csv's
+    estimation part (a little noise), one on a noiseless record of another
+    second-order system (which it fits exactly: the lower estimation
+    cost)."""
+    data = IOData.from_csv(files / "ok.csv", ts=0.01)
+    est, val = data.split(2 / 3)
+    u = np.random.default_rng(5).standard_normal(400)
+    y = lfilter([0.0, 0.3, 0.2], [1.0, 0.4, 0.3], u)
+    other = identify(IOData(u, y, ts=0.01), ARX(2, 2, 1), method="ls")
+    right = identify(est, ARX(2, 2, 1), method="ls")
+    return [other, right], est, val
+
+
+def test_choose_order_validates_every_model_of_one_size(files):
+    from spiralid.sysid import choose_order, fits_by_order, validate, validation_fits
+
+    models, est, val = _two_of_one_size(files)
+    assert models[0].params.size == models[1].params.size
+    assert models[0].cost < 1e-6 * models[1].cost
+    fits = [validate(m, val, warmup=est).fit_percent for m in models]
+    assert fits[1] > 95 > fits[0] + 50
+    assert validation_fits(models, val, warmup=est) == [
+        (4, 0, fits[0]),
+        (4, 1, fits[1]),
+    ]
+    # Not the lower estimation cost: the better validation fit.
+    assert choose_order(models, val, warmup=est, tolerance=1.0) == 1
+    # A dict keyed by size cannot hold both: refused, not one dropped.
+    with pytest.raises(ValueError, match=r"`front` holds 2 models of 4 parameters"):
+        fits_by_order(models, val, warmup=est)
+
+
+def _narx_record(n=300, constant_end=0):
+    u = np.random.default_rng(0).standard_normal(n)
+    y = np.tanh(lfilter([0.0, 0.5], [1.0, -0.8], u))
+    if constant_end:
+        y[-constant_end:] = 1.0
+    return IOData(u, y, ts=0.01)
+
+
+SMALL_BOX = dict(lags=(1, 2), hidden=(1, 2), n_points=3, rng=0)
+
+
+@pytest.mark.parametrize(
+    "data, kwargs, words",
+    [
+        # round(0.001 * 300) = 0 samples held back: the fit was nan.
+        (_narx_record(), dict(holdback=0.001, budget=2),
+         "`holdback` = 0.001 holds back 0 of the 300 samples of `data`: too few"),
+        (_narx_record(), dict(holdback=1 / 300, budget=2),
+         "holds back 1 of the 300 samples"),
+        # A constant held-back output: the fit was -inf.
+        (_narx_record(constant_end=75), dict(budget=2),
+         "the held-back output (the last 75 samples of `data`, `holdback` = 0.25) "
+         "is constant, every sample 1.0: no variance"),
+        # NARX(4, 4, 1, hidden=(8,)): 8 x 8 input weights, 8 biases, 8 output
+        # weights, 1 bias and 8 linear terms are 89 parameters, after 4
+        # initial samples; 80 * 3/4 leave 60.
+        (_narx_record(80), dict(lags=(1, 4), hidden=(1, 8), budget=2),
+         "needs at least 94 samples (89 parameters after 4 initial samples, plus "
+         "one); got 60 before the held-back part (`holdback` = 0.25), for the "
+         "largest choice of `lags` and `hidden`"),
+    ],
+)  # fmt: skip
+def test_choose_narx_refuses_what_it_cannot_score_in_one_line(data, kwargs, words):
+    from spiralid.sysid import choose_narx
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError) as err:
+            choose_narx(data, **{**SMALL_BOX, **kwargs})
+    message = str(err.value)
+    assert words in message and "\n" not in message, message
+    assert "np.float" not in message
+
+
+def test_choose_narx_with_a_budget_of_one_trains_one_choice(monkeypatch):
+    """budget=1 is one training (and the refit): the search's first point,
+    scored here again from the model it trained by fit_percent."""
+    from spiralid.sysid import choose_narx, fit_percent
+    from spiralid.sysid.estimation import narx_choice
+
+    trained = []
+
+    def recording(data, structure, **options):
+        model = identify(data, structure, **options)
+        trained.append((data.n, structure, options["decay"], model))
+        return model
+
+    monkeypatch.setattr(narx_choice, "identify", recording)
+    data = _narx_record()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = choose_narx(data, **{**SMALL_BOX, "budget": 1})
+    assert res.success and res.nfev == 1 and len(res.trials) == 1
+    assert res.message == "The budget of 1 training was spent."
+    # One training on the first 225 samples, then the refit on all 300.
+    (n_train, st, decay, model), (n_all, refit_st, refit_decay, refit) = trained
+    assert (n_train, n_all) == (225, 300)
+    assert st == refit_st == res.structure and decay == refit_decay == res.decay
+    assert refit is res.model
+    held = fit_percent(data.y[225:], model.simulate(data.u)[225:])
+    assert np.isfinite(held) and res.fit == pytest.approx(held, abs=1e-9)
+    n, h, d = res.trials[0][:3]
+    assert res.trials[0][3] == res.fit and tuple(res.x) == (n, h, d)
+    assert st == NARX(n, n, 1, hidden=(h,)) and res.fun == pytest.approx(100 - res.fit)

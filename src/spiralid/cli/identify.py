@@ -190,10 +190,11 @@ def _run_narx(args) -> int:
 
 def _chosen_by_fit(args, est, val, options, progress):
     """--by-fit POINTS: every candidate structure fitted on the estimation
-    part, and the smallest whose validation fit is within POINTS of the best
-    (choose_order's rule, by number of parameters); the model and the lines that
-    say how it was chosen."""
-    from spiralid.sysid import fits_by_order, identify
+    part and validated, and the smallest (by number of parameters) whose
+    validation fit is within POINTS of the best, the best-fitting of several
+    of that size (choose_order's rule); the model and the lines that say how
+    it was chosen, one per candidate."""
+    from spiralid.sysid import identify, validation_fits
     from spiralid.sysid.validation.selection import lowest_within
 
     structures = _narx_structures(args)
@@ -203,17 +204,18 @@ def _chosen_by_fit(args, est, val, options, progress):
         models.append(identify(est, st, method=args.method, **options))
     # Each candidate validated once: the table below and the choice read
     # the same fits.
-    fits = fits_by_order(models, val, warmup=est)
+    fits = validation_fits(models, val, warmup=est)
     best = models[lowest_within(fits, args.by_fit)]
     lines = [
         f"\nchosen by validation fit (--by-fit {args.by_fit:g}): the smallest "
-        f"candidate within {args.by_fit:g} points of the best; its validation fit "
-        "below is optimistic, as it was chosen on that part"
+        f"candidate within {args.by_fit:g} points of the best (of equal sizes, "
+        "the better fit); its validation fit below is optimistic, as it was "
+        "chosen on that part"
     ]
     lines += [
         f"  {models[i].structure}: {n} parameters, validation fit {fit:.2f} %"
         + ("  <- chosen" if models[i] is best else "")
-        for n, (i, fit) in fits.items()
+        for n, i, fit in fits
     ]
     return best, "\n".join(lines)
 
@@ -646,9 +648,10 @@ def add_parser(sub) -> None:
         type=_nonneg_float,
         default=None,
         metavar="POINTS",
-        help="--model narx or polynomial: fit every --lags and --hidden candidate "
-        "and keep the smallest whose validation fit is within POINTS of the best "
-        "(default: none, one structure)",
+        help="--model narx or polynomial: fit and validate every --lags and "
+        "--hidden candidate, list each, and keep the smallest (fewest parameters; "
+        "of equal sizes, the better fit) whose validation fit is within POINTS of "
+        "the best (default: none, one structure)",
     )
     p.add_argument(
         "--activation",

@@ -54,6 +54,7 @@ from .validation.selection import choose as choose
 from .validation.selection import choose_order as choose_order
 from .validation.selection import fits_by_order as fits_by_order
 from .validation.selection import knee_point as knee_point
+from .validation.selection import validation_fits as validation_fits
 from .validation.stabilisation import StabilisationDiagram as StabilisationDiagram
 from .validation.stabilisation import stabilisation as stabilisation
 from .validation.validate import Realization as Realization
@@ -118,6 +119,7 @@ __all__ = [
     "subspace_denominator",
     "validate",
     "validate_outputs",
+    "validation_fits",
     "whiteness_test",
 ]
 

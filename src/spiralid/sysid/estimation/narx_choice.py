@@ -107,7 +107,7 @@ def _decay_range(value) -> tuple[float, float]:
 
 def _held_back_fit(y: np.ndarray, yhat: np.ndarray) -> float:
     """MATLAB's ``compare`` fit in percent (as ``validate``); -inf for a
-    free run that diverged."""
+    free run that diverged. `y` varies (choose_narx checks it)."""
     if not np.all(np.isfinite(yhat)):
         return -math.inf
     spread = np.linalg.norm(y - y.mean())
@@ -146,14 +146,17 @@ def choose_narx(
         Inclusive range of ``log10`` of the weight decay, searched in steps
         of 0.5.
     budget : int
-        Trainings at most in the search (a point that rounds to a choice
-        already trained costs none), beside the final one.
+        Trainings at most in the search, 1 or more (a point that rounds to a
+        choice already trained costs none), beside the final one. With 1,
+        the choice is the search's first point, uniform in the ranges.
     holdback : float
-        Share of `data` held back to score the candidates, in (0, 0.5].
+        Share of `data` held back to score the candidates, in (0, 0.5]; it
+        must hold at least 2 samples, and the output must vary over them.
     rule : str
         The spiral rule of :func:`spiralid.optim.minimize`.
     n_points : int
-        The search's uniform first points.
+        The search's uniform first points, 2 or more (no more than `budget`
+        are drawn, but never fewer than 2).
     integrator : int
         Integrators of every candidate (``NARX(..., integrator=...)``).
     rng : int, Generator or None
@@ -169,6 +172,15 @@ def choose_narx(
         training, in order), ``nfev`` (trainings, the final one excluded),
         ``n_calls`` (the search's evaluations, repeats included),
         ``elapsed``.
+
+    Raises
+    ------
+    ValueError
+        Before any training, for an argument out of its range, a held-back
+        part of fewer than 2 samples or with a constant output (no fit can
+        be scored on it), or ranges whose largest choice,
+        ``NARX(lags[1], lags[1], nk, hidden=(hidden[1],))``, is too large
+        for the samples before the held-back part.
 
     Examples
     --------
@@ -195,12 +207,37 @@ def choose_narx(
     if not 0.0 < share <= 0.5:
         raise ValueError(f"`holdback` must be a number in (0, 0.5]; got {holdback!r}")
     gen = generator(rng)
-    split = data.n - round(share * data.n)
+    held = round(share * data.n)
+    if held < 2:
+        raise ValueError(
+            f"`holdback` = {share!r} holds back {held} of the {data.n} samples "
+            "of `data`: too few to score a fit (at least 2); raise `holdback` "
+            "or give a longer record"
+        )
+    split = data.n - held
     train = IOData(data.u[:split], data.y[:split], ts=data.ts)
     y_end = data.y[split:]
+    if np.ptp(y_end) == 0.0:
+        raise ValueError(
+            f"the held-back output (the last {held} samples of `data`, "
+            f"`holdback` = {share!r}) is constant, every sample {float(y_end[0])!r}: "
+            "no variance to score a fit against; hold back a part where the "
+            "output moves"
+        )
 
     def structure(n: int, h: int) -> NARX:
         return NARX(n, n, nk, hidden=(h,), integrator=integrator)
+
+    # Any choice in the ranges may be trained: the largest must fit before
+    # the search starts, not fail at whichever point first reaches it.
+    try:
+        structure(lags[1], hidden[1]).check_length(train, "data")
+    except ValueError as e:
+        raise ValueError(
+            f"{e} before the held-back part (`holdback` = {share!r}), for the "
+            "largest choice of `lags` and `hidden`: narrow them, lower "
+            "`holdback` or give a longer record"
+        ) from None
 
     trials: dict[tuple, float] = {}
     calls = [0]
@@ -235,13 +272,16 @@ def choose_narx(
             cost,
             box,
             method=rule,
-            n_points=min(n_points, budget),
+            # At least 2, as the search needs; a first point beyond the
+            # budget ends the search (budget=1 trains the first point only).
+            n_points=max(2, min(n_points, budget)),
             max_nfev=50 * budget + n_points,
             rng=gen,
             restarts=True,
         )
     except _BudgetSpent:
-        message = f"The budget of {budget} trainings was spent."
+        trainings = "training" if budget == 1 else "trainings"
+        message = f"The budget of {budget} {trainings} was spent."
     (n, h, d), fit = max(trials.items(), key=lambda kv: kv[1])
     model = identify(data, structure(n, h), method="oe", decay=10.0**d, rng=gen)
     return OptimiserResult(

@@ -14,7 +14,7 @@ its model:
 - :func:`choose_order`: the lowest order that validates within a tolerance
   of the best order on a held-out record; it also chooses among fitted
   models of any structure (NARX lags and hidden sizes), by their number of
-  parameters.
+  parameters, every model validated (several may share a size).
 
 The knee is a property of the front's shape and need not sit at the order
 where a model stops improving on data it was not fitted to
@@ -39,7 +39,14 @@ from ..estimation.pareto import ParetoIdentification
 from ..models.fitted import FittedModel
 from .validate import validate
 
-__all__ = ["choose", "choose_order", "fits_by_order", "knee_point", "lowest_within"]
+__all__ = [
+    "choose",
+    "choose_order",
+    "fits_by_order",
+    "knee_point",
+    "lowest_within",
+    "validation_fits",
+]
 
 
 def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int:
@@ -88,13 +95,18 @@ def choose(front: ParetoIdentification, minimise: str = "cost", **limits) -> int
     return int(np.argmin(column))
 
 
+def _is_front(front) -> bool:
+    """A front is anything with models and their objectives (the front's
+    own type, or one built by hand); anything else should be a list of
+    fitted models."""
+    return hasattr(front, "models") and hasattr(front, "objectives")
+
+
 def _candidates(front) -> tuple[list, np.ndarray, list[int]]:
     """The models, their estimation costs and their sizes: a Pareto front's
     (size ``na + nb``, cost its first objective), or a sequence of fitted
     models of any structure (size the number of parameters)."""
-    # A front is anything with models and their objectives (the front's
-    # own type, or one built by hand).
-    if hasattr(front, "models") and hasattr(front, "objectives"):
+    if _is_front(front):
         if not front.models:
             raise ValueError("`front` must be a non-empty ParetoIdentification")
         sizes = [m.arx.na + m.arx.nb for m in front.models]
@@ -108,8 +120,9 @@ def _candidates(front) -> tuple[list, np.ndarray, list[int]]:
     return models, np.array([m.cost for m in models]), [m.params.size for m in models]
 
 
-def fits_by_order(front, data, *, warmup=None) -> dict[int, tuple[int, float]]:
-    """Each order's lowest-cost model and its validation fit.
+def validation_fits(front, data, *, warmup=None) -> list[tuple[int, int, float]]:
+    """Every candidate's size and validation fit: what :func:`choose_order`
+    chooses among.
 
     Parameters
     ----------
@@ -125,20 +138,69 @@ def fits_by_order(front, data, *, warmup=None) -> dict[int, tuple[int, float]]:
 
     Returns
     -------
-    dict
-        ``{order: (index into the models, fit %)}``, by increasing order:
-        ``na + nb`` on a front (where "lowest cost" is its first
-        objective), the number of parameters for a list (lowest
-        estimation cost among models of equal size).
+    list of (int, int, float)
+        ``(size, index into the models, fit %)``, by increasing size, then
+        index. On a front the candidates are each order's lowest-cost model
+        (size ``na + nb``, cost its first objective: the front's other
+        models of that order trade cost for its other objectives); in a
+        list every model is one (size: its number of parameters), however
+        many share a size.
     """
     models, cost, sizes = _candidates(front)
-    best: dict[int, int] = {}
-    for i, order in enumerate(sizes):
-        if order not in best or cost[i] < cost[best[order]]:
-            best[order] = i
+    if _is_front(front):
+        best: dict[int, int] = {}
+        for i, order in enumerate(sizes):
+            if order not in best or cost[i] < cost[best[order]]:
+                best[order] = i
+        picked = sorted((order, i) for order, i in best.items())
+    else:
+        picked = sorted((size, i) for i, size in enumerate(sizes))
+    return [
+        (size, i, validate(models[i], data, warmup=warmup).fit_percent)
+        for size, i in picked
+    ]
+
+
+def fits_by_order(front, data, *, warmup=None) -> dict[int, tuple[int, float]]:
+    """Each order's candidate and its validation fit, keyed by order.
+
+    Parameters
+    ----------
+    front : ParetoIdentification or list of FittedModel
+        As in :func:`validation_fits`; a list whose models all differ in
+        size (the number of parameters), as one size keys one fit.
+    data : IOData
+        A record the models were not estimated on (the validation third).
+    warmup : IOData, optional
+        The record before `data` (the estimation part), run first so the
+        models start from its end, as :func:`validate` does.
+
+    Returns
+    -------
+    dict
+        ``{order: (index into the models, fit %)}``, by increasing order:
+        ``na + nb`` on a front (its lowest-cost model of that order), the
+        number of parameters for a list.
+
+    Raises
+    ------
+    ValueError
+        For a list with two models of one size: a dict keyed by size would
+        drop all but one, unvalidated. :func:`validation_fits` lists every
+        model.
+    """
+    if not _is_front(front):
+        _, _, sizes = _candidates(front)
+        for size in sorted(set(sizes)):
+            shared = [i for i, s in enumerate(sizes) if s == size]
+            if len(shared) > 1:
+                raise ValueError(
+                    f"`front` holds {len(shared)} models of {size} parameters "
+                    f"(at {', '.join(map(str, shared))}): fits_by_order keys "
+                    "one fit per size; validation_fits gives every model's"
+                )
     return {
-        order: (i, validate(models[i], data, warmup=warmup).fit_percent)
-        for order, i in sorted(best.items())
+        size: (i, fit) for size, i, fit in validation_fits(front, data, warmup=warmup)
     }
 
 
@@ -149,9 +211,11 @@ def choose_order(front, data, *, warmup=None, tolerance: float = 1.0) -> int:
     Parameters
     ----------
     front : ParetoIdentification or list of FittedModel
-        From :func:`~spiralid.sysid.identify_pareto` (orders ``na + nb``),
-        or fitted models of any structures, e.g. NARX models of several
-        lags and hidden sizes (order: the number of parameters).
+        From :func:`~spiralid.sysid.identify_pareto` (orders ``na + nb``,
+        each order's lowest-cost model validated), or fitted models of any
+        structures, e.g. NARX models of several lags and hidden sizes
+        (order: the number of parameters; every model validated, and of
+        several of the chosen size, the best-fitting taken).
     data : IOData
         A record the models were not estimated on. The chosen model's fit on
         that same record is then optimistic (it was chosen on it); validate
@@ -186,26 +250,49 @@ def choose_order(front, data, *, warmup=None, tolerance: float = 1.0) -> int:
     True
     """
     tolerance = nonneg(tolerance, "tolerance")
-    return lowest_within(fits_by_order(front, data, warmup=warmup), tolerance)
+    return lowest_within(validation_fits(front, data, warmup=warmup), tolerance)
 
 
-def lowest_within(fits: dict[int, tuple[int, float]], tolerance: float) -> int:
+def lowest_within(fits, tolerance: float) -> int:
     """:func:`choose_order`'s rule on fits already computed: the index of
-    the lowest order whose fit is within `tolerance` points of the best.
+    the smallest candidate whose fit is within `tolerance` points of the
+    best, and of candidates of that size, the best-fitting.
 
     Parameters
     ----------
-    fits : dict
-        :func:`fits_by_order`'s ``{order: (index, fit %)}``, by increasing
-        order.
+    fits : list of (int, int, float) or dict
+        :func:`validation_fits`'s ``(size, index, fit %)`` for every
+        candidate, or :func:`fits_by_order`'s ``{order: (index, fit %)}``.
     tolerance : float
-        Percentage points of fit a lower order may lose to the best.
+        Percentage points of fit a smaller candidate may lose to the best.
 
     Returns
     -------
     int
-        The chosen model's index.
+        The chosen model's index (ties: the first listed).
+
+    Examples
+    --------
+    Sizes 10, 10 and 20: the second model is within 1 point of the best and
+    fits better than the first of its size.
+
+    >>> lowest_within([(10, 0, 80.0), (10, 1, 89.5), (20, 2, 90.0)], 1.0)
+    1
+    >>> lowest_within([(10, 0, 80.0), (10, 1, 89.5), (20, 2, 90.0)], 0.0)
+    2
     """
     tolerance = nonneg(tolerance, "tolerance")
-    top = np.nanmax([fit for _, fit in fits.values()])
-    return next(i for i, fit in fits.values() if fit >= top - tolerance)
+    if isinstance(fits, dict):
+        fits = [(size, i, fit) for size, (i, fit) in fits.items()]
+    fits = list(fits)
+    scored = [(size, i, fit) for size, i, fit in fits if not np.isnan(fit)]
+    if not scored:
+        raise ValueError(
+            "`fits` must hold at least one candidate whose fit is a number; "
+            f"got {len(fits)} candidate(s), none"
+        )
+    top = max(fit for _, _, fit in scored)
+    within = [c for c in scored if c[2] >= top - tolerance]
+    size = min(c[0] for c in within)
+    # max keeps the first of equal fits.
+    return max((c for c in within if c[0] == size), key=lambda c: c[2])[1]
