@@ -139,6 +139,19 @@ def test_the_default_rule_is_the_learned_metric_poll():
     assert paper.nit == 19 and default.nit == 9  # 1 and 2 points per subproblem
 
 
+def test_the_budget_allows_the_initial_population_and_one_iteration():
+    # A spiral rule evaluates a point per subproblem and iteration, the
+    # learned-metric poll two: two populations, or three.
+    kw = dict(n_points=10, rng=0, vectorized=True)
+    assert minimize_pareto(_zdt1, [(0, 1)] * 2, "ebsda", max_nfev=20, **kw).nit == 1
+    assert minimize_pareto(_zdt1, [(0, 1)] * 2, max_nfev=30, **kw).nit == 1
+    with pytest.raises(ValueError, match=r"`max_nfev` must be an integer >= 30; "
+                       r"got 29"):  # fmt: skip
+        minimize_pareto(_zdt1, [(0, 1)] * 2, max_nfev=29, **kw)
+    with pytest.raises(ValueError, match=r"`max_nfev` must be an integer >= 20"):
+        minimize_pareto(_zdt1, [(0, 1)] * 2, "sda", max_nfev=19, **kw)
+
+
 def test_step_rate_rules_are_refused():
     with pytest.raises(ValueError, match="`method` must be one of sda, ebsda"):
         minimize_pareto(_zdt1, [(0, 1)] * 2, "periodic", n_points=10, max_nfev=40)

@@ -309,7 +309,9 @@ def minimize_pareto(
         point each), as :func:`~spiralid.sysid.identify_pareto`'s 50 points
         make with its 5,000 evaluations.
     max_nfev : int
-        Budget of objective evaluations (at least two populations).
+        Budget of objective evaluations: at least the initial population
+        and one iteration, two populations (three for
+        ``"learned-metric"``, which evaluates two points per subproblem).
     archive : bool
         Keep every evaluated non-dominated point and return that archive
         thinned to at most `n_points` evenly spread points (SPEA2's
@@ -385,7 +387,10 @@ def minimize_pareto(
     lo, hi = box_bounds(bounds)
     rule = _parse_rule(method)
     m = integer(n_points, "n_points", 4)
-    max_nfev = integer(max_nfev, "max_nfev", 2 * m)
+    # The initial population and one iteration: a point per subproblem, or
+    # the poll's two.
+    per_point = 2 if isinstance(rule, LearnedMetricSpiral) else 1
+    max_nfev = integer(max_nfev, "max_nfev", (1 + per_point) * m)
     max_time = check_max_time(opts["max_time"])
     neighbours = integer(opts["neighbours"], "neighbours", 2)
     if not isinstance(archive, bool):
