@@ -318,7 +318,8 @@ def identify_pareto(
         :func:`~spiralid.sysid.estimation.frequency.h1_estimate`). The
         defaults differ from ``minimize_pareto``'s 100 points and 10,000
         evaluations because every order is a search of its own: half of
-        each gives the same 100 iterations.
+        each gives the same number of iterations (49 of the default rule,
+        99 of a spiral rule).
 
     Returns
     -------
