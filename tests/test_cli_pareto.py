@@ -40,6 +40,18 @@ def test_the_front_and_its_models_are_written(written):
     assert (out / "front.png").stat().st_size > 10_000
 
 
+def test_the_method_default_is_identify_paretos(written):
+    from spiralid.choices import DEFAULT_PARETO_METHOD, PARETO_METHOD_NAMES
+    from spiralid.cli import build_parser
+
+    cmd = build_parser()._subparsers._group_actions[0].choices["pareto"]
+    method = next(a for a in cmd._actions if a.dest == "method")
+    assert method.default is DEFAULT_PARETO_METHOD
+    assert list(method.choices) == list(PARETO_METHOD_NAMES)
+    _, proc = written
+    assert f"by {DEFAULT_PARETO_METHOD} on robot_arm" in proc.stdout
+
+
 def test_the_knee_is_validated_as_identify_writes_it(written):
     out, _ = written
     knee = next(

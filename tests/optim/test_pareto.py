@@ -117,6 +117,41 @@ def test_a_bad_objective_is_a_clear_error(fun, match):
                         vectorized=True)  # fmt: skip
 
 
+def test_the_default_rule_is_the_learned_metric_poll():
+    # One named default (spiralid.choices) for minimize_pareto and
+    # identify_pareto; the paper's Eb-SDA stays available by name.
+    import inspect
+
+    from spiralid.choices import DEFAULT_PARETO_METHOD
+    from spiralid.optim import pareto
+    from spiralid.sysid import identify_pareto
+
+    assert DEFAULT_PARETO_METHOD == pareto.DEFAULT_PARETO_METHOD == "learned-metric"
+    for fun in (minimize_pareto, identify_pareto):
+        default = inspect.signature(fun).parameters["method"].default
+        assert default is DEFAULT_PARETO_METHOD
+    kw = dict(n_points=10, max_nfev=200, rng=0, vectorized=True)
+    default = minimize_pareto(_zdt1, [(0, 1)] * 3, **kw)
+    learned = minimize_pareto(_zdt1, [(0, 1)] * 3, "learned-metric", **kw)
+    np.testing.assert_array_equal(default.x, learned.x)
+    np.testing.assert_array_equal(default.history, learned.history)
+    paper = minimize_pareto(_zdt1, [(0, 1)] * 3, "ebsda", **kw)
+    assert paper.nit == 19 and default.nit == 9  # 1 and 2 points per subproblem
+
+
+def test_the_budget_allows_the_initial_population_and_one_iteration():
+    # A spiral rule evaluates a point per subproblem and iteration, the
+    # learned-metric poll two: two populations, or three.
+    kw = dict(n_points=10, rng=0, vectorized=True)
+    assert minimize_pareto(_zdt1, [(0, 1)] * 2, "ebsda", max_nfev=20, **kw).nit == 1
+    assert minimize_pareto(_zdt1, [(0, 1)] * 2, max_nfev=30, **kw).nit == 1
+    with pytest.raises(ValueError, match=r"`max_nfev` must be an integer >= 30; "
+                       r"got 29"):  # fmt: skip
+        minimize_pareto(_zdt1, [(0, 1)] * 2, max_nfev=29, **kw)
+    with pytest.raises(ValueError, match=r"`max_nfev` must be an integer >= 20"):
+        minimize_pareto(_zdt1, [(0, 1)] * 2, "sda", max_nfev=19, **kw)
+
+
 def test_step_rate_rules_are_refused():
     with pytest.raises(ValueError, match="`method` must be one of sda, ebsda"):
         minimize_pareto(_zdt1, [(0, 1)] * 2, "periodic", n_points=10, max_nfev=40)
@@ -139,8 +174,9 @@ def _later(bad):
     "bad, match",
     [
         (lambda f: np.where(f > 0.5, np.nan, f), "non-finite objective"),
-        (lambda f: np.column_stack([f, f[:, :1]]), r"must return \(10, 2\)"),
-        (lambda f: f[:, :1], r"must return \(10, 2\)"),
+        # The default poll's iteration: two points for each of 10 subproblems.
+        (lambda f: np.column_stack([f, f[:, :1]]), r"must return \(20, 2\)"),
+        (lambda f: f[:, :1], r"must return \(20, 2\)"),
     ],
 )
 def test_an_objective_that_turns_bad_later_is_a_clear_error(bad, match):

@@ -257,7 +257,12 @@ def _headline(args, front, chosen: int, why: str) -> str:
 
 
 def add_parser(sub) -> None:
-    from spiralid.choices import OBJECTIVES, PARAMETRIZATION_NAMES, PARETO_METHOD_NAMES
+    from spiralid.choices import (
+        DEFAULT_PARETO_METHOD,
+        OBJECTIVES,
+        PARAMETRIZATION_NAMES,
+        PARETO_METHOD_NAMES,
+    )
 
     p = sub.add_parser(
         "pareto",
@@ -294,8 +299,8 @@ def add_parser(sub) -> None:
         "--method",
         type=str.lower,
         choices=PARETO_METHOD_NAMES,
-        default="ebsda",
-        help="spiral rule of the search",
+        default=DEFAULT_PARETO_METHOD,
+        help="spiral rule of the search (ebsda: the paper's Eb-SDA)",
     )
     p.add_argument(
         "--parametrization",

@@ -35,7 +35,10 @@ history is exact for 2 and 3 objectives and a Monte-Carlo estimate with
 its standard error beyond (``history_kind``, ``history_stderr``).
 
 The paper's rule constants are kept (``method="sda"``: ``r = 0.95``,
-``theta = pi/4``; ``"ebsda"``: eq. (4), (7), (8)).
+``theta = pi/4``; ``"ebsda"``: eq. (4), (7), (8)). The default rule is the
+learned-metric poll (:data:`DEFAULT_PARETO_METHOD`), the strongest of them
+on the benchmark problems (docs/results/multiobjective.md); the paper's
+Eb-SDA is ``method="ebsda"``.
 """
 
 from __future__ import annotations
@@ -46,7 +49,11 @@ from collections.abc import Callable
 import numpy as np
 
 from spiralid._checks import box_bounds, generator, integer
-from spiralid.choices import PARETO_METHOD_NAMES, require_names
+from spiralid.choices import (
+    DEFAULT_PARETO_METHOD,
+    PARETO_METHOD_NAMES,
+    require_names,
+)
 from spiralid.optim._decomposition import (
     Archive,
     PollMoves,
@@ -78,6 +85,7 @@ from spiralid.optim.rules import SpiralRule
 from spiralid.optim.spiral import RULES, _parse_method
 
 __all__ = [
+    "DEFAULT_PARETO_METHOD",
     "PARETO_METHODS",
     "PARETO_OPTIONS",
     "HypervolumeEstimate",
@@ -251,7 +259,7 @@ _MOVED = moved_into_options("minimize_pareto", PARETO_OPTIONS)
 def minimize_pareto(
     fun: Callable,
     bounds,
-    method="ebsda",
+    method=DEFAULT_PARETO_METHOD,
     *,
     n_points: int = 100,
     max_nfev: int = 10_000,
@@ -279,15 +287,15 @@ def minimize_pareto(
     bounds : sequence of (low, high), (n, 2) array or scipy.optimize.Bounds
         The search box; points are kept inside it.
     method : str, SpiralRule or LearnedMetricSpiral
-        ``"ebsda"``, ``"sda"``, ``"lasda"`` or ``"ebsda-scaled"``: the
-        spiral rule (see :func:`spiralid.optim.minimize`), with the paper's
-        constants; ``"learned-metric"`` polls a pair of directions
-        per subproblem with a step per direction from success, half the
-        subproblems a crossover pair instead at each iteration (its
-        ``basis``, ``grow``, ``shrink`` and ``crossover`` options apply;
-        ``populations``,
-        ``model_step`` and ``success_steps`` belong to the single-objective
-        search, and a rule that turns one off is refused).
+        ``"learned-metric"`` (the default, :data:`DEFAULT_PARETO_METHOD`)
+        polls a pair of directions per subproblem with a step per direction
+        from success, half the subproblems a crossover pair instead at each
+        iteration (its ``basis``, ``grow``, ``shrink`` and ``crossover``
+        options apply; ``populations``, ``model_step`` and
+        ``success_steps`` belong to the single-objective search, and a rule
+        that turns one off is refused). ``"ebsda"`` (the paper's rule),
+        ``"sda"``, ``"lasda"`` or ``"ebsda-scaled"``: the spiral rule (see
+        :func:`spiralid.optim.minimize`), with the paper's constants.
     n_points : int
         Population size: one subproblem each (for 3 or more objectives the
         weight lattice of :func:`~spiralid.optim.front.weight_vectors` that
@@ -296,11 +304,14 @@ def minimize_pareto(
         Default 100, twice :func:`~spiralid.optim.minimize`'s 50, because
         it is also the front's resolution: 100 is MOEA/D's population for
         two objectives (Zhang and Li 2007) and gives 91 subproblems for
-        three. With the default budget that is 100 iterations, as
-        :func:`~spiralid.sysid.identify_pareto`'s 50 points make with its
-        5,000 evaluations.
+        three. With the default budget that is 49 iterations of the default
+        rule (two points per subproblem each; 99 of a spiral rule, one
+        point each), as :func:`~spiralid.sysid.identify_pareto`'s 50 points
+        make with its 5,000 evaluations.
     max_nfev : int
-        Budget of objective evaluations (at least two populations).
+        Budget of objective evaluations: at least the initial population
+        and one iteration, two populations (three for
+        ``"learned-metric"``, which evaluates two points per subproblem).
     archive : bool
         Keep every evaluated non-dominated point and return that archive
         thinned to at most `n_points` evenly spread points (SPEA2's
@@ -376,7 +387,10 @@ def minimize_pareto(
     lo, hi = box_bounds(bounds)
     rule = _parse_rule(method)
     m = integer(n_points, "n_points", 4)
-    max_nfev = integer(max_nfev, "max_nfev", 2 * m)
+    # The initial population and one iteration: a point per subproblem, or
+    # the poll's two.
+    per_point = 2 if isinstance(rule, LearnedMetricSpiral) else 1
+    max_nfev = integer(max_nfev, "max_nfev", (1 + per_point) * m)
     max_time = check_max_time(opts["max_time"])
     neighbours = integer(opts["neighbours"], "neighbours", 2)
     if not isinstance(archive, bool):

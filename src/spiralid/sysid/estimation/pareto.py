@@ -64,7 +64,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from spiralid._checks import generator, integer
-from spiralid.choices import OBJECTIVES
+from spiralid.choices import DEFAULT_PARETO_METHOD, OBJECTIVES
 from spiralid.optim.front import knee_point
 from spiralid.optim.pareto import non_dominated
 
@@ -259,7 +259,7 @@ def identify_pareto(
     data: IOData,
     orders,
     objectives=("cost", "frequency"),
-    method: str = "ebsda",
+    method: str = DEFAULT_PARETO_METHOD,
     *,
     rng=None,
     nk: int | None = None,
@@ -286,9 +286,11 @@ def identify_pareto(
         (several add the ``"order"`` objective).
     objectives : sequence of str, default ("cost", "frequency")
         Names from :data:`OBJECTIVES` (see the module docstring).
-    method : str or rule
-        A name of :data:`~spiralid.optim.pareto.PARETO_METHODS` (``"ebsda"``,
-        ``"sda"``, ``"learned-metric"``, ...) or a rule object, as
+    method : str or rule, default "learned-metric"
+        A name of :data:`~spiralid.optim.pareto.PARETO_METHODS`
+        (``"learned-metric"``, the default,
+        :data:`~spiralid.optim.pareto.DEFAULT_PARETO_METHOD`; ``"ebsda"``,
+        the paper's rule; ``"sda"``, ...) or a rule object, as
         :func:`~spiralid.optim.pareto.minimize_pareto` takes.
     rng : None, int or numpy.random.Generator
         Seed of the searches (one generator, orders in the given order).
@@ -324,7 +326,8 @@ def identify_pareto(
         :func:`~spiralid.sysid.estimation.frequency.h1_estimate`). The
         defaults differ from ``minimize_pareto``'s 100 points and 10,000
         evaluations because every order is a search of its own: half of
-        each gives the same 100 iterations.
+        each gives the same number of iterations (49 of the default rule,
+        99 of a spiral rule).
 
     Returns
     -------

@@ -52,8 +52,9 @@ def _search_defaults() -> dict:
     }
     defaults.update((k, v) for k, v in PARETO_OPTIONS.items() if k not in own)
     # Per order, half minimize_pareto's 100 points and 10,000 evaluations:
-    # the same 100 iterations per search, and every order is a search of its
-    # own (with its seeds' output-error fits and its polishes besides).
+    # the same iterations per search (49 of the default rule, 99 of a spiral
+    # rule), and every order is a search of its own (with its seeds'
+    # output-error fits and its polishes besides).
     defaults.update(n_points=50, max_nfev=5_000)
     return defaults
 
