@@ -168,6 +168,71 @@ def _cancel(
     )
 
 
+def _act_on_modes(
+    problem: Problem,
+    result: EstimatorResult,
+    max_nfev: int | None = None,
+) -> None:
+    """Remove the poles the modes table flags (an interval that reaches
+    ``|z| = 1``, a cancelling zero) where the likelihood-ratio test allows
+    (:func:`~spiralid.sysid.estimation.spurious.remove_flagged`), after the
+    cancellation: each reduced model is polished by output error from the
+    deflated one, with the same margin; `max_nfev` caps each polish.
+    ``result.diagnosis`` says what was removed and what was kept."""
+    from .cancellation import effective, pad
+    from .spurious import remove_flagged
+
+    arx = problem.arx
+    cap = {} if max_nfev is None else {"max_nfev": max_nfev}
+    order = result.get("effective_order") or (arx.na, arx.nb)
+    theta_r, arx_r = effective(result.x, arx, order)
+
+    def polish(start, reduced):
+        theta, _ = local_polish(
+            start,
+            reduced,
+            problem.data,
+            "simulation",
+            problem.initial,
+            max_radius=problem.max_radius,
+            **cap,
+        )
+        return theta
+
+    def cost(theta):
+        # Padded to the estimated structure: the paper's cost of the model.
+        return float(problem.cost(pad(theta, arx_r, arx)))
+
+    def error(theta):
+        return problem.data.y - arx_r.simulate(theta, problem.data.u)
+
+    theta, reduced, diagnosis = remove_flagged(
+        theta_r, arx_r, problem.data, problem.initial, cost, polish, error
+    )
+    result.diagnosis = diagnosis
+    if not diagnosis.removed:
+        return
+    if result.get("x_full") is None:
+        result.x_full, result.fun_full = result.x, result.fun
+    # `theta` is padded to the effective structure it started from; the
+    # model's layout is the structure asked for.
+    theta_red, _ = effective(theta, arx_r, (reduced.na, reduced.nb))
+    result.x = pad(theta_red, reduced, arx)
+    result.fun = float(problem.cost(result.x))
+    removed = [
+        {k: v for k, v in r.items() if k != "reasons"}
+        | {"reason": "; ".join(r["reasons"])}
+        for r in diagnosis.removed
+    ]
+    result.cancelled = [*(result.get("cancelled") or []), *removed]
+    k = sum(c["order"] for c in result.cancelled)
+    result.effective_order = (arx.na - k, arx.nb - k)
+    result.message = (
+        f"{result.message} Then {len(removed)} pole(s) the modes table flags "
+        f"removed: effective order {reduced}."
+    )
+
+
 def _refine(
     problem: Problem,
     result: EstimatorResult,
