@@ -155,3 +155,20 @@ def test_the_default_reports_its_effective_order_and_the_note_survives_a_file():
     # Without the cancellation nothing acts on the table.
     off = identify(est, ARX(8, 8, 0), rng=2, cancel=False)
     assert off.diagnosis is None and off.effective_order == (8, 8)
+
+
+def test_an_explicit_margin_holds_every_refitted_pole_and_is_never_lifted():
+    # The removals are refitted with the same margin: a time constant the
+    # user gave bounds every pole of the returned model, as before.
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parents[2] / "benchmarks" / "drift_process.py"
+    spec = importlib.util.spec_from_file_location("drift_process", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    est, _ = module.record(2).split(2 / 3)
+    seconds = est.n * est.ts / 2
+    fit = identify(est, ARX(8, 8, 0), rng=2, max_time_constant=seconds)
+    assert fit.margin is None
+    assert fit.max_pole_radius <= np.exp(-est.ts / seconds) + 1e-12
