@@ -483,7 +483,7 @@ def _packaged(
 def _diagnosis(res) -> dict | None:
     """What acting on the modes table did, when it found a flagged pole."""
     found = res.get("diagnosis")
-    if found is None or not (found.removed or found.kept):
+    if found is None or not (found.removed or found.kept or found.untried):
         return None
     return found.to_dict()
 

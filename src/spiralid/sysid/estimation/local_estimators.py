@@ -183,12 +183,20 @@ def _act_on_modes(
     from .spurious import remove_flagged
 
     arx = problem.arx
-    cap = {} if max_nfev is None else {"max_nfev": max_nfev}
     order = result.get("effective_order") or (arx.na, arx.nb)
     theta_r, arx_r = effective(result.x, arx, order)
+    # With `max_nfev` (output error's pace) the polishes share a budget of
+    # twice that cap, so that a model with many flagged poles adds a
+    # bounded share of output error's time; the poles left untried when it
+    # is spent stay flagged, and the diagnosis says so.
+    budget = [None if max_nfev is None else 2 * int(max_nfev)]
 
     def polish(start, reduced):
-        theta, _ = local_polish(
+        left = budget[0]
+        if left is not None and left < 5:
+            return None
+        cap = {} if left is None else {"max_nfev": min(int(max_nfev), left)}
+        theta, res = local_polish(
             start,
             reduced,
             problem.data,
@@ -197,6 +205,8 @@ def _act_on_modes(
             max_radius=problem.max_radius,
             **cap,
         )
+        if left is not None:
+            budget[0] = left - int(res.nfev)
         return theta
 
     def cost(theta):

@@ -96,12 +96,14 @@ class Diagnosis:
     """What acting on the diagnosis did (``IdentifiedModel.diagnosis``):
     the poles removed and the flagged poles kept, with the test's
     tolerance, the effective samples it used and the cost each kept pole's
-    removal would have taken."""
+    removal would have taken; ``untried`` counts the flagged poles left
+    when the polishes' budget was spent."""
 
     n_samples: int
     n_effective: float
     removed: list[dict] = field(default_factory=list)
     kept: list[dict] = field(default_factory=list)
+    untried: int = 0
 
     def to_dict(self) -> dict:
         return {
@@ -109,6 +111,7 @@ class Diagnosis:
             "n_effective": float(self.n_effective),
             "removed": [dict(r) for r in self.removed],
             "kept": [dict(k) for k in self.kept],
+            "untried": int(self.untried),
             "note": self.sentence(),
         }
 
@@ -133,6 +136,11 @@ class Diagnosis:
                 f"the tolerance {100 * k['tolerance']:.3g} % (likelihood-ratio "
                 f"test at {100 * LEVEL:g} %, {self.n_effective:.0f} effective "
                 "samples): the record holds evidence for it"
+            )
+        if self.untried:
+            parts.append(
+                f"{self.untried} flagged pole(s) left untried: the removal's "
+                "evaluation budget (tied to output error's work) was spent"
             )
         return "; ".join(parts)
 
@@ -282,7 +290,8 @@ def remove_flagged(
     cost : callable
         The estimation cost of a theta in `arx`'s layout.
     polish : callable
-        ``polish(start, reduced) -> theta`` at the reduced structure.
+        ``polish(start, reduced) -> theta`` at the reduced structure, or
+        None when its budget is spent (that pole is then left untried).
     error : callable
         The simulation error of a theta in `arx`'s layout (its effective
         samples set the test's tolerance).
@@ -311,7 +320,7 @@ def remove_flagged(
         # Every flag of the current model is tried, slowest first; the
         # first removal the test allows starts the next pass at the reduced
         # order. A pass without one ends: its refusals are what was kept.
-        kept, acted = [], False
+        kept, acted, untried = [], False, 0
         for flag in flagged_poles(current, structure, data, initial):
             zero = _partner(flag, current[structure.na :])
             if zero is None:
@@ -320,7 +329,12 @@ def remove_flagged(
             start, reduced = deflate(current, structure, candidate)
             if reduced.nb < 1 or not np.all(np.isfinite(start)):
                 continue
-            polished = np.asarray(polish(start, reduced), dtype=float)
+            polished = polish(start, reduced)
+            if polished is None:
+                # The polishes' budget is spent: this pole stays untried.
+                untried += 1
+                continue
+            polished = np.asarray(polished, dtype=float)
             value = float(cost(pad(polished, reduced, arx)))
             rise = value / base - 1.0
             allowed = tolerance(fixed + 2 * flag.size, n_eff, level)
@@ -333,7 +347,7 @@ def remove_flagged(
                 break
             kept.append(entry)
         if not acted:
-            diagnosis.kept = kept
+            diagnosis.kept, diagnosis.untried = kept, untried
             break
     if not diagnosis.removed:
         return theta, arx, diagnosis
