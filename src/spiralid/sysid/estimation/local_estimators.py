@@ -185,11 +185,12 @@ def _act_on_modes(
     arx = problem.arx
     order = result.get("effective_order") or (arx.na, arx.nb)
     theta_r, arx_r = effective(result.x, arx, order)
-    # With `max_nfev` (output error's pace) the polishes share a budget of
-    # twice that cap, so that a model with many flagged poles adds a
-    # bounded share of output error's time; the poles left untried when it
-    # is spent stay flagged, and the diagnosis says so.
-    budget = [None if max_nfev is None else 2 * int(max_nfev)]
+    # With `max_nfev` (output error's pace: one cancellation polish's cap)
+    # the polishes share that cap, so that a model with many flagged poles
+    # adds a bounded share of output error's time (twice the cap took the
+    # rig's ARX(16, 16, 0) to 2x output error's processor time); the poles
+    # left untried when it is spent stay flagged, and the diagnosis says so.
+    budget = [None if max_nfev is None else int(max_nfev)]
 
     def polish(start, reduced):
         left = budget[0]
