@@ -233,7 +233,9 @@ def flagged_poles(theta, arx: ARX, data: IOData, initial: str) -> list[Flagged]:
     cov_a = cov[:na, :na]
     root_a = None if root is None else root[:, :na]
     b = np.r_[np.zeros(arx.nk), theta[na:]]
-    table = mode_table(theta[:na], b, data.ts, covariance=cov_a, factor=root_a)
+    table = mode_table(
+        theta[:na], b, data.ts, covariance=cov_a, factor=root_a, shares=False
+    )
     out = []
     for i in range(len(table)):
         reasons = tuple(
