@@ -197,6 +197,11 @@ def identify(
         (:mod:`~spiralid.sysid.estimation.cancellation`). The model keeps
         the structure asked for, with zero coefficients where the pair was;
         ``effective_order`` and ``cancellations`` say what was removed.
+        After ``"spiral"`` it then removes each pole its modes table flags
+        (an interval that reaches ``|z| = 1``, a cancelling zero) with its
+        nearest zero where a likelihood-ratio test at 5 % allows
+        (:mod:`~spiralid.sysid.estimation.spurious`; ``model.diagnosis``
+        says what was removed and what was kept, and why).
         Refused by the other methods.
     **options
         The method's own options (:func:`identify_options` lists them per
