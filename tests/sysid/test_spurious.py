@@ -172,3 +172,26 @@ def test_an_explicit_margin_holds_every_refitted_pole_and_is_never_lifted():
     fit = identify(est, ARX(8, 8, 0), rng=2, max_time_constant=seconds)
     assert fit.margin is None
     assert fit.max_pole_radius <= np.exp(-est.ts / seconds) + 1e-12
+
+
+def test_a_flagged_complex_pair_is_removed_with_its_zero_pair():
+    # The plant times a lightly damped pair at 20 Hz that a zero pair just
+    # beside it cancels: the pair carries nothing the record can see.
+    data = _record(3)
+    p = 0.9995 * np.exp(2j * np.pi * 20.0 * data.ts)
+    z = 0.9990 * np.exp(2j * np.pi * 20.05 * data.ts)
+    a = np.polymul(np.r_[1.0, A_TRUE], np.poly([p, np.conj(p)]).real)[1:]
+    b = np.polymul(B_TRUE[1:], np.poly([z, np.conj(z)]).real)
+    arx = ARX(4, 4, 1)
+    theta = np.r_[a, b]
+    flags = flagged_poles(theta, arx, data, "rest")
+    assert any(f.size == 2 and abs(f.pole - p) < 1e-9 for f in flags)
+    cost, polish, error = _tools(data, arx)
+    out, reduced, diagnosis = remove_flagged(
+        theta, arx, data, "rest", cost, polish, error
+    )
+    assert reduced == ARX(2, 2, 1)
+    assert [r["order"] for r in diagnosis.removed] == [2]
+    np.testing.assert_allclose(out[:2], A_TRUE, atol=0.01)
+    np.testing.assert_allclose(out[4:6], B_TRUE[1:], atol=0.02)
+    assert out[[2, 3, 6, 7]].tolist() == [0.0, 0.0, 0.0, 0.0]
