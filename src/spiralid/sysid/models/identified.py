@@ -111,7 +111,10 @@ class IdentifiedModel(FittedModel):
         pair), its ``order`` (1 real, 2 a complex pair), their
         ``distance``, the ``tolerance`` and the ``cost_increase`` (a share
         of the cost). The removed coefficients are zeros at the end of
-        ``a`` and ``b``; :attr:`effective_order` is what is left.
+        ``a`` and ``b``; :attr:`effective_order` is what is left. A pole
+        removed because the modes table flagged it (:attr:`diagnosis`) has
+        a ``reason`` too, and its ``tolerance`` is the likelihood-ratio
+        test's.
     selection : dict or None
         How the recommended method chose among its distinct minima on the
         held-back end of the estimation record
