@@ -64,6 +64,7 @@ from .cancellation import effective, embed_covariance, embed_factor
 from .cost import PaperCost
 from .estimators import DEFAULT_METHOD, METHODS
 from .heldback import HOLDBACK
+from .local_estimators import _act_on_modes
 from .margin import AUTO, is_auto, max_radius
 from .options import (
     IDENTIFY_DEFAULTS,
@@ -196,6 +197,11 @@ def identify(
         (:mod:`~spiralid.sysid.estimation.cancellation`). The model keeps
         the structure asked for, with zero coefficients where the pair was;
         ``effective_order`` and ``cancellations`` say what was removed.
+        After ``"spiral"`` it then removes each pole its modes table flags
+        (an interval that reaches ``|z| = 1``, a cancelling zero) with its
+        nearest zero where a likelihood-ratio test at 5 % allows
+        (:mod:`~spiralid.sysid.estimation.spurious`; ``model.diagnosis``
+        says what was removed and what was kept, and why).
         Refused by the other methods.
     **options
         The method's own options (:func:`identify_options` lists them per
@@ -338,6 +344,10 @@ def identify(
         chosen = margin_choice.choose(problem, res, _holdback(method, options))
         if chosen is not None:
             problem, res, margin = chosen
+    if method == DEFAULT_METHOD and problem.cancel and arx.na:
+        # The recommended method acts on its own modes table's diagnosis:
+        # a flagged pole is removed where the cost allows (issue 47).
+        _act_on_modes(problem, res, (res.get("caps") or {}).get("cancel"))
     return _packaged(method, problem, res, t_start, margin)
 
 
@@ -470,8 +480,17 @@ def _packaged(
         cancellations=tuple(cancelled),
         selection=None if res.get("selection") is None else res.selection.to_dict(),
         margin=None if margin is None else margin.to_dict(),
+        diagnosis=_diagnosis(res),
         **data.provenance(),
     )
+
+
+def _diagnosis(res) -> dict | None:
+    """What acting on the modes table did, when it found a flagged pole."""
+    found = res.get("diagnosis")
+    if found is None or not (found.removed or found.kept or found.untried):
+        return None
+    return found.to_dict()
 
 
 def margin_options(method: str, data: IOData, refine, max_time_constant, cancel):

@@ -168,6 +168,82 @@ def _cancel(
     )
 
 
+def _act_on_modes(
+    problem: Problem,
+    result: EstimatorResult,
+    max_nfev: int | None = None,
+) -> None:
+    """Remove the poles the modes table flags (an interval that reaches
+    ``|z| = 1``, a cancelling zero) where the likelihood-ratio test allows
+    (:func:`~spiralid.sysid.estimation.spurious.remove_flagged`), after the
+    cancellation: each reduced model is polished by output error from the
+    deflated one, with the same margin; `max_nfev` caps each polish.
+    ``result.diagnosis`` says what was removed and what was kept."""
+    from .cancellation import effective, pad
+    from .spurious import remove_flagged
+
+    arx = problem.arx
+    order = result.get("effective_order") or (arx.na, arx.nb)
+    theta_r, arx_r = effective(result.x, arx, order)
+    # With `max_nfev` (output error's pace: one cancellation polish's cap)
+    # the polishes share that cap, so that a model with many flagged poles
+    # adds a bounded share of output error's time (twice the cap took the
+    # rig's ARX(16, 16, 0) to 2x output error's processor time); the poles
+    # left untried when it is spent stay flagged, and the diagnosis says so.
+    budget = [None if max_nfev is None else int(max_nfev)]
+
+    def polish(start, reduced):
+        left = budget[0]
+        if left is not None and left < 5:
+            return None
+        cap = {} if left is None else {"max_nfev": min(int(max_nfev), left)}
+        theta, res = local_polish(
+            start,
+            reduced,
+            problem.data,
+            "simulation",
+            problem.initial,
+            max_radius=problem.max_radius,
+            **cap,
+        )
+        if left is not None:
+            budget[0] = left - int(res.nfev)
+        return theta
+
+    def cost(theta):
+        # Padded to the estimated structure: the paper's cost of the model.
+        return float(problem.cost(pad(theta, arx_r, arx)))
+
+    def error(theta):
+        return problem.data.y - arx_r.simulate(theta, problem.data.u)
+
+    theta, reduced, diagnosis = remove_flagged(
+        theta_r, arx_r, problem.data, problem.initial, cost, polish, error
+    )
+    result.diagnosis = diagnosis
+    if not diagnosis.removed:
+        return
+    if result.get("x_full") is None:
+        result.x_full, result.fun_full = result.x, result.fun
+    # `theta` is padded to the effective structure it started from; the
+    # model's layout is the structure asked for.
+    theta_red, _ = effective(theta, arx_r, (reduced.na, reduced.nb))
+    result.x = pad(theta_red, reduced, arx)
+    result.fun = float(problem.cost(result.x))
+    removed = [
+        {k: v for k, v in r.items() if k != "reasons"}
+        | {"reason": "; ".join(r["reasons"])}
+        for r in diagnosis.removed
+    ]
+    result.cancelled = [*(result.get("cancelled") or []), *removed]
+    k = sum(c["order"] for c in result.cancelled)
+    result.effective_order = (arx.na - k, arx.nb - k)
+    result.message = (
+        f"{result.message} Then {len(removed)} pole(s) the modes table flags "
+        f"removed: effective order {reduced}."
+    )
+
+
 def _refine(
     problem: Problem,
     result: EstimatorResult,

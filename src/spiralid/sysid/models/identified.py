@@ -111,7 +111,10 @@ class IdentifiedModel(FittedModel):
         pair), its ``order`` (1 real, 2 a complex pair), their
         ``distance``, the ``tolerance`` and the ``cost_increase`` (a share
         of the cost). The removed coefficients are zeros at the end of
-        ``a`` and ``b``; :attr:`effective_order` is what is left.
+        ``a`` and ``b``; :attr:`effective_order` is what is left. A pole
+        removed because the modes table flagged it (:attr:`diagnosis`) has
+        a ``reason`` too, and its ``tolerance`` is the likelihood-ratio
+        test's.
     selection : dict or None
         How the recommended method chose among its distinct minima on the
         held-back end of the estimation record
@@ -130,6 +133,15 @@ class IdentifiedModel(FittedModel):
         (``"margin"``, ``"free"``), whether it was ``lifted`` and a ``note``
         in words; None when the margin did not bind, was given explicitly
         or was off.
+    diagnosis : dict or None
+        What the recommended method did with the poles its modes table
+        flags (an interval that reaches ``|z| = 1``, a cancelling zero;
+        :mod:`~spiralid.sysid.estimation.spurious`): the poles ``removed``
+        (also in :attr:`cancellations`, with a ``reason``) and ``kept``
+        (each with the ``cost_increase`` its removal took and the test's
+        ``tolerance``), the record's ``n_samples`` and the error's
+        ``n_effective`` samples the test used, and a ``note`` in words;
+        None when no pole was flagged or with ``cancel=False``.
     """
 
     theta: np.ndarray
@@ -149,6 +161,7 @@ class IdentifiedModel(FittedModel):
     cancellations: tuple = ()
     selection: dict | None = None
     margin: dict | None = None
+    diagnosis: dict | None = None
 
     def __post_init__(self) -> None:
         self._check_provenance()
@@ -273,19 +286,37 @@ class IdentifiedModel(FittedModel):
         """What the pole-zero cancellation removed, in a sentence, or None."""
         if not self.cancellations:
             return None
-        where = ", ".join(_root_text(c["pole"]) for c in self.cancellations)
-        dist = max(float(c["distance"]) for c in self.cancellations)
-        tol = float(self.cancellations[0]["tolerance"])
-        # Each removal's rise is of the cost before any: the last is the total.
-        rise = float(self.cancellations[-1]["cost_increase"])
         na, nb = self.effective_order
-        n = len(self.cancellations)
+        near = [c for c in self.cancellations if "reason" not in c]
+        flagged = [c for c in self.cancellations if "reason" in c]
+        parts = []
+        if near:
+            where = ", ".join(_root_text(c["pole"]) for c in near)
+            dist = max(float(c["distance"]) for c in near)
+            tol = float(near[0]["tolerance"])
+            # Each removal's rise is of the cost before any: the last is the
+            # total.
+            rise = float(near[-1]["cost_increase"])
+            n = len(near)
+            parts.append(
+                f"{n} near-cancelling pole-zero pair{'s' if n > 1 else ''} "
+                f"removed after the estimation (pole at z = {where}; |p - z| <= "
+                f"{dist:.2g}, below the record's resolution 2 pi / N = {tol:.2g}; "
+                f"estimation cost {100 * rise:+.2g} %)"
+            )
+        if flagged:
+            where = ", ".join(_root_text(c["pole"]) for c in flagged)
+            rise = float(flagged[-1]["cost_increase"])
+            tol = float(flagged[-1]["tolerance"])
+            n = len(flagged)
+            parts.append(
+                f"{n} pole{'s' if n > 1 else ''} the modes table flags removed "
+                f"(z = {where}; {flagged[0]['reason']}; estimation cost "
+                f"{100 * rise:+.2g} % of the estimate after the cancellation, "
+                f"within the likelihood-ratio test's {100 * tol:.2g} %)"
+            )
         return (
-            f"{n} near-cancelling pole-zero pair{'s' if n > 1 else ''} removed "
-            f"after the estimation (pole at z = {where}; |p - z| <= {dist:.2g}, "
-            f"below the record's resolution 2 pi / N = {tol:.2g}; estimation "
-            f"cost {100 * rise:+.2g} %): effective order na = {na}, nb = {nb} "
-            f"of {self.arx}"
+            f"{' and '.join(parts)}: effective order na = {na}, nb = {nb} of {self.arx}"
         )
 
     @property
@@ -388,6 +419,7 @@ class IdentifiedModel(FittedModel):
             "cancellations": [dict(c) for c in self.cancellations],
             "selection": self.selection,
             "margin": self.margin,
+            "diagnosis": self.diagnosis,
             "modes": self.modes.to_dict(),
         }
         if out["result"] is not None and self.refine_result is not None:
@@ -442,6 +474,7 @@ class IdentifiedModel(FittedModel):
                 cancellations=_cancellations_field(d),
                 selection=_note_field(d, "selection"),
                 margin=_note_field(d, "margin"),
+                diagnosis=_note_field(d, "diagnosis"),
             )
         except KeyError as exc:
             raise ValueError(f"the field {exc.args[0]!r} is missing") from None
@@ -508,6 +541,9 @@ def _cancellations_field(d: dict) -> tuple:
                 "tolerance": float(c["tolerance"]),
                 "cost_increase": float(c["cost_increase"]),
             }
+            if "reason" in c:
+                # A pole removed on the modes table's flags (spurious.py).
+                entry["reason"] = str(c["reason"])
         except (KeyError, TypeError, ValueError):
             raise bad from None
         if (

@@ -205,6 +205,7 @@ def mode_table(
     covariance=None,
     level: float = 0.95,
     factor=None,
+    shares: bool = True,
 ) -> ModeTable:
     """The modes of ``B(q) / A(q)`` with intervals from the coefficients'
     covariance.
@@ -227,6 +228,12 @@ def mode_table(
         A square-root factor ``R`` of `covariance` (``C = R^T R``): the
         variances are then ``|R g|^2``, which keep their precision where
         ``g^T C g`` on an ill-conditioned ``C`` rounds to zero.
+
+    shares : bool, default True
+        Compute each mode's share of the output (partial fractions, the
+        table's slowest part at high orders); without them ``share`` is NaN
+        and no mode is flagged for a small share (the estimation's own
+        diagnosis, which acts on the interval and cancellation flags only).
 
     Returns
     -------
@@ -288,7 +295,7 @@ def mode_table(
         cancelled = gap <= z * pole_se
     else:
         cancelled = np.zeros(upper.size, bool)
-    share = _peak_shares(b, den, upper)
+    share = _peak_shares(b, den, upper) if shares else np.full(upper.size, np.nan)
     spurious = (
         (share < SPURIOUS_SHARE)
         | (z * freq_se > SPURIOUS_WIDTH * frequency)

@@ -276,6 +276,7 @@ def _choice_notes(model) -> str | None:
         for record in (
             getattr(model, "selection", None),
             getattr(model, "margin", None),
+            getattr(model, "diagnosis", None),
         )
         if record
     ]
