@@ -71,7 +71,7 @@ def element_matrices(
     Examples
     --------
     >>> ke, me, ce = element_matrices(1.0, 1.0, 1.0, 0.0)
-    >>> float(me[::2, ::2].sum()), float(ke[0, 0])   # mass rho A le, 12 EI / le^3
+    >>> round(float(me[::2, ::2].sum()), 12), float(ke[0, 0])  # rho A le, 12 EI/le^3
     (1.0, 12.0)
     """
     le, ei, rho_a = (

@@ -13,7 +13,7 @@ Examples
 >>> p = PROBLEMS["rastrigin"]
 >>> p.bounds(2).tolist(), p.optimum(2).tolist(), p.f_opt
 ([[-5.12, 5.12], [-5.12, 5.12]], [0.0, 0.0], 0.0)
->>> float(rastrigin([1.0, 0.5]))
+>>> round(float(rastrigin([1.0, 0.5])), 9)
 21.25
 >>> rastrigin(np.zeros((3, 4))).tolist()
 [0.0, 0.0, 0.0]

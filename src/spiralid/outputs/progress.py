@@ -67,7 +67,7 @@ class Progress:
     spiralid demo: searching: 0/4 runs (0 %), 0 s
     spiralid demo: searching: 1/4 runs (25 %), 0 s
     ...
-    spiralid demo: done in 0.0 s
+    spiralid demo: done in ... s
     <BLANKLINE>
     >>> sorted(progress.timings())
     ['search', 'total']
