@@ -108,7 +108,12 @@ def test_spiral_never_ends_above_the_best_baseline(kind):
     assert not above
     for fit, _ in _runs(kind):
         before = fit.result.get("fun_full", fit.cost)
-        assert fit.cost <= before * (1 + CANCEL_COST_SHARE)
+        # Acting on the modes table's flags (estimation/spurious.py) then
+        # trades at most its likelihood-ratio test's tolerance, the last
+        # removal's, on top of the cancellation's share.
+        removed = (fit.diagnosis or {}).get("removed") or [{"tolerance": 0.0}]
+        test = 1 + removed[-1]["tolerance"]
+        assert fit.cost <= before * (1 + CANCEL_COST_SHARE) * test
 
 
 def test_the_search_alone_would_not_always_hold_the_baselines():
