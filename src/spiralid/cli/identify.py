@@ -503,8 +503,7 @@ def _check_candidates(args) -> None:
 def _check_shared_options(args, est) -> None:
     """The method and typed flags a fit of several outputs takes (the
     library's table, shared_options), refused by their flags."""
-    from spiralid.sysid.estimation.identify import shared_options
-    from spiralid.sysid.estimation.shared import SHARED_METHODS
+    from spiralid.sysid.estimation.shared import SHARED_METHODS, shared_options
 
     outputs = f"{est.n_outputs} outputs (one shared denominator)"
     if args.method not in SHARED_METHODS:

@@ -346,7 +346,7 @@ def identify(
             problem, res, margin = chosen
     if method == DEFAULT_METHOD and problem.cancel and arx.na:
         # The recommended method acts on its own modes table's diagnosis:
-        # a flagged pole is removed where the cost allows (issue 47).
+        # a flagged pole is removed where the cost allows.
         _act_on_modes(problem, res, (res.get("caps") or {}).get("cancel"))
     return _packaged(method, problem, res, t_start, margin)
 
@@ -534,19 +534,11 @@ def _time_constant(value, ts: float) -> float | None:
     return seconds
 
 
-def shared_options(method: str) -> tuple[str, ...]:
-    """The options `identify` takes with `method` on a record of several
-    outputs (one shared denominator)."""
-    from .shared import SHARED_METHODS
-
-    return ("rng", "predictor", "initial", "integrator", *SHARED_METHODS[method])
-
-
 def _identify_shared(data: IOData, arx: ARX, method, given: dict):
     """`identify` on a record of several outputs: one denominator for all
     (:func:`~spiralid.sysid.estimation.shared.identify_shared`) by the
     methods of :data:`~spiralid.sysid.estimation.shared.SHARED_METHODS`."""
-    from .shared import SHARED_METHODS, identify_shared
+    from .shared import SHARED_METHODS, identify_shared, shared_options
 
     method = _check_method(method)
     if method not in SHARED_METHODS:

@@ -69,6 +69,12 @@ _POLISH_NFEV = 40
 _REWEIGHTS = 5
 
 
+def shared_options(method: str) -> tuple[str, ...]:
+    """The options `identify` takes with `method` on a record of several
+    outputs (one shared denominator)."""
+    return ("rng", "predictor", "initial", "integrator", *SHARED_METHODS[method])
+
+
 def _integrators(integrators, p: int) -> tuple[int, ...]:
     """Each output's count of known integrators: one count for all, or one
     per output; a one-line ValueError otherwise."""

@@ -5,8 +5,8 @@ mode whose pole's 95 % radius interval reaches ``|z| = 1`` (the record does
 not show it decay: it is indistinguishable from a drift or an offset) or
 that a zero cancels within the pole's interval (it barely reaches the
 output). On real records the recommended method returned such modes and
-said so without acting on it (issue 47: a heat-exchanger record whose every
-mode was flagged validated 15 points below output error). After
+said so without acting on it (a heat-exchanger record whose every mode
+was flagged validated 15 points below output error). After
 ``"spiral"`` (``cancel=True``, its default) each flagged pole is therefore
 a candidate for removal, as a near pole-zero cancellation is
 (:mod:`~spiralid.sysid.estimation.cancellation`):
