@@ -142,16 +142,7 @@ def _cancel(
     cap = {} if max_nfev is None else {"max_nfev": max_nfev}
 
     def polish(start, reduced):
-        theta, _ = local_polish(
-            start,
-            reduced,
-            problem.data,
-            "simulation",
-            problem.initial,
-            max_radius=problem.max_radius,
-            **cap,
-        )
-        return theta
+        return _polish_reduced(problem, start, reduced, **cap)[0]
 
     theta, removed = reduce_order(result.x, problem.arx, problem.data.n, cost, polish)
     if not removed:
@@ -165,6 +156,21 @@ def _cancel(
     result.message = (
         f"{result.message} Then {len(removed)} near-cancelling pole-zero "
         f"pair(s) removed: effective order {reduced}."
+    )
+
+
+def _polish_reduced(problem: Problem, start, reduced, **cap):
+    """Output error's polish of a reduced model from `start`, on the
+    problem's record and initial condition, under its margin: what both the
+    cancellation and the modes table's removals refit with."""
+    return local_polish(
+        start,
+        reduced,
+        problem.data,
+        "simulation",
+        problem.initial,
+        max_radius=problem.max_radius,
+        **cap,
     )
 
 
@@ -197,15 +203,7 @@ def _act_on_modes(
         if left is not None and left < 5:
             return None
         cap = {} if left is None else {"max_nfev": min(int(max_nfev), left)}
-        theta, res = local_polish(
-            start,
-            reduced,
-            problem.data,
-            "simulation",
-            problem.initial,
-            max_radius=problem.max_radius,
-            **cap,
-        )
+        theta, res = _polish_reduced(problem, start, reduced, **cap)
         if left is not None:
             budget[0] = left - int(res.nfev)
         return theta
