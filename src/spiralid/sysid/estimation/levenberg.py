@@ -98,7 +98,8 @@ def damped_descent(
     lam_max : float
         The largest damping before the step is given up.
     shrink : float
-        The damping's divisor after an accepted trial point.
+        The damping's divisor after a trial point accepted once a smaller
+        damping was rejected (10 otherwise).
 
     Returns
     -------
@@ -128,7 +129,7 @@ def damped_descent(
         if stationary:
             stop = "stationary"
             break
-        stepped = False
+        stepped = rejected = False
         while nfev < max_nfev and lam <= lam_max:
             s = step(lam)
             trial = None if s is None else project(x + s)
@@ -140,10 +141,11 @@ def damped_descent(
             if cost_trial < cost:  # NaN compares False: rejected
                 before = (x, cost)
                 x, cost, state = trial, cost_trial, state_trial
-                lam = max(lam / shrink, 1e-12)
+                lam = max(lam / (shrink if rejected else 10.0), 1e-12)
                 nit += 1
                 stepped = True
                 break
+            rejected = True
             lam *= grow
         if not stepped:
             stop = "no decrease" if lam > lam_max else "cap"
@@ -206,10 +208,11 @@ def levenberg_marquardt(
         evaluations at ARX(24, 24, 0) and above). `project` still corrects
         what the linearisation misses.
     shrink : float
-        The damping's divisor after an accepted step (10, Marquardt's).
-        Where the model holds only a little beyond the last accepted step,
-        dividing by 10 makes the next trial too long, and accepted and
-        rejected trials alternate: half the evaluations wasted.
+        The damping's divisor after a step accepted once a smaller damping
+        was rejected (10, Marquardt's, otherwise). Where the model holds
+        only a little beyond such a step, dividing by 10 makes the next
+        trial the one just rejected, and accepted and rejected trials
+        alternate: half the evaluations wasted.
 
     Returns
     -------
