@@ -10,14 +10,17 @@ on the rig's record crept for 36,000 evaluations; searched as coefficients
 with unstable trial points rejected, LM ran into the stability boundary from
 a start whose way to the optimum passes round it and stayed there. Here a
 trial point that leaves the feasible set is first projected back (for a
-denominator: its unstable poles reflected into the unit circle, as Ljung's
-prediction-error methods do), and the projected point is the one judged and
-kept, so LM takes Gauss-Newton steps in the coefficients (fast near an
-optimum) and slides along the boundary instead of stopping at it.
+denominator: its outside poles moved radially onto the region's edge; a
+reflection into the unit circle, as Ljung's prediction-error methods
+stabilise, undid the step's move along the edge), and the projected point
+is the one judged and kept, so LM takes Gauss-Newton steps in the
+coefficients (fast near an optimum) and slides along the boundary instead
+of stopping at it.
 
 The damping follows Marquardt with the Jacobian's columns scaled to unit
 norm (``x_scale="jac"`` in SciPy's terms): ``lambda`` divided by 10 after an
-accepted step, multiplied by 10 after a rejected one.
+accepted step (by `shrink` after one accepted once a smaller damping was
+rejected), multiplied by 10 after a rejected one.
 """
 
 from __future__ import annotations

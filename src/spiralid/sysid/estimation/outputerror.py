@@ -6,13 +6,13 @@
 Jacobian) on the error :class:`~spiralid.sysid.PaperCost` defines, over the
 ARX coefficients themselves, kept in the stable region :data:`KMAX` defines
 (every reflection coefficient ``|k_j| <= KMAX``, ``KMAX = 1 - 1e-6``): a
-trial step that leaves it has its unstable poles reflected into the unit
-circle, ``z -> 1 / conj(z)``, as a start's are. With a stability margin
+trial step that leaves it has its outside poles moved radially onto the
+region's edge (a start's are reflected, ``z -> 1 / conj(z)``). With a stability margin
 (``max_radius = r_max``, identify's ``max_time_constant``, see
 :mod:`~spiralid.sysid.estimation.margin`) the region is the disc of radius
 ``r_max`` instead: the reflection coefficients of ``A(r_max z)`` are
-bounded by ``KMAX``, and outside poles are reflected about that circle
-(``z -> r_max^2 / conj(z)``). :func:`steiglitz_mcbride`
+bounded by ``KMAX``, and a start's outside poles are reflected about that
+circle (``z -> r_max^2 / conj(z)``). :func:`steiglitz_mcbride`
 gives the classical output-error start. The estimators
 (:mod:`spiralid.sysid.estimation.estimators`) run the polish from several
 starts and keep the lowest cost. docs/design-notes.md, "Where a local polish
@@ -71,16 +71,14 @@ def _clip_into_bound(
     """`theta` with its denominator's poles outside the region moved
     radially onto its edge (``None`` when rounding leaves it outside).
 
-    The polish's projection of a trial point (the steps themselves keep to
-    the region's linearisation, :func:`_pole_rows`, so this corrects what
-    the linearisation misses). Reflection (``z -> 1 / conj(z)``, the starts'
-    projection and the polish's before issue 52) sends a pole that a step
-    pushed a distance ``d`` outside to ``d`` inside: the step's move of that
-    pole is undone twice over while the numerator keeps the move it made to
-    match it, and LM along the boundary crawled (ARX(24, 24, 0) on the
-    paper's record: 1,461 evaluations from least squares, 1,322 of the trial
-    points reflected). Moving the pole onto the edge keeps the step's move
-    along it."""
+    The polish's projection of a trial point. Reflection (``z -> 1 /
+    conj(z)``, the starts' projection and the polish's before issue 52)
+    sends a pole that a step pushed a distance ``d`` outside to ``d``
+    inside: the step's move of that pole is undone twice over while the
+    numerator keeps the move it made to match it, and LM along the boundary
+    crawled (ARX(24, 24, 0) on the paper's record: 1,461 evaluations from
+    least squares, 1,322 of the trial points reflected). Moving the pole
+    onto the edge keeps the step's move along it."""
     if _within_bound(theta[:na], radius):
         return theta
     w = theta[:na] if radius is None else scaled(theta[:na], radius)
@@ -211,7 +209,7 @@ def local_polish(
     :class:`PaperCost` defines it, kept stable: the search is over ``theta``
     itself, and a trial step whose denominator leaves the stable region
     (some reflection coefficient ``|k_j| > KMAX``) has its outside poles
-    reflected in before it is judged. Analytic Jacobian:
+    moved radially onto the region's edge before it is judged. Analytic Jacobian:
     ``d yhat / d b_j = u(t-nk-j) / A`` and ``d yhat / d a_i = -yhat(t-i) / A``
     (simulation: sensitivities filtered from rest, with ``yhat`` zero before
     ``t = 0`` for ``initial="rest"`` and the measured initial state fixed
