@@ -165,7 +165,11 @@ def test_output_error_ends_where_no_local_step_improves():
     fit = identify(est, ARX441, method="oe", max_time_constant=None)
     res = fit.result
     assert res["status"] == 0 and res["start"] == "steiglitz-mcbride"
-    assert "flat valley" in res["message"] and np.isfinite(res["optimality"])
+    # Since issue 52 the polish slides along the boundary and ends by its
+    # tolerance there; before, it crawled and the stall window ended it.
+    stops = ("flat valley", "less than its tolerance", "No damped step")
+    assert any(w in res["message"] for w in stops)
+    assert np.isfinite(res["optimality"])
     cost = PaperCost(ARX441, est)
     again, _ = outputerror.local_polish(fit.theta, ARX441, est, "simulation")
     assert cost(again) >= fit.cost * (1 - 1e-6)
