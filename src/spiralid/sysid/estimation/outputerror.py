@@ -72,11 +72,10 @@ def _clip_into_bound(
     radially onto its edge (``None`` when rounding leaves it outside).
 
     The polish's projection of a trial point. Reflection (``z -> 1 /
-    conj(z)``, the starts' projection and the polish's before issue 52)
-    sends a pole that a step pushed a distance ``d`` outside to ``d``
+    conj(z)``, the starts' projection) would send a pole that a step pushed a distance ``d`` outside to ``d``
     inside: the step's move of that pole is undone twice over while the
     numerator keeps the move it made to match it, and LM along the boundary
-    crawled (ARX(24, 24, 0) on the paper's record: 1,461 evaluations from
+    crawls (with reflection, ARX(24, 24, 0) on the paper's record: 1,461 evaluations from
     least squares, 1,322 of the trial points reflected). Moving the pole
     onto the edge keeps the step's move along it."""
     if _within_bound(theta[:na], radius):
@@ -249,8 +248,8 @@ def local_polish(
         tol=_TOL,
         stall=(_STALL_WINDOW * (arx.n_params + 1), _STALL_GAIN),
         # Steps under the region's linearisation (_pole_rows) reach the
-        # minimum on the margin that projection alone misses (issue 52,
-        # tests/sysid/test_boundary_polish.py), but move the margin
+        # minimum on the margin that projection alone misses
+        # (tests/sysid/test_boundary_polish.py), but move the margin
         # choice's decisions on its test records: off until that is judged.
         constraints=None,
         shrink=_SHRINK,
