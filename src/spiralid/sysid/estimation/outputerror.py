@@ -72,12 +72,13 @@ def _clip_into_bound(
     radially onto its edge (``None`` when rounding leaves it outside).
 
     The polish's projection of a trial point. Reflection (``z -> 1 /
-    conj(z)``, the starts' projection) would send a pole that a step pushed a distance ``d`` outside to ``d``
-    inside: the step's move of that pole is undone twice over while the
-    numerator keeps the move it made to match it, and LM along the boundary
-    crawls (with reflection, ARX(24, 24, 0) on the paper's record: 1,461 evaluations from
-    least squares, 1,322 of the trial points reflected). Moving the pole
-    onto the edge keeps the step's move along it."""
+    conj(z)``, the starts' projection) would send a pole that a step pushed
+    a distance ``d`` outside to ``d`` inside: the step's move of that pole
+    is undone twice over while the numerator keeps the move it made to
+    match it, and LM along the boundary crawls (with reflection,
+    ARX(24, 24, 0) on the paper's record: 1,461 evaluations from least
+    squares, 1,322 of the trial points reflected). Moving the pole
+onto the edge keeps the step's move along it."""
     if _within_bound(theta[:na], radius):
         return theta
     w = theta[:na] if radius is None else scaled(theta[:na], radius)
