@@ -39,6 +39,11 @@ __all__ = ["damped_descent", "levenberg_marquardt"]
 _LAMBDA0 = 1e-3
 _LAMBDA_MAX = 1e16
 
+# The race against a rival's cost is judged over a fifth of the stall
+# window: a crawl that loses shows it early, and a polish still descending
+# fast is never given up (its straight line reaches far).
+_RACE_WINDOWS = 5
+
 # Why the polish stopped (``stop``); 0 is the evaluation cap, the only one
 # that is status 1 of :data:`~spiralid.optim.result.STATUS`.
 STOPS = {
@@ -49,6 +54,8 @@ STOPS = {
     4: "No damped step lowers the cost: a local minimum to working precision.",
     5: "The cost fell by less than its stall tolerance over the stall window: "
     "the end of a flat valley.",
+    6: "At the pace of its last stall window the evaluations left could not "
+    "bring the cost down to the rival's: given up.",
 }
 
 
@@ -173,6 +180,7 @@ def levenberg_marquardt(
     stall: tuple[int, float] | None = None,
     constraints: Callable[[np.ndarray], tuple | None] | None = None,
     shrink: float = 10.0,
+    rival: float | None = None,
 ) -> OptimiserResult:
     """Minimise ``0.5 |residual(x)|^2`` from `x0` by Levenberg-Marquardt.
 
@@ -216,6 +224,13 @@ def levenberg_marquardt(
         only a little beyond such a step, dividing by 10 makes the next
         trial the one just rejected, and accepted and rejected trials
         alternate: half the evaluations wasted.
+    rival : float, optional
+        ``|r|^2`` that another start's polish of the same residual reached,
+        when only the lower of the two is kept. Every fifth of the stall
+        window (which `stall` must give) the polish gives up (stop 6) if its
+        cost is above `rival` by more than that stretch's fall times the
+        stretches its cap leaves: at its own pace it cannot win. A crawl's
+        pace falls, so the straight line is optimistic for it.
 
     Returns
     -------
@@ -251,16 +266,23 @@ def levenberg_marquardt(
             stationary,
         )
 
-    # The stall window's start: (evaluations, cost), first the start's.
+    # The stall window's start: (evaluations, cost), first the start's; and
+    # the race's, a fifth as long.
     checkpoint = [1, None]
+    race = [1, None]
 
     def converged(before, x, cost_before, cost, nfev):
         if checkpoint[1] is None:
-            checkpoint[1] = cost_before
+            checkpoint[1] = race[1] = cost_before
         if (cost_before - cost) / cost_before <= tol:
             return 2
         if np.linalg.norm(x - before) <= tol * (np.linalg.norm(x) + tol):
             return 3
+        if rival is not None and nfev - race[0] >= stall[0] // _RACE_WINDOWS:
+            windows_left = (max_nfev - nfev) / (nfev - race[0])
+            if cost - rival > (race[1] - cost) * windows_left:
+                return 6
+            race[:] = [nfev, cost]
         if stall is not None and nfev - checkpoint[0] >= stall[0]:
             if checkpoint[1] - cost <= stall[1] * checkpoint[1]:
                 return 5

@@ -51,12 +51,19 @@ def _polish(
     result's ``runs``): it takes part in the choice without a second run.
     The result's ``runs`` holds every start's ``(theta, res)`` and ``work``
     their residual evaluations together (what the polishes cost, in the
-    unit their caps are set in)."""
+    unit their caps are set in).
+
+    Each polish after the first races the lowest squared error reached so
+    far (``rival`` of
+    :func:`~spiralid.sysid.estimation.levenberg.levenberg_marquardt`): one
+    that cannot reach it at its own pace is given up, since only the lowest
+    is kept."""
     t0 = time.perf_counter()
     best = None
     costs, thetas, runs = {}, {}, {}
     # Passed only when set, so local_polish's own default stays its own.
     cap = {} if max_nfev is None else {"max_nfev": max_nfev}
+    rival = None
     for name, start in starts.items():
         if isinstance(start, tuple):
             theta, res = start
@@ -68,8 +75,11 @@ def _polish(
                 predictor,
                 problem.initial,
                 max_radius=problem.max_radius,
+                rival=rival,
                 **cap,
             )
+        squared = float(res.fun @ res.fun)
+        rival = squared if rival is None else min(rival, squared)
         costs[name] = float(cost(theta))
         thetas[name] = theta
         runs[name] = (theta, res)

@@ -78,7 +78,7 @@ def _clip_into_bound(
     match it, and LM along the boundary crawls (with reflection,
     ARX(24, 24, 0) on the paper's record: 1,461 evaluations from least
     squares, 1,322 of the trial points reflected). Moving the pole
-onto the edge keeps the step's move along it."""
+    onto the edge keeps the step's move along it."""
     if _within_bound(theta[:na], radius):
         return theta
     w = theta[:na] if radius is None else scaled(theta[:na], radius)
@@ -204,6 +204,7 @@ def local_polish(
     initial: str = "rest",
     max_nfev: int | None = None,
     max_radius: float | None = None,
+    rival: float | None = None,
 ) -> tuple[np.ndarray, OptimiserResult]:
     """Levenberg-Marquardt polish of the `predictor`'s error as
     :class:`PaperCost` defines it, kept stable: the search is over ``theta``
@@ -228,7 +229,12 @@ def local_polish(
 
     ``max_radius`` (``r_max``, optional) is a stability margin: the region
     is then the disc of radius ``r_max`` (see the module docstring), the
-    start is projected into it, and ``at_bound`` is on its edge."""
+    start is projected into it, and ``at_bound`` is on its edge.
+
+    ``rival`` (optional) is the squared error ``|r|^2`` another start's
+    polish reached when only the lower is kept: the polish gives up where
+    its pace cannot reach it (stop 6 of
+    :func:`~spiralid.sysid.estimation.levenberg.levenberg_marquardt`)."""
     na = arx.na
     residual, jacobian = error_functions(arx, data, predictor, initial)
     if max_nfev is None:
@@ -254,6 +260,7 @@ def local_polish(
         # choice's decisions on its test records: off until that is judged.
         constraints=None,
         shrink=_SHRINK,
+        rival=rival,
     )
     res.max_nfev = max_nfev
     res.capped = res.status == 1
