@@ -74,7 +74,7 @@ module that this one imports, as the others are: ``ls`` and ``oe`` in
 :mod:`~spiralid.sysid.estimation.spiral.recommended`; the :class:`Problem` it
 takes and the :class:`EstimatorResult` it returns are in
 :mod:`~spiralid.sysid.estimation.core.problem`. A population search builds on
-``searches._search`` with its optimiser, which gives it the
+``population._search`` with its optimiser, which gives it the
 parametrisation, the box, the initial points, the safe start, the status
 and ``refine``.
 Then add one entry to :data:`METHODS`::

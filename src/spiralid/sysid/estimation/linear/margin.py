@@ -40,8 +40,9 @@ Where the margin acts, so that no evaluation is spent outside it:
   the spiral search and its variable-projection polish
   (:func:`~spiralid.sysid.estimation.linear.varpro.gauss_newton_polish`) move in
   those coordinates;
-- the reflection parametrisation (:class:`~spiralid.sysid.estimation.
-  parametrizations.Reflection` with ``max_radius``): the step-up
+- the reflection parametrisation
+  (:class:`~spiralid.sysid.estimation.linear.parametrizations.Reflection`
+  with ``max_radius``): the step-up
   polynomial's roots ``p`` map to ``r_max p`` (``a_k -> a_k r_max^k``);
 - the Levenberg-Marquardt polish of ``"oe"`` and ``refine``
   (:func:`~spiralid.sysid.estimation.linear.outputerror.local_polish` with

@@ -273,7 +273,7 @@ class NARXProblem:
 
 
 def stopping_options(max_rounds, patience, patience_share) -> dict:
-    """The early stopping's options, checked, as :func:`~.narx._fit` takes
+    """The early stopping's options, checked, as :func:`~.training._fit` takes
     them.
 
     Parameters

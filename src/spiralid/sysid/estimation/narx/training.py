@@ -1,4 +1,4 @@
-"""Training NARX models: the estimators :data:`~.estimators.METHODS` holds
+"""Training NARX models: the estimators :data:`~.core.estimators.METHODS` holds
 for a :class:`~spiralid.sysid.models.narx.NARX` or
 :class:`~spiralid.sysid.models.narx.PolynomialNARX` structure.
 

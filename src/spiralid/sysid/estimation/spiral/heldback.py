@@ -4,8 +4,9 @@ A lower estimation cost is not a better model: the simulation error of a
 flexible structure has several local minima, and the lowest one on the
 estimation record may owe its edge to fitting that record's drift or noise
 (a pole slower than the record, a near-cancelling pole-zero pair). The
-recommended method (``"spiral"``, :func:`~spiralid.sysid.estimation.
-spiral_method._estimate_recommended` with ``holdback``) therefore takes each
+recommended method (``"spiral"``,
+:func:`~spiralid.sysid.estimation.spiral.recommended._estimate_recommended`
+with ``holdback``) therefore takes each
 distinct minimum it found on the whole estimation record (the search's
 best, output error from least squares and from Steiglitz-McBride), refits
 it locally on the first ``1 - h`` of the record (a Levenberg-Marquardt
