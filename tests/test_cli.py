@@ -332,7 +332,7 @@ def test_an_internal_error_says_it_is_a_bug(tmp_path, monkeypatch, capsys):
 
     monkeypatch.setattr(arx, "arx_least_squares", broken)
     monkeypatch.setattr(
-        "spiralid.sysid.estimation.local_estimators.arx_least_squares", broken
+        "spiralid.sysid.estimation.linear.local_estimators.arx_least_squares", broken
     )
     assert _arm_identify(tmp_path) == 1
     err = capsys.readouterr().err.splitlines()
@@ -346,7 +346,7 @@ def test_an_internal_error_says_it_is_a_bug(tmp_path, monkeypatch, capsys):
 
 
 def test_a_value_error_from_inside_numpy_is_a_bug(tmp_path, monkeypatch, capsys):
-    import spiralid.sysid.estimation.local_estimators as local_estimators
+    import spiralid.sysid.estimation.linear.local_estimators as local_estimators
 
     def numpy_fails(*args, **kwargs):
         return np.zeros(3) + np.zeros(4)  # raises ValueError inside NumPy

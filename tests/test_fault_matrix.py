@@ -1259,7 +1259,7 @@ def test_choose_narx_with_a_budget_of_one_trains_one_choice(monkeypatch):
     """budget=1 is one training (and the refit): the search's first point,
     scored here again from the model it trained by fit_percent."""
     from spiralid.sysid import choose_narx, fit_percent
-    from spiralid.sysid.estimation import narx_choice
+    from spiralid.sysid.estimation.narx import choice as narx_choice
 
     trained = []
 

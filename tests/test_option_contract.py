@@ -51,13 +51,13 @@ def test_minimize_pareto_checks_vectorized_as_minimize_does():
 
 import re  # noqa: E402
 
-import spiralid.sysid.estimation.identify as identify_module  # noqa: E402
-import spiralid.sysid.estimation.narx as narx_module  # noqa: E402
+import spiralid.sysid.estimation.core.identify as identify_module  # noqa: E402
+import spiralid.sysid.estimation.narx.training as narx_module  # noqa: E402
 from spiralid.cli import build_parser  # noqa: E402
 from spiralid.cli.errors import UsageError  # noqa: E402
 from spiralid.cli.identify import _OPTION_FLAGS, _check_options  # noqa: E402
 from spiralid.sysid import METHODS  # noqa: E402
-from spiralid.sysid.estimation.identify import (  # noqa: E402
+from spiralid.sysid.estimation.core.identify import (  # noqa: E402
     identify_options,
     refused_options,
 )
@@ -525,11 +525,11 @@ def test_an_options_key_that_does_not_apply_is_named_with_those_that_do():
 
 # -- identify_pareto's contract, enumerated -----------------------------------
 
-import spiralid.sysid.estimation.pareto as pareto_module  # noqa: E402
+import spiralid.sysid.estimation.pareto.identify as pareto_module  # noqa: E402
 from spiralid.cli.pareto import _OPTION_FLAGS as _PARETO_FLAGS  # noqa: E402
 from spiralid.cli.pareto import _check_options as _check_pareto  # noqa: E402
 from spiralid.optim.pareto import PARETO_METHODS  # noqa: E402
-from spiralid.sysid.estimation.pareto_settings import (  # noqa: E402
+from spiralid.sysid.estimation.pareto.options import (  # noqa: E402
     pareto_options,
     refused_pareto_options,
 )

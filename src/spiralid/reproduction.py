@@ -38,8 +38,8 @@ from spiralid.sysid import (
     arx_least_squares,
     identify,
 )
-from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
-from spiralid.sysid.estimation.searches import search_options
+from spiralid.sysid.estimation.linear.parametrizations import DEFAULT_PARAMETRIZATION
+from spiralid.sysid.estimation.spiral.population import search_options
 from spiralid.sysid.validation.validate import Validation, validate
 
 __all__ = [
@@ -108,7 +108,7 @@ class Configuration:
         Polish the search's result locally.
     safe_start : bool or None, default None
         None takes the method's default (off for the paper's methods, see
-        :mod:`spiralid.sysid.estimation.estimators`).
+        :mod:`spiralid.sysid.estimation.core.estimators`).
     """
 
     label: str
@@ -526,7 +526,7 @@ def reproduce(
     max_nfev : int, default 20000
         Budget of cost evaluations of every search run, the same for all so
         that the algorithms compare at equal cost; no iteration cap stops a
-        run first (:func:`spiralid.sysid.estimation.searches.search_options`).
+        run first (:func:`spiralid.sysid.estimation.spiral.population.search_options`).
     n_points : int, default 50
         Search points ``m``.
     arx : ARX, default ARX(8, 8, 0)

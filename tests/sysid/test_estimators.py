@@ -10,19 +10,22 @@ from scipy import optimize, signal
 from spiralid.cli import build_parser
 from spiralid.datasets import robot_arm
 from spiralid.sysid import ARX, IOData, PaperCost, identify, step_up
-from spiralid.sysid.estimation import (
-    estimators,
-    local_estimators,
-    outputerror,
-    parametrizations,
-)
-from spiralid.sysid.estimation.estimators import (
+from spiralid.sysid.estimation.core import estimators
+from spiralid.sysid.estimation.core.estimators import (
     METHODS,
     STATUS,
     EstimatorResult,
     search_options,
 )
-from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS, stabilise
+from spiralid.sysid.estimation.linear import (
+    local_estimators,
+    outputerror,
+    parametrizations,
+)
+from spiralid.sysid.estimation.linear.parametrizations import (
+    PARAMETRIZATIONS,
+    stabilise,
+)
 
 SEARCHES = [name for name, m in METHODS.items() if m.search]
 

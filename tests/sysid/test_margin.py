@@ -12,7 +12,11 @@ from clitools import run
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, validate
-from spiralid.sysid.estimation.cancellation import (
+from spiralid.sysid.estimation.linear.margin import project_denominator, scaled
+from spiralid.sysid.estimation.linear.modal import ModalParametrization
+from spiralid.sysid.estimation.linear.outputerror import local_polish
+from spiralid.sysid.estimation.linear.parametrizations import KMAX, Reflection
+from spiralid.sysid.estimation.spiral.cancellation import (
     CANCEL_COST_SHARE,
     Candidate,
     deflate,
@@ -21,10 +25,6 @@ from spiralid.sysid.estimation.cancellation import (
     reduce_order,
     resolution,
 )
-from spiralid.sysid.estimation.margin import project_denominator, scaled
-from spiralid.sysid.estimation.modal import ModalParametrization
-from spiralid.sysid.estimation.outputerror import local_polish
-from spiralid.sysid.estimation.parametrizations import KMAX, Reflection
 from spiralid.sysid.models.polynomials import (
     is_stable_polynomial,
     max_pole_radius,

@@ -8,7 +8,7 @@ import pytest
 from scipy.signal import lfilter
 
 import spiralid as sid
-from spiralid.sysid.estimation.narx_choice import choose_narx, round_choice
+from spiralid.sysid.estimation.narx.choice import choose_narx, round_choice
 
 BOX = dict(lags=(1, 3), hidden=(1, 2), log_decay=(-3.0, -3.0))
 

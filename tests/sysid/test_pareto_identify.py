@@ -9,7 +9,7 @@ import spiralid as sid
 from spiralid.optim import minimize_pareto  # noqa: F401  (the search it runs)
 from spiralid.optim.pareto import non_dominated
 from spiralid.sysid import ARX, PaperCost, choose, identify_pareto, knee_point
-from spiralid.sysid.estimation.frequency import FrequencyError
+from spiralid.sysid.estimation.linear.frequency import FrequencyError
 
 SMALL = dict(max_nfev=600, n_points=20, extremes_nfev=50)
 

@@ -466,7 +466,7 @@ def _option_values(args) -> dict:
 def _identify_options(args, structure) -> dict:
     """What `run` passes to identify(): the options that apply to the
     method and structure (identify_options), less the budgets not given."""
-    from spiralid.sysid.estimation.identify import identify_options
+    from spiralid.sysid.estimation.core.identify import identify_options
 
     takes = identify_options(args.method, structure, args.refine)
     return {
@@ -503,7 +503,10 @@ def _check_candidates(args) -> None:
 def _check_shared_options(args, est) -> None:
     """The method and typed flags a fit of several outputs takes (the
     library's table, shared_options), refused by their flags."""
-    from spiralid.sysid.estimation.shared import SHARED_METHODS, shared_options
+    from spiralid.sysid.estimation.shared.denominator import (
+        SHARED_METHODS,
+        shared_options,
+    )
 
     outputs = f"{est.n_outputs} outputs (one shared denominator)"
     if args.method not in SHARED_METHODS:
@@ -528,7 +531,10 @@ def _check_options(args) -> None:
     method and structure (identify_options, the one table), with the
     options that do apply."""
     from spiralid.sysid import METHODS
-    from spiralid.sysid.estimation.identify import identify_options, refused_options
+    from spiralid.sysid.estimation.core.identify import (
+        identify_options,
+        refused_options,
+    )
 
     model, method = args.model, args.method
     _check_candidates(args)

@@ -164,7 +164,7 @@ def _option_values(args) -> dict:
 def _passed(args) -> dict:
     """What `run` passes to identify_pareto: the options that apply to the
     objectives (pareto_options), as the flags set them."""
-    from spiralid.sysid.estimation.pareto_settings import pareto_options
+    from spiralid.sysid.estimation.pareto.options import pareto_options
 
     takes = pareto_options(args.objectives)
     return {name: v for name, v in _option_values(args).items() if name in takes}
@@ -174,7 +174,7 @@ def _check_options(args) -> None:
     """Refuse every typed flag whose option identify_pareto would refuse
     from Python for these objectives (refused_pareto_options, from the same
     table, pareto_options), naming the flags that do apply."""
-    from spiralid.sysid.estimation.pareto_settings import (
+    from spiralid.sysid.estimation.pareto.options import (
         pareto_options,
         refused_pareto_options,
     )

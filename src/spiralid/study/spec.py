@@ -315,7 +315,7 @@ def _optimizer(entry: Any, methods, where: str) -> OptimizerSpec:
     options = entry.get("options", {})
     if not isinstance(options, dict):
         _fail(where, f"[[optimizer]] {label!r}: `options` must be a table")
-    from spiralid.sysid.estimation.identify import check_method_options
+    from spiralid.sysid.estimation.core.identify import check_method_options
 
     try:
         # Checked here, before any run, as identify() would check each.

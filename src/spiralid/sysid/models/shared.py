@@ -147,7 +147,7 @@ class SharedDenominatorModel(Provenance):
         The estimator.
     cost : float
         The weighted joint cost the estimator minimised (percent RMS error,
-        see :class:`~spiralid.sysid.estimation.shared.SharedProjectedCost`).
+        see :class:`~spiralid.sysid.estimation.shared.denominator.SharedProjectedCost`).
     weights : ndarray, shape (p,)
         The outputs' weights in that cost (``1 / sigma_i^2``).
     costs : ndarray, shape (p,)

@@ -12,8 +12,8 @@ import numpy as np
 
 from spiralid._checks import positive
 
-from ..estimation.cost import auto_gain
-from ..estimation.outputerror import error_functions
+from ..estimation.core.cost import auto_gain
+from ..estimation.linear.outputerror import error_functions
 from ..signals import check_pair
 
 __all__ = ["fit_from_measured", "fit_percent", "rmse"]

@@ -1,0 +1,316 @@
+"""Spiral search over denominators with the numerator projected out, a
+memetic local step, and starts from the measured frequency response.
+
+:func:`projected_spiral` runs a spiral optimiser
+(:class:`spiralid.optim.SpiralSearch`) over the coordinates of a
+denominator parametrisation (e.g. :class:`~spiralid.sysid.estimation.linear.modal.
+ModalParametrization`), scoring each candidate with
+:class:`~spiralid.sysid.estimation.linear.varpro.ProjectedCost` (the paper's cost at the
+least-squares numerator). Two optional ingredients:
+
+- ``polish_every=k``: every ``k`` iterations (and once at the end, the
+  best point) the centre is polished by a few Levenberg-Marquardt steps of the projected
+  problem (:func:`~spiralid.sysid.estimation.linear.varpro.gauss_newton_polish`) and
+  moved to the polished point if that is better: a memetic algorithm (a
+  population search with individual learning; Moscato 1989). The spiral
+  moves then rotate about the polished centre.
+- :func:`frequency_seeds`: initial points whose natural frequencies sit at
+  the peaks of the estimated frequency response ``|P_uy / P_uu|``.
+
+The evaluation budget counts every cost evaluation: the population's, each
+trial point of the polish and each of its Jacobians (one evaluation each:
+a Jacobian costs about as much as a few cost evaluations of one candidate,
+but far less than a population step).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from spiralid._checks import integer
+from spiralid.optim import OptimiserResult, Restarts, SpiralSearch, minimize
+
+from ...data import IOData
+from ...spectra import PSD, default_nperseg, find_resonances
+from ..linear.varpro import ProjectedCost, gauss_newton_polish
+
+__all__ = ["RTOL", "PatientRestarts", "frequency_seeds", "projected_spiral"]
+
+#: A population "found a new basin" when it lowered the best cost by more
+#: than this share of it. Two runs into one minimum end within the polish's
+#: tolerances of each other (about 1e-8 of the cost); a different minimum of
+#: the simulation error differs by far more than 1e-6.
+RTOL = 1e-6
+
+
+@dataclass(frozen=True)
+class PatientRestarts(Restarts):
+    """Restarts that also end the search (:func:`projected_spiral`): once
+    ``patience`` populations in a row have stalled without lowering the
+    best cost by more than ``rtol`` of it, the search stops before its
+    budget.
+
+    Each such population fell into a basin already found (or a worse one),
+    and the restarts are drawn alike, so more of them are not expected to
+    pay. The first population counts too: with ``patience=1`` a search
+    whose first population ends at its safe start's minimum and whose first
+    restart finds nothing lower stops there. With patience a population
+    also stalls when its best falls by no more than ``rtol`` (not 1e-9)
+    over ``stall`` iterations: smaller gains are the final polish's work.
+
+    Parameters
+    ----------
+    growth, tol_radius, stall
+        As :class:`~spiralid.optim.Restarts`.
+    patience : int
+        Populations in a row without a new basin that stop the search.
+    rtol : float
+        A new basin lowers the best cost by more than this share of it
+        (default :data:`RTOL`).
+    """
+
+    patience: int = 1
+    rtol: float = RTOL
+
+    def __post_init__(self):
+        super().__post_init__()
+        object.__setattr__(self, "patience", integer(self.patience, "patience", 1))
+        rtol = float(self.rtol)
+        if not 0.0 < rtol < 1.0:
+            raise ValueError(f"`rtol` must be in (0, 1); got {self.rtol!r}")
+        object.__setattr__(self, "rtol", rtol)
+
+
+def frequency_seeds(data: IOData, parametrization, m: int, rng=None) -> np.ndarray:
+    """``m`` modal starting points placed at the frequency response's peaks.
+
+    The response is the H1 estimate ``P_uy / P_uu`` (Welch averages,
+    Hann window, the segment length of :func:`~spiralid.sysid.spectra.psd`);
+    its most prominent peaks (:func:`~spiralid.sysid.spectra.find_resonances`,
+    at most one per second-order section) give the sections' frequencies,
+    each jittered uniformly within one resolution cell. Sections without a
+    peak get a uniform frequency; every damping is log-uniform in
+    ``[1e-2.5, 1e-0.5]`` (the lightly damped modes a peak shows); first-order
+    poles are uniform.
+
+    Parameters
+    ----------
+    data : IOData
+    parametrization : ModalParametrization
+    m : int
+        Number of points.
+    rng : int, Generator or None
+
+    Returns
+    -------
+    ndarray, shape (m, na), inside ``parametrization.bounds``
+    """
+    m = integer(m, "m", 1)
+    gen = np.random.default_rng(rng)
+    fs = 1.0 / data.ts
+    nperseg = default_nperseg(data.n)
+    kw = dict(fs=fs, window="hann", nperseg=nperseg, nfft=4 * nperseg)
+    f, puy = signal.csd(data.u, data.y, **kw)
+    _, puu = signal.welch(data.u, **kw)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gain2 = np.where(puu > 0, np.abs(puy / puu) ** 2, 0.0)
+    spectrum = PSD(f=f, p=gain2, fs=fs, nperseg=nperseg, resolution=fs / nperseg)
+    s = parametrization.n_sections
+    peaks = find_resonances(spectrum, n_peaks=max(s, 1)).frequency[:s]
+    box = parametrization.bounds
+    pts = parametrization.initial_points(m, gen)
+    k = peaks.size
+    jitter = gen.uniform(-0.5, 0.5, size=(m, k)) * spectrum.resolution
+    pts[:, :k] = peaks + jitter
+    pts[:, s : 2 * s] = gen.uniform(-2.5, -0.5, size=(m, s))
+    return np.clip(pts, box[:, 0], box[:, 1])
+
+
+def projected_spiral(
+    cost: ProjectedCost,
+    parametrization,
+    method,
+    *,
+    n_points: int,
+    max_nfev: int,
+    polish_every: int | None,
+    polish_nfev: int,
+    restarts: Restarts | None,
+    x0=None,
+    max_iter: int | None = None,
+    callback=None,
+    rng=None,
+) -> OptimiserResult:
+    """Spiral search over denominator coordinates, numerator projected out.
+
+    :func:`spiralid.optim.minimize` drives the search (its budget); the
+    memetic polish and the restarts are its callback, which then calls
+    `callback`.
+    The settings have no defaults here: the recommended method's are
+    :func:`~spiralid.sysid.estimation.spiral.recommended._estimate_recommended`'s.
+
+    Parameters
+    ----------
+    cost : ProjectedCost
+    parametrization
+        Denominator coordinates: ``bounds``, ``to_denominator``, and
+        ``jacobian`` when `polish_every` is set.
+    method : str or SpiralRule
+        As in :func:`spiralid.optim.minimize` (``"sda"``, ``"ebsda"``...).
+    n_points : int
+        Population size.
+    max_nfev : int
+        Budget of cost evaluations, polish included; no population step or
+        polish is started that would exceed it.
+    polish_every : int or None
+        Polish the centre every this many iterations and the best point
+        once at the end; ``None``: a pure spiral search.
+    polish_nfev : int
+        Evaluations per polish.
+    restarts : Restarts or None
+        Start a fresh population of ``restarts.next_size`` points, uniform
+        in the box (:meth:`~spiralid.optim.SpiralSearch.restart`), when the
+        best cost has not fallen by more than 1e-9 of itself for
+        ``restarts.stall`` iterations (a move of the centre by the polish
+        does not count: its ever smaller steps would keep a stalled
+        population alive); the best point over all populations is
+        returned. ``tol_radius`` is not used (the polished centre is not a
+        collapse test). A :class:`PatientRestarts` also stops the search
+        before the budget once its ``patience`` populations in a row found
+        no lower basin. ``None``: no restarts.
+    x0 : array_like, shape (k, na), optional
+        Initial points (the rest of the population is uniform in the box).
+    max_iter : int, optional
+        Cap on the iterations (all populations together).
+    callback : callable, optional
+        As in :func:`spiralid.optim.minimize`: after every iteration with
+        the result so far (``x`` in the searched coordinates); returning
+        True stops the search.
+    rng : int, Generator or None
+    Returns
+    -------
+    OptimiserResult
+        ``x`` the ARX theta ``[a, b]``, ``fun`` its cost (eq. (2)-(3)),
+        ``z`` the searched coordinates, ``status`` (1: budget used, 2:
+        `max_iter`, 0: the callback or a :class:`PatientRestarts`'
+        patience), ``n_polish`` (polishes that moved the centre),
+        ``populations`` (``(nfev, cost)`` at which each population stalled
+        or the search ended, its centre's cost), ``converged`` (whether the
+        patience stopped it) and the rest of
+        :func:`~spiralid.optim.minimize`'s result.
+    """
+    t_start = time.perf_counter()
+    n_points = integer(n_points, "n_points", 2)
+    max_nfev = integer(max_nfev, "max_nfev", n_points)
+    polish_nfev = integer(polish_nfev, "polish_nfev", 2)
+    if polish_every is not None:
+        polish_every = integer(polish_every, "polish_every", 1)
+    if restarts is not None and not isinstance(restarts, Restarts):
+        raise ValueError(f"`restarts` must be a Restarts or None; got {restarts!r}")
+    patience = restarts.patience if isinstance(restarts, PatientRestarts) else None
+    rtol = restarts.rtol if patience is not None else RTOL
+    # With `patience` a population whose best falls by less than `rtol` has
+    # converged as far as the search can tell (the final polish takes it
+    # further, to its tolerances); without, only a 1e-9 fall is none.
+    progress = 1e-9 if patience is None else max(float(rtol), 1e-9)
+    n_dim = parametrization.bounds.shape[0]
+    max_iter = max_nfev if max_iter is None else integer(max_iter, "max_iter", 1)
+    n_polish = 0
+    stalled, before = 0, np.inf
+    # The best cost when the current population started, and how many
+    # populations in a row have ended without lowering it (`patience`).
+    populations: list[tuple[int, float]] = []
+    at_start, idle, converged, ended = np.inf, 0, False, False
+    tail = (0, np.inf)
+
+    def fun(z):
+        return cost(parametrization.to_denominator(z))
+
+    def after_step(intermediate) -> bool:
+        nonlocal n_polish, stalled, before, at_start, idle, converged, ended, tail
+        called = time.perf_counter()
+        search: SpiralSearch = intermediate.search
+        due = polish_every and search.nit % polish_every == 0
+        if due and search.nfev + polish_nfev <= max_nfev:
+            res = gauss_newton_polish(cost, parametrization, search.centre, polish_nfev)
+            n_polish += search.move_centre(res.x, res.fun, nfev=res.nfev)
+        # Progress is a fall of the best cost by more than `progress` of it:
+        # the polish moves the centre by less at every call near a minimum,
+        # and that must not keep a stalled population alive.
+        stalled = 0 if search.fun < before * (1.0 - progress) else stalled + 1
+        before = min(before, search.fun)
+        tail = (search.nfev, search.centre_cost)
+        if restarts is not None and stalled >= restarts.stall_for(n_dim):
+            if not ended:
+                ended = True
+                populations.append((search.nfev, search.centre_cost))
+                # A population that ends within `rtol` of the best it
+                # started from found no new basin (the first starts from
+                # none, so it always counts as new).
+                idle = idle + 1 if search.fun >= at_start * (1.0 - rtol) else 0
+                at_start = min(at_start, search.fun)
+                if patience is not None and idle >= patience:
+                    converged = True
+                    return True
+            size = restarts.next_size(search.n_points)
+            if search.nfev + 2 * size - 1 <= max_nfev:
+                search.restart(size)
+                stalled, ended = 0, False
+        if callback is None:
+            return False
+        # The caller's callback sees the search after the polish and restart.
+        now = search.result(
+            "running", intermediate.elapsed + time.perf_counter() - called
+        )
+        now.search = search
+        return callback(now)
+
+    res = minimize(
+        fun,
+        parametrization.bounds,
+        method,
+        n_points=n_points,
+        max_iter=max_iter,
+        max_nfev=max_nfev,
+        rng=rng,
+        vectorized=True,
+        x0=x0,
+        callback=after_step,
+        options={"bounds_policy": "clip"},
+    )
+    z, nfev = res.x, res.nfev
+    if not ended and np.isfinite(tail[1]):
+        populations.append(tail)
+    if (
+        polish_every
+        and (res.status != 0 or converged)
+        and nfev + polish_nfev <= max_nfev
+    ):
+        end = gauss_newton_polish(cost, parametrization, z, polish_nfev)
+        nfev += end.nfev
+        if end.fun < res.fun:
+            z = end.x
+            n_polish += 1
+    f_best, b_best = cost.evaluate(parametrization.to_denominator(z)[None, :])
+    res.update(
+        x=np.r_[parametrization.to_denominator(z), b_best[0]],
+        fun=float(f_best[0]),
+        z=z,
+        nfev=nfev,
+        n_polish=n_polish,
+        populations=populations,
+        converged=converged,
+        elapsed=time.perf_counter() - t_start,
+    )
+    if converged:
+        res.message = (
+            f"Converged: {patience} population(s) in a row found no basin "
+            f"lower than the best by more than {rtol:g} of its cost."
+        )
+    if res.history.size:
+        res.history[-1] = min(res.history[-1], res.fun)
+    return res
