@@ -17,7 +17,7 @@ Default (``max_time_constant="auto"``): ``T = N ts``, the estimation
 record's length, for the methods the margin applies to -- the recommended
 ``"spiral"``, output error ``"oe"`` and the Levenberg-Marquardt polish of
 ``refine=True``. ``None`` switches it off (poles anywhere inside the unit
-circle, as before). The paper's searches (``"sda"``, ``"ebsda"``,
+circle). The paper's searches (``"sda"``, ``"ebsda"``,
 ``"lasda"``..., and the ``"de"`` baseline over the same cost) keep eq. (3)'s
 stability penalty exactly as printed and no margin; a value other than
 ``"auto"`` given to one of them without ``refine=True`` is refused, as it is

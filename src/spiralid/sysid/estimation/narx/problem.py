@@ -34,8 +34,8 @@ _ROUND = 10  # LM evaluations per early-stopping round
 MAX_ROUNDS = 500
 PATIENCE = 3
 PATIENCE_SHARE = 0.5
-# LM's tolerances (gradient, relative fall, step), SciPy's 1e-8 as before
-# the polish moved onto levenberg.py.
+# LM's tolerances (gradient, relative fall, step): SciPy's least_squares
+# defaults, 1e-8.
 _TOL = 1e-8
 
 

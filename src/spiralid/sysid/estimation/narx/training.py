@@ -356,8 +356,8 @@ def estimate_spiral(
     patience_share : float
         The patience grows with the best round: the polish stops after
         ``max(patience, ceil(patience_share * best_round))`` rounds without
-        a lower held-back cost (default 0.5; 0 with ``max_rounds=50`` is
-        the final polish before this option).
+        a lower held-back cost (default 0.5; 0 with ``max_rounds=50`` is a
+        fixed patience over 50 rounds).
 
     Returns
     -------

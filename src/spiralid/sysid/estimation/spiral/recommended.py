@@ -221,7 +221,7 @@ def _estimate_recommended(
     ``result.caps`` the caps), so the method adds a bounded share of output
     error's time to it; without the safe start or with
     ``polish_every=None`` there is no output error to measure and it is
-    ``"converged"``. ``"budget"`` spends the whole budget, as before
+    ``"converged"``. ``"budget"`` spends the whole budget
     (restarts drawn uniformly in the box rarely beat the first population,
     which holds the safe starts: ``benchmarks/identification.py
     --scaling`` measures all three). Every stop is deterministic: the same
