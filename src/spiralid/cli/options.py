@@ -116,6 +116,119 @@ def _orders(text: str) -> list[int]:
     return values
 
 
+# -- the options several subcommands share, each defined here once -----------
+# Functions, not argparse parents: a parent's options come first in --help,
+# while each subcommand lists the shared ones among its own.
+
+_DATA_HELP = "CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+_NON_EMPTY = "write into a non-empty --out"
+
+
+def _command(
+    sub,
+    name: str,
+    summary: str,
+    description: str,
+    run,
+    formatter: type[argparse.HelpFormatter] = _HelpFormatter,
+) -> argparse.ArgumentParser:
+    """The parser of subcommand `name`, which runs `run(args, argv)`;
+    `summary` is its line in ``spiralid --help``."""
+    p = sub.add_parser(
+        name, formatter_class=formatter, help=summary, description=description
+    )
+    p.set_defaults(run=run)
+    return p
+
+
+def _add_order_options(p: argparse.ArgumentParser) -> None:
+    """--na, --nb, --nk: the ARX orders and the input delay."""
+    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
+    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
+    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
+
+
+def _add_points_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+
+
+def _add_seed_option(
+    p: argparse.ArgumentParser, help: str = "seed of the search"
+) -> None:
+    p.add_argument("--seed", type=_nonneg_int, default=0, help=help)
+
+
+def _add_fraction_option(
+    p: argparse.ArgumentParser,
+    default: str | None = "2/3",
+    help: str = "share of the record that estimates; the rest validates",
+) -> None:
+    p.add_argument("--fraction", type=_fraction, default=default, help=help)
+
+
+def _add_by_fit_option(p: argparse.ArgumentParser, help: str) -> None:
+    """--by-fit POINTS: choose among candidates by their validation fit."""
+    p.add_argument(
+        "--by-fit", type=_nonneg_float, default=None, metavar="POINTS", help=help
+    )
+
+
+def _add_method_option(
+    p: argparse.ArgumentParser, names, default: str, help: str
+) -> None:
+    """--method among `names` (case-insensitive)."""
+    p.add_argument(
+        "--method", type=str.lower, choices=names, default=default, help=help
+    )
+
+
+def _add_parametrization_option(
+    p: argparse.ArgumentParser, default: str | None, help: str
+) -> None:
+    """--parametrization: what a search moves."""
+    # Names only: building the parser loads no estimator.
+    from spiralid.choices import PARAMETRIZATION_NAMES
+
+    p.add_argument(
+        "--parametrization", choices=PARAMETRIZATION_NAMES, default=default, help=help
+    )
+
+
+def _add_out_option(
+    p: argparse.ArgumentParser,
+    default: str | None,
+    help: str = "output directory",
+    metavar: str | None = None,
+) -> None:
+    p.add_argument("--out", default=default, metavar=metavar, help=help)
+
+
+def _add_force_option(p: argparse.ArgumentParser, help: str = _NON_EMPTY) -> None:
+    p.add_argument("--force", action="store_true", help=help)
+
+
+def _add_quiet_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="print no progress, summary or warnings (errors still print)",
+    )
+
+
+def _add_output_options(
+    p: argparse.ArgumentParser,
+    default: str | None,
+    help: str = "output directory",
+    force: str = _NON_EMPTY,
+    metavar: str | None = None,
+) -> None:
+    """--out (`default`, `help`, `metavar`), --force (`force` its help) and
+    --quiet: where a command writes and how much it says."""
+    _add_out_option(p, default, help, metavar)
+    _add_force_option(p, force)
+    _add_quiet_option(p)
+
+
 def _add_initial_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--initial",
@@ -137,9 +250,14 @@ def _one_column(value: str) -> str | int:
     return _column(value)
 
 
-def _add_data_options(p: argparse.ArgumentParser, several_outputs: bool = True) -> None:
-    """--input, --output (several only where the command models several),
-    --ts and the units."""
+def _add_data_options(
+    p: argparse.ArgumentParser, several_outputs: bool = True, positional: bool = True
+) -> None:
+    """DATA, --input, --output (several only where the command models
+    several), --ts and the units. `positional` False leaves DATA out, for a
+    command whose record is an option of its own (``reproduce --data``)."""
+    if positional:
+        p.add_argument("data", help=_DATA_HELP)
     p.add_argument(
         "--input",
         type=_column,
@@ -224,14 +342,6 @@ def _open_folder(path: str, force: bool):
 def _save_figures(figures: dict, folder: Path, prefix: str = "") -> None:
     for name, fig in figures.items():
         fig.savefig(folder / f"{prefix}{name}.png", dpi=110)
-
-
-def _add_quiet_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--quiet",
-        action="store_true",
-        help="print no progress, summary or warnings (errors still print)",
-    )
 
 
 def _progress(args):
