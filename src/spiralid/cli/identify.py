@@ -21,12 +21,14 @@ from .options import (
     _command,
     _detrended,
     _given,
+    _interval,
     _listing,
     _load_data,
     _open_folder,
     _orders,
     _positive_int,
     _progress,
+    _refuse_inapplicable,
     _refuse_unused,
     _save_figures,
 )
@@ -38,16 +40,7 @@ def _structure(args):
     return ARX(args.na, args.nb, args.nk)
 
 
-def _holdout(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not 0.0 <= v < 0.5:
-        import argparse
-
-        raise argparse.ArgumentTypeError(f"must be a number in [0, 0.5); got {text!r}")
-    return v
+_holdout = _interval(0.0, 0.5)
 
 
 def _time_constant(text: str) -> float | str | None:
@@ -517,13 +510,9 @@ def _check_shared_options(args, est) -> None:
         )
     takes = shared_options(args.method)
     refused = [f for f in _given(args, *_OPTION_FLAGS) if _OPTION_FLAGS[f] not in takes]
-    if refused:
-        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
-        verb = "does" if len(refused) == 1 else "do"
-        raise UsageError(
-            f"{', '.join(refused)} {verb} not apply to --method {args.method} on "
-            f"{outputs}; the options that do: {', '.join(able)}"
-        )
+    _refuse_inapplicable(
+        refused, _OPTION_FLAGS, takes, f"--method {args.method} on {outputs}"
+    )
 
 
 def _check_options(args) -> None:
@@ -558,13 +547,8 @@ def _check_options(args) -> None:
     if refused:
         flags = [f for f, name in _OPTION_FLAGS.items() if name in refused]
         takes = identify_options(method, structure, args.refine)
-        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
         kind = "" if model == "arx" else f" --model {model}"
-        verb = "does" if len(flags) == 1 else "do"
-        raise UsageError(
-            f"{', '.join(flags)} {verb} not apply to --method {method}{kind}; "
-            f"the options that do: {', '.join(able)}"
-        )
+        _refuse_inapplicable(flags, _OPTION_FLAGS, takes, f"--method {method}{kind}")
 
 
 def run(args, argv: list[str]) -> int:

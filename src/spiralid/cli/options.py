@@ -43,6 +43,21 @@ def _refuse_unused(flags: list[str], where: str) -> None:
         raise UsageError(f"{', '.join(flags)} {verb} {where}")
 
 
+def _refuse_inapplicable(
+    flags: list[str], table: dict[str, str], takes, where: str
+) -> None:
+    """Refuse `flags`, which do not apply to `where` (e.g. "--method ls"),
+    naming the options that do: those of `table` (flag -> the library's
+    option name) whose names are in `takes`."""
+    if flags:
+        able = [f for f, name in table.items() if name in takes]
+        verb = "does" if len(flags) == 1 else "do"
+        raise UsageError(
+            f"{', '.join(flags)} {verb} not apply to {where}; "
+            f"the options that do: {', '.join(able)}"
+        )
+
+
 def _column(value: str) -> str | int:
     """A column given by name, or by 0-based index when it is all digits."""
     return int(value) if value.isdigit() else value
@@ -95,6 +110,24 @@ def _ratio(text: str) -> float:
 
 
 _fraction = _number(_ratio, "in (0, 1), e.g. 0.5 or 2/3", lambda v: 0 < v < 1)
+
+
+def _interval(low: float, high: float):
+    """An argparse type: a number in [`low`, `high`), with one message for
+    text that is not a number and for a number outside."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not low <= value < high:
+            raise argparse.ArgumentTypeError(
+                f"must be a number in [{low:g}, {high:g}); got {text!r}"
+            )
+        return value
+
+    return parse
 
 
 def _orders(text: str) -> list[int]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 
@@ -22,6 +21,7 @@ from .options import (
     _command,
     _detrended,
     _given,
+    _interval,
     _listing,
     _load_data,
     _nonneg_float,
@@ -30,6 +30,7 @@ from .options import (
     _orders,
     _positive_int,
     _progress,
+    _refuse_inapplicable,
 )
 
 
@@ -37,14 +38,7 @@ def _objectives(text: str) -> tuple[str, ...]:
     return tuple(v.strip() for v in text.split(",") if v.strip())
 
 
-def _coherence(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not 0.0 <= v < 1.0:
-        raise argparse.ArgumentTypeError(f"must be a number in [0, 1); got {text!r}")
-    return v
+_coherence = _interval(0.0, 1.0)
 
 
 # Each objective as front.csv names its column (with its unit, as the
@@ -193,12 +187,8 @@ def _check_options(args) -> None:
     if refused:
         flags = [f for f, name in _OPTION_FLAGS.items() if name in refused]
         takes = pareto_options(args.objectives)
-        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
-        verb = "does" if len(flags) == 1 else "do"
-        raise UsageError(
-            f"{', '.join(flags)} {verb} not apply to --objectives "
-            f"{','.join(args.objectives)}; the options that do: {', '.join(able)}"
-        )
+        where = f"--objectives {','.join(args.objectives)}"
+        _refuse_inapplicable(flags, _OPTION_FLAGS, takes, where)
 
 
 def _structures(args) -> tuple:
