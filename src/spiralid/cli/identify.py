@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import shlex
 
@@ -613,7 +614,7 @@ def add_parser(sub) -> None:
     _add_output_options(p, "spiralid-identify")
 
 
-def _add_model_options(p) -> None:
+def _add_model_options(p: argparse.ArgumentParser) -> None:
     """--model, and the options of the NARX families."""
     p.add_argument(
         "--model",
@@ -663,7 +664,7 @@ def _add_model_options(p) -> None:
     )
 
 
-def _add_method_options(p) -> None:
+def _add_method_options(p: argparse.ArgumentParser) -> None:
     """--method and what shapes its cost: predictor, parametrisation, initial
     condition, detrending, polish, stability margin, integrators."""
     # Names only: building the parser loads no estimator (`spiralid --help`
@@ -717,7 +718,7 @@ def _add_method_options(p) -> None:
     )
 
 
-def _add_search_options(p) -> None:
+def _add_search_options(p: argparse.ArgumentParser) -> None:
     """A search's size, budget and seed."""
     _add_points_option(p)
     p.add_argument(

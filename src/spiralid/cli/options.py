@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -44,7 +45,7 @@ def _refuse_unused(flags: list[str], where: str) -> None:
 
 
 def _refuse_inapplicable(
-    flags: list[str], table: dict[str, str], takes, where: str
+    flags: list[str], table: dict[str, str], takes: Collection[str], where: str
 ) -> None:
     """Refuse `flags`, which do not apply to `where` (e.g. "--method ls"),
     naming the options that do: those of `table` (flag -> the library's
@@ -112,7 +113,7 @@ def _ratio(text: str) -> float:
 _fraction = _number(_ratio, "in (0, 1), e.g. 0.5 or 2/3", lambda v: 0 < v < 1)
 
 
-def _interval(low: float, high: float):
+def _interval(low: float, high: float) -> Callable[[str], float]:
     """An argparse type: a number in [`low`, `high`), with one message for
     text that is not a number and for a number outside."""
 
@@ -158,11 +159,11 @@ _NON_EMPTY = "write into a non-empty --out"
 
 
 def _command(
-    sub,
+    sub: argparse._SubParsersAction,
     name: str,
     summary: str,
     description: str,
-    run,
+    run: Callable[[argparse.Namespace, list[str]], int],
     formatter: type[argparse.HelpFormatter] = _HelpFormatter,
 ) -> argparse.ArgumentParser:
     """The parser of subcommand `name`, which runs `run(args, argv)`;
@@ -207,7 +208,7 @@ def _add_by_fit_option(p: argparse.ArgumentParser, help: str) -> None:
 
 
 def _add_method_option(
-    p: argparse.ArgumentParser, names, default: str, help: str
+    p: argparse.ArgumentParser, names: Sequence[str], default: str, help: str
 ) -> None:
     """--method among `names` (case-insensitive)."""
     p.add_argument(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import csv
 import json
 
@@ -302,7 +303,7 @@ def add_parser(sub) -> None:
     _add_output_options(p, "spiralid-pareto")
 
 
-def _add_front_options(p) -> None:
+def _add_front_options(p: argparse.ArgumentParser) -> None:
     """What the front spans (--orders, --objectives) and the search that
     finds it (--method, --parametrization)."""
     # Names only: building the parser loads no estimator.
@@ -341,7 +342,7 @@ def _add_front_options(p) -> None:
     )
 
 
-def _add_choice_options(p) -> None:
+def _add_choice_options(p: argparse.ArgumentParser) -> None:
     """Which point of the front is validated, instead of the knee."""
     p.add_argument(
         "--max-frequency",
