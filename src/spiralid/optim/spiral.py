@@ -36,9 +36,7 @@ from spiralid.optim._loop import (
     apply_bounds,
     check_max_time,
     finite_or_inf,
-    moved_into_options,
     point_in_box,
-    refuse_keywords,
     seed_points,
     settings,
     stop_report,
@@ -406,15 +404,6 @@ def _fixed_rotation(rule: StepRateRule, n: int) -> np.ndarray:
 # `options` mapping, as scipy.optimize.minimize takes its solvers' settings.
 MINIMIZE_OPTIONS = {"max_time": None, "target": None, "bounds_policy": "none"}
 
-# Keywords minimize() no longer takes, and what replaced each.
-_REMOVED = {
-    "on_iteration": (
-        "`on_iteration` was removed: use `callback`, whose "
-        "`intermediate_result.search` is the search the hook received"
-    ),
-    **moved_into_options("minimize", MINIMIZE_OPTIONS),
-}
-
 
 def _target(target) -> float | None:
     """`target` as a float (None: no target), or a ValueError naming it."""
@@ -531,7 +520,6 @@ def minimize(
     callback: Callable | None = None,
     restarts: bool | Restarts = False,
     options: dict | None = None,
-    **_removed,
 ) -> OptimiserResult:
     """Minimise ``fun`` with a spiral dynamic algorithm (SDA, Eb-SDA, LASDA).
 
@@ -611,9 +599,6 @@ def minimize(
             What to do with points that leave the box. The paper has no
             bound handling, so ``"none"`` (the default) lets them go.
 
-        They were keywords of their own; passing one so is a one-line
-        TypeError saying to use ``options``.
-
     Returns
     -------
     OptimiserResult
@@ -648,7 +633,6 @@ def minimize(
     ('Target cost reached.', True)
     """
     start = time.perf_counter()
-    refuse_keywords(minimize, _removed, method, MINIMIZE_OPTIONS, _REMOVED)
     opts = settings(options, MINIMIZE_OPTIONS, "the options of minimize()")
     budget = _Budget.check(
         max_iter, n_points, max_nfev, opts["max_time"], opts["target"], start

@@ -143,18 +143,6 @@ class ParetoIdentification:
         """The model at the knee point."""
         return self.models[self.knee]
 
-    def __getattr__(self, name: str):
-        # The selection rules moved to validation/selection.py (one module,
-        # beside choose_order); say where instead of a bare AttributeError.
-        if name == "choose":
-            raise AttributeError(
-                "`ParetoIdentification.choose` was moved: use "
-                "`spiralid.choose(front, minimise, **limits)`"
-            )
-        raise AttributeError(
-            f"{type(self).__name__!r} object has no attribute {name!r}"
-        )
-
 
 def _structures(orders, nk: int | None) -> list[ARX]:
     if isinstance(orders, ARX):
