@@ -201,4 +201,3 @@ def settings(options, defaults: dict, where: str) -> dict:
         )
     refuse_options(options, defaults, where)
     return {**defaults, **options}
-

@@ -341,7 +341,7 @@ def estimate_spiral(
         Polish the centre every this many iterations.
     polish_nfev : int
         Levenberg-Marquardt evaluations per polish (the ARX ``"spiral"``'s
-        option of the same name and meaning; it was ``polish_iterations``).
+        option of the same name and meaning).
         The defaults differ from the ARX method's (every 5 iterations, 10
         evaluations) because each step here is a free run of the network
         with its forward sensitivities, not a projected linear solve; they
