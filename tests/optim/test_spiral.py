@@ -600,7 +600,7 @@ B2 = [(-1, 1)] * 2
 def test_bad_input(kwargs, match):
     args = dict(fun=lambda x: float(x @ x), bounds=B2)
     args.update(kwargs)
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         minimize(args.pop("fun"), args.pop("bounds"), **args)
 
 
@@ -705,5 +705,5 @@ class _Returns(SpiralRule):
 )
 def test_custom_rule_bad_output(out, match):
     search = SpiralSearch(sphere, B2, _Returns(out), n_points=4, vectorized=True)
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         search.step()

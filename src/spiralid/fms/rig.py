@@ -291,14 +291,15 @@ class FlexibleManipulator:
             "friction_substeps",
             integer(self.friction_substeps, "friction_substeps", 1),
         )
+        what = f"`damping_ratio` must be in [0, 1); got {self.damping_ratio!r}"
         try:
             z = nonneg(self.damping_ratio, "damping_ratio")
+        except TypeError:
+            raise TypeError(what) from None
         except ValueError:
             z = math.nan
         if not z < 1.0:
-            raise ValueError(
-                f"`damping_ratio` must be in [0, 1); got {self.damping_ratio!r}"
-            )
+            raise ValueError(what)
         object.__setattr__(self, "damping_ratio", z)
         object.__setattr__(
             self, "n_elements", integer(self.n_elements, "n_elements", 1)
@@ -676,7 +677,7 @@ class FlexibleManipulator:
         if sensors is None:
             sensors = Sensors()
         elif not isinstance(sensors, Sensors):
-            raise ValueError(f"`sensors` must be a Sensors or None; got {sensors!r}")
+            raise TypeError(f"`sensors` must be a Sensors or None; got {sensors!r}")
         n = self.ndof
         if x0 is None:
             x0v = np.zeros(2 * n)
@@ -688,7 +689,7 @@ class FlexibleManipulator:
                     f"({2 * n},); got {x0!r:.80}"
                 )
         if not isinstance(return_state, bool | np.bool_):
-            raise ValueError(
+            raise TypeError(
                 f"`return_state` must be True or False; got {return_state!r}"
             )
         # Checked even without noise, so a bad seed never goes unnoticed.

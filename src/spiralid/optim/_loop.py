@@ -63,9 +63,9 @@ def check_costs(raw, shape: tuple, what: str) -> np.ndarray:
 def check_objective(fun, vectorized) -> bool:
     """Check `fun` is callable and `vectorized` a flag; return the flag."""
     if not callable(fun):
-        raise ValueError(f"`fun` must be callable; got {fun!r}")
+        raise TypeError(f"`fun` must be callable; got {fun!r}")
     if not isinstance(vectorized, bool | np.bool_):
-        raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
+        raise TypeError(f"`vectorized` must be True or False; got {vectorized!r}")
     return bool(vectorized)
 
 
@@ -195,7 +195,7 @@ def settings(options, defaults: dict, where: str) -> dict:
     if options is None:
         return dict(defaults)
     if not isinstance(options, Mapping):
-        raise ValueError(
+        raise TypeError(
             f"`options` must be a mapping of {', '.join(defaults)} or None; "
             f"got {options!r:.80}"
         )

@@ -384,9 +384,9 @@ def minimize_pareto(
     max_time = check_max_time(opts["max_time"])
     neighbours = integer(opts["neighbours"], "neighbours", 2)
     if not isinstance(archive, bool):
-        raise ValueError(f"`archive` must be True or False; got {archive!r}")
+        raise TypeError(f"`archive` must be True or False; got {archive!r}")
     if callback is not None and not callable(callback):
-        raise ValueError(f"`callback` must be callable or None; got {callback!r}")
+        raise TypeError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
     vectorized = check_objective(fun, vectorized)
     ref = _check_ref_point(opts["ref_point"])

@@ -82,7 +82,9 @@ def _parse_method(method) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
     if isinstance(method, str) and method.lower() in _METHODS:
         return _METHODS[method.lower()]()
     names = ", ".join(repr(name) for name in _METHODS)
-    raise ValueError(
+    # An unknown name is a wrong value; anything else a wrong type.
+    error = ValueError if isinstance(method, str) else TypeError
+    raise error(
         f"`method` must be {names}, a SpiralRule or a StepRateRule instance; "
         f"got {method!r}"
     )
@@ -638,7 +640,7 @@ def minimize(
         max_iter, n_points, max_nfev, opts["max_time"], opts["target"], start
     )
     if callback is not None and not callable(callback):
-        raise ValueError(f"`callback` must be callable or None; got {callback!r}")
+        raise TypeError(f"`callback` must be callable or None; got {callback!r}")
     restarts = parse_restarts(restarts)
     rule = _parse_method(method)
     n = box_bounds(bounds)[0].size

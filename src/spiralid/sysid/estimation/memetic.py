@@ -210,7 +210,7 @@ def projected_spiral(
     if polish_every is not None:
         polish_every = integer(polish_every, "polish_every", 1)
     if restarts is not None and not isinstance(restarts, Restarts):
-        raise ValueError(f"`restarts` must be a Restarts or None; got {restarts!r}")
+        raise TypeError(f"`restarts` must be a Restarts or None; got {restarts!r}")
     patience = restarts.patience if isinstance(restarts, PatientRestarts) else None
     rtol = restarts.rtol if patience is not None else RTOL
     # With `patience` a population whose best falls by less than `rtol` has

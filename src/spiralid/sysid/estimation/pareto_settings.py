@@ -105,6 +105,6 @@ def _pareto_settings(method, names, options: dict) -> dict:
     settings = {**_EVERY_DEFAULT, **options}
     seeded = settings["seed_estimates"]
     if not isinstance(seeded, bool | np.bool_):
-        raise ValueError(f"`seed_estimates` must be True or False; got {seeded!r}")
+        raise TypeError(f"`seed_estimates` must be True or False; got {seeded!r}")
     settings["extremes_nfev"] = integer(settings["extremes_nfev"], "extremes_nfev", 0)
     return settings

@@ -231,9 +231,9 @@ def _estimate_recommended(
 
     try:
         _parse_method(rule)
-    except ValueError:
+    except (TypeError, ValueError) as err:
         # Named as this method's option, not as minimize's `method`.
-        raise ValueError(
+        raise type(err)(
             f"`rule` of method 'spiral' must be one of {', '.join(RULES)}, a "
             f"SpiralRule or a StepRateRule instance; got {rule!r}"
         ) from None

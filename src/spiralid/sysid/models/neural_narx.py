@@ -85,7 +85,7 @@ class NARX(_Lags):
         )
         one_of(self.activation, "activation", ACTIVATIONS)
         if not isinstance(self.linear, bool | np.bool_):
-            raise ValueError(f"`linear` must be True or False; got {self.linear!r}")
+            raise TypeError(f"`linear` must be True or False; got {self.linear!r}")
         object.__setattr__(self, "linear", bool(self.linear))
         object.__setattr__(self, "integrator", _integrators(self.integrator))
         if not self.hidden and not self.linear:
