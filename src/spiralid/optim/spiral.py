@@ -76,7 +76,11 @@ require_names(_METHODS, RULE_NAMES, "spiralid.optim.RULES")
 RULES = _METHODS
 
 
-def _parse_method(method) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
+def _parse_method(
+    method, name: str = "method"
+) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
+    """The rule `method` names or is; refused naming `name`, the argument
+    the caller took it as (an estimator's ``rule``, say)."""
     if isinstance(method, SpiralRule | StepRateRule | LearnedMetricSpiral):
         return method
     if isinstance(method, str) and method.lower() in _METHODS:
@@ -85,7 +89,7 @@ def _parse_method(method) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
     # An unknown name is a wrong value; anything else a wrong type.
     error = ValueError if isinstance(method, str) else TypeError
     raise error(
-        f"`method` must be {names}, a SpiralRule or a StepRateRule instance; "
+        f"`{name}` must be {names}, a SpiralRule or a StepRateRule instance; "
         f"got {method!r}"
     )
 

@@ -256,6 +256,12 @@ def _estimate_recommended(
         )
     if frequency_seeds:
         frequency_seeds = integer(frequency_seeds, "frequency_seeds", 0)
+    # Checked before the work shares compute with them, so that a bad size
+    # or budget is named rather than failing in arithmetic; the search
+    # checks them again against each other.
+    integer(n_points, "n_points", 2)
+    if max_nfev is not None:
+        integer(max_nfev, "max_nfev", n_points)
     settings = dict(
         rule=rule,
         n_points=n_points,
