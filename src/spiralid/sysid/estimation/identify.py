@@ -139,7 +139,9 @@ def identify(
         cost, box and initial points, a baseline), ``"ls"`` or ``"oe"`` (see
         :mod:`spiralid.sysid.estimation.estimators`). ``"ls"`` minimises the one-step
         error and ``"oe"`` the simulation error whatever `predictor` says;
-        `predictor` then only selects the reported cost.
+        `predictor` then only selects the reported cost. The default is
+        not ``identify_pareto``'s (``"learned-metric"``): ``"spiral"``
+        minimises one cost, and a front needs a multiobjective search.
     predictor : {"simulation", "one-step"}
         The error of the paper's cost, eq. (2): the free-run simulation
         error or the one-step prediction error.

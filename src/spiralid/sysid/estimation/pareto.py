@@ -279,7 +279,12 @@ def identify_pareto(
         (``"learned-metric"``, the default,
         :data:`~spiralid.optim.pareto.DEFAULT_PARETO_METHOD`; ``"ebsda"``,
         the paper's rule; ``"sda"``, ...) or a rule object, as
-        :func:`~spiralid.optim.pareto.minimize_pareto` takes.
+        :func:`~spiralid.optim.pareto.minimize_pareto` takes. Not
+        ``identify``'s default ``"spiral"``: that method is a search for
+        one cost (a memetic polish, restarts, a held-back choice), while
+        this one approximates a front, and the learned-metric poll is the
+        best front search on the benchmark problems
+        (docs/results/multiobjective.md).
     rng : None, int or numpy.random.Generator
         Seed of the searches (one generator, orders in the given order).
     nk : int, optional
