@@ -85,7 +85,7 @@ def test_unsupported_settings_are_refused_clearly(two_modes, kwargs, match):
     ],
 )
 def test_bad_search_options_are_named(two_modes, kwargs, match):
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         identify(two_modes, ARX4, **kwargs)
 
 
