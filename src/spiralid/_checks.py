@@ -119,15 +119,16 @@ def real_array(value, name: str) -> np.ndarray:
     """
     if isinstance(value, np.ndarray) and value.dtype == np.float64:
         return value
-    what = f"`{name}` must be an array of real numbers; got {value!r:.80}"
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError):  # ragged nested sequences
-        raise ValueError(what) from None
+        arr = None
     # Kinds b, i, u, f convert exactly enough; complex would lose its
     # imaginary part and object/str arrays would fail or become NaN.
-    if arr.dtype.kind not in "biuf":
-        raise TypeError(what)
+    if arr is None or arr.dtype.kind not in "biuf":
+        # The message only when refused: the repr of a long record is slow.
+        error = ValueError if arr is None else TypeError
+        raise error(f"`{name}` must be an array of real numbers; got {value!r:.80}")
     return arr.astype(np.float64, copy=False)
 
 
