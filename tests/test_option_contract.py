@@ -278,6 +278,29 @@ _IDENTIFY_MISUSE = [
 ]
 
 
+@pytest.mark.parametrize(
+    ("structure", "kwargs", "option", "error"),
+    [
+        # The budget rule copies max_nfev into max_iter: max_nfev is named.
+        (ARX2, dict(method="sda", max_nfev="1000"), "max_nfev", TypeError),
+        (ARX2, dict(method="de", max_nfev=1000.0), "max_nfev", TypeError),
+        (ARX2, dict(method="sda", max_nfev=0), "max_nfev", ValueError),
+        (ARX2, dict(method="spiral", max_nfev="1000"), "max_nfev", TypeError),
+        (ARX2, dict(method="spiral", n_points=2.5), "n_points", TypeError),
+        (ARX2, dict(method="sda", n_points="x"), "n_points", TypeError),
+        (NARX2, dict(method="sda", max_nfev="1000"), "max_nfev", TypeError),
+        # The NARX spiral's rule is its `rule`, not minimize's `method`.
+        (NARX2, dict(method="spiral", rule="x"), "rule", ValueError),
+        (NARX2, dict(method="spiral", max_iter="x"), "max_iter", TypeError),
+    ],
+)
+def test_an_error_names_the_argument_passed(record, structure, kwargs, option, error):
+    with pytest.raises((TypeError, ValueError)) as refused:
+        sid.identify(record, structure, **kwargs)
+    assert refused.type is error
+    assert str(refused.value).startswith(f"`{option}` must be")
+
+
 @pytest.mark.parametrize(("structure", "kwargs", "option"), _IDENTIFY_MISUSE)
 def test_identify_misuse_is_one_line_naming_the_option(
     record, structure, kwargs, option
