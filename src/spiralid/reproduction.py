@@ -623,7 +623,7 @@ def _all_outputs_record(data, all_outputs) -> IOData | None:
     """The rig's record of every sensor when `all_outputs` asks for it
     (the same run as :func:`default_data`'s), after its checks."""
     if not isinstance(all_outputs, bool | np.bool_):
-        raise ValueError(f"`all_outputs` must be True or False; got {all_outputs!r}")
+        raise TypeError(f"`all_outputs` must be True or False; got {all_outputs!r}")
     if is_default(all_outputs, False):
         return None
     if data is not None:
@@ -637,7 +637,7 @@ def _all_outputs_record(data, all_outputs) -> IOData | None:
 def _checked_seeds(data, seeds, n_points, max_nfev) -> list[int]:
     """The seeds as a list, after :func:`reproduce`'s argument checks."""
     if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData or None; got {type(data)!r}")
+        raise TypeError(f"`data` must be an IOData or None; got {type(data)!r}")
     seed_list = list(range(seeds)) if isinstance(seeds, int) else list(seeds)
     if not seed_list:
         raise ValueError(f"`seeds` must give at least one seed; got {seeds!r}")

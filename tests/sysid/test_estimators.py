@@ -197,7 +197,7 @@ def test_polish_says_when_it_stopped_at_its_evaluation_cap(record, monkeypatch):
 
 
 def test_bad_safe_start_is_rejected(record):
-    with pytest.raises(ValueError, match="`safe_start` must be True, False or None"):
+    with pytest.raises(TypeError, match="`safe_start` must be True, False or None"):
         identify(record, ARX4, method="sda", safe_start="yes")
 
 

@@ -374,7 +374,7 @@ def test_differential_evolution_shares_the_spiral_methods_start(known):
     ],
 )
 def test_bad_refine_and_rng_are_refused_by_name(known, kwargs, match):
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises(TypeError, match=match):
         identify(known, ARX(2, 2, 1), method="ebsda", **kwargs)
 
 

@@ -113,5 +113,5 @@ def test_bad_arguments_are_refused_by_name(second_order, kwargs, name):
 
 
 def test_data_must_be_a_record():
-    with pytest.raises(ValueError, match="`data` must be an IOData"):
+    with pytest.raises(TypeError, match="`data` must be an IOData"):
         choose_narx(np.zeros(10))

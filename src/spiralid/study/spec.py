@@ -320,7 +320,7 @@ def _optimizer(entry: Any, methods, where: str) -> OptimizerSpec:
     try:
         # Checked here, before any run, as identify() would check each.
         check_method_options(method, options)
-    except ValueError as exc:
+    except (TypeError, ValueError) as exc:
         _fail(where, f"[[optimizer]] {label!r}: {exc}")
     return OptimizerSpec(label, method, refine, float(scale), safe_start, dict(options))
 

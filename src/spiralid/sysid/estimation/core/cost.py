@@ -175,8 +175,8 @@ class PaperCost:
         else:
             try:
                 self.w = positive(gain, "gain")
-            except ValueError:
-                raise ValueError(
+            except (TypeError, ValueError) as err:
+                raise type(err)(
                     f"`gain` must be 'auto' or a finite number > 0; got {gain!r}"
                 ) from None
         # The one-step error always sums over t >= max_lag (all regressors

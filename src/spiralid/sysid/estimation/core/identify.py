@@ -139,7 +139,9 @@ def identify(
         cost, box and initial points, a baseline), ``"ls"`` or ``"oe"`` (see
         :mod:`spiralid.sysid.estimation.core.estimators`). ``"ls"`` minimises the
         one-step error and ``"oe"`` the simulation error whatever `predictor` says;
-        `predictor` then only selects the reported cost.
+        `predictor` then only selects the reported cost. The default is
+        not ``identify_pareto``'s (``"learned-metric"``): ``"spiral"``
+        minimises one cost, and a front needs a multiobjective search.
     predictor : {"simulation", "one-step"}
         The error of the paper's cost, eq. (2): the free-run simulation
         error or the one-step prediction error.
@@ -368,11 +370,9 @@ def _problem(method: str, data: IOData, arx: ARX, given: dict):
     options = {k: v for k, v in given.items() if k not in IDENTIFY_DEFAULTS}
     refine, safe_start = settings["refine"], settings["safe_start"]
     if not isinstance(refine, bool | np.bool_):
-        raise ValueError(f"`refine` must be True or False; got {refine!r}")
+        raise TypeError(f"`refine` must be True or False; got {refine!r}")
     if safe_start is not None and not isinstance(safe_start, bool | np.bool_):
-        raise ValueError(
-            f"`safe_start` must be True, False or None; got {safe_start!r}"
-        )
+        raise TypeError(f"`safe_start` must be True, False or None; got {safe_start!r}")
     parametrization = settings["parametrization"]
     if parametrization is None:
         parametrization = spec.parametrization
@@ -506,7 +506,7 @@ def margin_options(method: str, data: IOData, refine, max_time_constant, cancel)
     if cancel is None:
         cancel = spec.cancel
     elif not isinstance(cancel, bool | np.bool_):
-        raise ValueError(f"`cancel` must be True, False or None; got {cancel!r}")
+        raise TypeError(f"`cancel` must be True, False or None; got {cancel!r}")
     return max_radius(data.ts, seconds), bool(cancel)
 
 

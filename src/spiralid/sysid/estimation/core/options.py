@@ -42,16 +42,6 @@ IDENTIFY_DEFAULTS = dict(
     holdout=0.2,
     decay=1e-3,
 )
-# Names identify's methods no longer take, and what to use instead.
-_RENAMED = {
-    "restart_after": (
-        "`restart_after` of method 'spiral' is now `restarts`: "
-        "restarts=Restarts(stall=k, growth=1) (False for none)"
-    ),
-    "polish_iterations": (
-        "`polish_iterations` of the NARX method 'spiral' is now `polish_nfev`"
-    ),
-}
 
 
 def identify_options(method: str, structure, refine: bool = False) -> tuple[str, ...]:
@@ -130,9 +120,6 @@ def check_method_options(method: str, options: dict, structure=None) -> None:
     never refused."""
     method = _check_method(method)
     structure = ARX(1, 1, 0) if structure is None else structure
-    for name in options:
-        if name in _RENAMED:
-            raise ValueError(_RENAMED[name])
     kind = ""
     if isinstance(structure, NARX | PolynomialNARX):
         if METHODS[method].narx is None:

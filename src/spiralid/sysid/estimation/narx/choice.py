@@ -114,6 +114,64 @@ def _held_back_fit(y: np.ndarray, yhat: np.ndarray) -> float:
     return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / spread))
 
 
+def _held_back(data: IOData, share: float) -> tuple[IOData, np.ndarray]:
+    """The training part of `data` and the held-back output, its last
+    `share`: at least 2 samples, and an output that moves (a fit is scored
+    on it)."""
+    held = round(share * data.n)
+    if held < 2:
+        raise ValueError(
+            f"`holdback` = {share!r} holds back {held} of the {data.n} samples "
+            "of `data`: too few to score a fit (at least 2); raise `holdback` "
+            "or give a longer record"
+        )
+    split = data.n - held
+    train = IOData(data.u[:split], data.y[:split], ts=data.ts)
+    y_end = data.y[split:]
+    if np.ptp(y_end) == 0.0:
+        raise ValueError(
+            f"the held-back output (the last {held} samples of `data`, "
+            f"`holdback` = {share!r}) is constant, every sample {float(y_end[0])!r}: "
+            "no variance to score a fit against; hold back a part where the "
+            "output moves"
+        )
+    return train, y_end
+
+
+def _search(cost, ranges, rule, n_points: int, budget: int, gen) -> str:
+    """The spiral search of `cost` over the `ranges` (lags, hidden units,
+    log10 decay) until `budget` trainings are spent; the message saying
+    what ended it."""
+    lags, hidden, log_decay = ranges
+    # Half a unit beyond each end, so the end values round in as often as
+    # the inner ones.
+    box = np.array(
+        [
+            [lags[0] - 0.5, lags[1] + 0.5],
+            [hidden[0] - 0.5, hidden[1] + 0.5],
+            [math.ceil(2 * log_decay[0]) - 0.5, math.floor(2 * log_decay[1]) + 0.5],
+        ]
+    )
+    try:
+        # Repeats cost no training, so the call cap only ends a search that
+        # keeps landing on choices it has trained.
+        minimize(
+            cost,
+            box,
+            method=rule,
+            # At least 2, as the search needs; a first point beyond the
+            # budget ends the search (budget=1 trains the first point only).
+            n_points=max(2, min(n_points, budget)),
+            max_nfev=50 * budget + n_points,
+            rng=gen,
+            restarts=True,
+        )
+    except _BudgetSpent:
+        trainings = "training" if budget == 1 else "trainings"
+        return f"The budget of {budget} {trainings} was spent."
+    return "The search ended before the budget."
+
+
 def choose_narx(
     data: IOData,
     *,
@@ -195,7 +253,7 @@ def choose_narx(
     """
     t0 = time.perf_counter()
     if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     nk = integer(nk, "nk", 0)
     lags = _range(lags, "lags", 1)
     hidden = _range(hidden, "hidden", 1)
@@ -207,23 +265,8 @@ def choose_narx(
     if not 0.0 < share <= 0.5:
         raise ValueError(f"`holdback` must be a number in (0, 0.5]; got {holdback!r}")
     gen = generator(rng)
-    held = round(share * data.n)
-    if held < 2:
-        raise ValueError(
-            f"`holdback` = {share!r} holds back {held} of the {data.n} samples "
-            "of `data`: too few to score a fit (at least 2); raise `holdback` "
-            "or give a longer record"
-        )
-    split = data.n - held
-    train = IOData(data.u[:split], data.y[:split], ts=data.ts)
-    y_end = data.y[split:]
-    if np.ptp(y_end) == 0.0:
-        raise ValueError(
-            f"the held-back output (the last {held} samples of `data`, "
-            f"`holdback` = {share!r}) is constant, every sample {float(y_end[0])!r}: "
-            "no variance to score a fit against; hold back a part where the "
-            "output moves"
-        )
+    train, y_end = _held_back(data, share)
+    split = train.n
 
     def structure(n: int, h: int) -> NARX:
         return NARX(n, n, nk, hidden=(h,), integrator=integrator)
@@ -255,33 +298,7 @@ def choose_narx(
             trials[key] = _held_back_fit(y_end, model.simulate(data.u)[split:])
         return 100.0 - trials[key]
 
-    # Half a unit beyond each end, so the end values round in as often as
-    # the inner ones.
-    box = np.array(
-        [
-            [lags[0] - 0.5, lags[1] + 0.5],
-            [hidden[0] - 0.5, hidden[1] + 0.5],
-            [math.ceil(2 * log_decay[0]) - 0.5, math.floor(2 * log_decay[1]) + 0.5],
-        ]
-    )
-    message = "The search ended before the budget."
-    try:
-        # Repeats cost no training, so the call cap only ends a search that
-        # keeps landing on choices it has trained.
-        minimize(
-            cost,
-            box,
-            method=rule,
-            # At least 2, as the search needs; a first point beyond the
-            # budget ends the search (budget=1 trains the first point only).
-            n_points=max(2, min(n_points, budget)),
-            max_nfev=50 * budget + n_points,
-            rng=gen,
-            restarts=True,
-        )
-    except _BudgetSpent:
-        trainings = "training" if budget == 1 else "trainings"
-        message = f"The budget of {budget} {trainings} was spent."
+    message = _search(cost, (lags, hidden, log_decay), rule, n_points, budget, gen)
     (n, h, d), fit = max(trials.items(), key=lambda kv: kv[1])
     model = identify(data, structure(n, h), method="oe", decay=10.0**d, rng=gen)
     return OptimiserResult(

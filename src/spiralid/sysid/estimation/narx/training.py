@@ -62,10 +62,12 @@ import numpy as np
 from spiralid._checks import generator, integer
 from spiralid.optim import MINIMIZE_OPTIONS, SpiralSearch, minimize
 from spiralid.optim.result import OptimiserResult
+from spiralid.optim.spiral import _parse_method
 
 from ...data import IOData
 from ...models.narx import NARXModel, PolynomialNARX
 from ..linear.levenberg import levenberg_marquardt
+from ..spiral.population import search_options
 from .frols import frols
 from .problem import (
     _TOL,
@@ -291,7 +293,7 @@ def estimate_search(problem: NARXProblem, *, rule: str, **options) -> OptimiserR
     t0 = time.perf_counter()
     opts = dict(options)
     opts.setdefault("max_nfev", 10_000)
-    opts.setdefault("max_iter", opts["max_nfev"])
+    opts = search_options(opts)
     # identify() takes minimize's `options` keys flat, as its own.
     opts["options"] = {k: opts.pop(k) for k in MINIMIZE_OPTIONS if k in opts}
     box = default_box(problem)
@@ -341,7 +343,7 @@ def estimate_spiral(
         Polish the centre every this many iterations.
     polish_nfev : int
         Levenberg-Marquardt evaluations per polish (the ARX ``"spiral"``'s
-        option of the same name and meaning; it was ``polish_iterations``).
+        option of the same name and meaning).
         The defaults differ from the ARX method's (every 5 iterations, 10
         evaluations) because each step here is a free run of the network
         with its forward sensitivities, not a projected linear solve; they
@@ -373,6 +375,9 @@ def estimate_spiral(
     max_nfev = integer(max_nfev, "max_nfev", n_points)
     polish_every = integer(polish_every, "polish_every", 1)
     polish_nfev = integer(polish_nfev, "polish_nfev", 1)
+    if max_iter is not None:
+        max_iter = integer(max_iter, "max_iter", 1)
+    _parse_method(rule, "rule")
     stopping = stopping_options(max_rounds, patience, patience_share)
     start, refit, linear, what = _starts(problem)
     starts = {"linear": start}

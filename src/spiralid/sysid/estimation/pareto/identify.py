@@ -143,18 +143,6 @@ class ParetoIdentification:
         """The model at the knee point."""
         return self.models[self.knee]
 
-    def __getattr__(self, name: str):
-        # The selection rules moved to validation/selection.py (one module,
-        # beside choose_order); say where instead of a bare AttributeError.
-        if name == "choose":
-            raise AttributeError(
-                "`ParetoIdentification.choose` was moved: use "
-                "`spiralid.choose(front, minimise, **limits)`"
-            )
-        raise AttributeError(
-            f"{type(self).__name__!r} object has no attribute {name!r}"
-        )
-
 
 def _structures(orders, nk: int | None) -> list[ARX]:
     if isinstance(orders, ARX):
@@ -291,7 +279,12 @@ def identify_pareto(
         (``"learned-metric"``, the default,
         :data:`~spiralid.optim.pareto.DEFAULT_PARETO_METHOD`; ``"ebsda"``,
         the paper's rule; ``"sda"``, ...) or a rule object, as
-        :func:`~spiralid.optim.pareto.minimize_pareto` takes.
+        :func:`~spiralid.optim.pareto.minimize_pareto` takes. Not
+        ``identify``'s default ``"spiral"``: that method is a search for
+        one cost (a memetic polish, restarts, a held-back choice), while
+        this one approximates a front, and the learned-metric poll is the
+        best front search on the benchmark problems
+        (docs/results/multiobjective.md).
     rng : None, int or numpy.random.Generator
         Seed of the searches (one generator, orders in the given order).
     nk : int, optional

@@ -64,14 +64,6 @@ _MODEL_DEFAULTS = dict(parametrization="modal", seed_estimates=True, extremes_nf
 _FREQUENCY_DEFAULTS = dict(
     nperseg=None, fmin=None, fmax=None, min_coherence=DEFAULT_MIN_COHERENCE
 )
-# Names this function no longer takes, and what to use instead.
-_RENAMED = {
-    "polish_nfev": (
-        "`polish_nfev` of identify_pareto is now `extremes_nfev` (each "
-        "extreme's polish); `polish_nfev` is the spiral method's budget per "
-        "polish of its centre"
-    ),
-}
 
 
 # Every option of identify_pareto with its default, whatever the objectives:
@@ -104,9 +96,6 @@ def refused_pareto_options(objectives, options: dict) -> list[str]:
 def _pareto_settings(method, names, options: dict) -> dict:
     """`options` checked against :func:`pareto_options` (one line naming an
     option that does not apply), completed with the defaults."""
-    for name in options:
-        if name in _RENAMED:
-            raise ValueError(_RENAMED[name])
     refuse_options(
         options,
         pareto_options(names),
@@ -116,6 +105,6 @@ def _pareto_settings(method, names, options: dict) -> dict:
     settings = {**_EVERY_DEFAULT, **options}
     seeded = settings["seed_estimates"]
     if not isinstance(seeded, bool | np.bool_):
-        raise ValueError(f"`seed_estimates` must be True or False; got {seeded!r}")
+        raise TypeError(f"`seed_estimates` must be True or False; got {seeded!r}")
     settings["extremes_nfev"] = integer(settings["extremes_nfev"], "extremes_nfev", 0)
     return settings

@@ -10,6 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from spiralid._checks import integer
 from spiralid.optim import MINIMIZE_OPTIONS, differential_evolution, minimize
 
 from ..core.problem import EstimatorResult, Problem
@@ -21,6 +22,10 @@ __all__ = ["search_options"]
 def search_options(options: dict) -> dict:
     """The one budget rule: `options` with the iteration cap a budget implies.
 
+    The cap is a copy of ``max_nfev``, so ``max_nfev`` is checked here: a
+    budget of the wrong type or below 1 is refused naming ``max_nfev``, the
+    argument the caller passed, rather than the ``max_iter`` copied from it.
+
     Examples
     --------
     >>> search_options({"n_points": 50, "max_nfev": 20_000})
@@ -29,10 +34,12 @@ def search_options(options: dict) -> dict:
     {'max_nfev': 1000, 'max_iter': 10}
     """
     out = dict(options)
-    if out.get("max_nfev") is not None and out.get("max_iter") is None:
+    budget = out.get("max_nfev")
+    if budget is not None and out.get("max_iter") is None:
+        integer(budget, "max_nfev", 1)
         # Every iteration costs at least one evaluation: this cap never
         # stops a run before its budget does.
-        out["max_iter"] = out["max_nfev"]
+        out["max_iter"] = budget
     return out
 
 
@@ -73,7 +80,7 @@ def _search(
     par = problem.parametrization
     box = par.default_bounds() if problem.bounds is None else problem.bounds
     options = search_options(options)
-    m = int(options.get("n_points", 50))
+    m = integer(options.get("n_points", 50), "n_points", 2)
     x0 = _first_population(problem, box, m, options.pop("x0", None))
     raw = optimiser(par.objective(problem.cost), box, x0=x0, **options)
     theta = par.to_theta(raw.x)

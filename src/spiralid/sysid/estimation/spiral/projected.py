@@ -210,64 +210,20 @@ def projected_spiral(
     if polish_every is not None:
         polish_every = integer(polish_every, "polish_every", 1)
     if restarts is not None and not isinstance(restarts, Restarts):
-        raise ValueError(f"`restarts` must be a Restarts or None; got {restarts!r}")
-    patience = restarts.patience if isinstance(restarts, PatientRestarts) else None
-    rtol = restarts.rtol if patience is not None else RTOL
-    # With `patience` a population whose best falls by less than `rtol` has
-    # converged as far as the search can tell (the final polish takes it
-    # further, to its tolerances); without, only a 1e-9 fall is none.
-    progress = 1e-9 if patience is None else max(float(rtol), 1e-9)
-    n_dim = parametrization.bounds.shape[0]
+        raise TypeError(f"`restarts` must be a Restarts or None; got {restarts!r}")
     max_iter = max_nfev if max_iter is None else integer(max_iter, "max_iter", 1)
-    n_polish = 0
-    stalled, before = 0, np.inf
-    # The best cost when the current population started, and how many
-    # populations in a row have ended without lowering it (`patience`).
-    populations: list[tuple[int, float]] = []
-    at_start, idle, converged, ended = np.inf, 0, False, False
-    tail = (0, np.inf)
+    step = _Memetic(
+        cost,
+        parametrization,
+        polish_every=polish_every,
+        polish_nfev=polish_nfev,
+        max_nfev=max_nfev,
+        restarts=restarts,
+        callback=callback,
+    )
 
     def fun(z):
         return cost(parametrization.to_denominator(z))
-
-    def after_step(intermediate) -> bool:
-        nonlocal n_polish, stalled, before, at_start, idle, converged, ended, tail
-        called = time.perf_counter()
-        search: SpiralSearch = intermediate.search
-        due = polish_every and search.nit % polish_every == 0
-        if due and search.nfev + polish_nfev <= max_nfev:
-            res = gauss_newton_polish(cost, parametrization, search.centre, polish_nfev)
-            n_polish += search.move_centre(res.x, res.fun, nfev=res.nfev)
-        # Progress is a fall of the best cost by more than `progress` of it:
-        # the polish moves the centre by less at every call near a minimum,
-        # and that must not keep a stalled population alive.
-        stalled = 0 if search.fun < before * (1.0 - progress) else stalled + 1
-        before = min(before, search.fun)
-        tail = (search.nfev, search.centre_cost)
-        if restarts is not None and stalled >= restarts.stall_for(n_dim):
-            if not ended:
-                ended = True
-                populations.append((search.nfev, search.centre_cost))
-                # A population that ends within `rtol` of the best it
-                # started from found no new basin (the first starts from
-                # none, so it always counts as new).
-                idle = idle + 1 if search.fun >= at_start * (1.0 - rtol) else 0
-                at_start = min(at_start, search.fun)
-                if patience is not None and idle >= patience:
-                    converged = True
-                    return True
-            size = restarts.next_size(search.n_points)
-            if search.nfev + 2 * size - 1 <= max_nfev:
-                search.restart(size)
-                stalled, ended = 0, False
-        if callback is None:
-            return False
-        # The caller's callback sees the search after the polish and restart.
-        now = search.result(
-            "running", intermediate.elapsed + time.perf_counter() - called
-        )
-        now.search = search
-        return callback(now)
 
     res = minimize(
         fun,
@@ -279,38 +235,142 @@ def projected_spiral(
         rng=rng,
         vectorized=True,
         x0=x0,
-        callback=after_step,
+        callback=step,
         options={"bounds_policy": "clip"},
     )
-    z, nfev = res.x, res.nfev
-    if not ended and np.isfinite(tail[1]):
-        populations.append(tail)
-    if (
-        polish_every
-        and (res.status != 0 or converged)
-        and nfev + polish_nfev <= max_nfev
-    ):
-        end = gauss_newton_polish(cost, parametrization, z, polish_nfev)
-        nfev += end.nfev
-        if end.fun < res.fun:
-            z = end.x
-            n_polish += 1
-    f_best, b_best = cost.evaluate(parametrization.to_denominator(z)[None, :])
-    res.update(
-        x=np.r_[parametrization.to_denominator(z), b_best[0]],
-        fun=float(f_best[0]),
-        z=z,
-        nfev=nfev,
-        n_polish=n_polish,
-        populations=populations,
-        converged=converged,
-        elapsed=time.perf_counter() - t_start,
-    )
-    if converged:
-        res.message = (
-            f"Converged: {patience} population(s) in a row found no basin "
-            f"lower than the best by more than {rtol:g} of its cost."
+    return step.finish(res, t_start)
+
+
+class _Memetic:
+    """The callback :func:`projected_spiral` gives
+    :func:`~spiralid.optim.minimize`: after each iteration the polish of
+    the centre, the restart of a stalled population (and the patience's
+    stop), then the caller's `callback`; and, after the search, the final
+    polish and the result. It keeps the record of the populations."""
+
+    def __init__(
+        self,
+        cost: ProjectedCost,
+        parametrization,
+        *,
+        polish_every: int | None,
+        polish_nfev: int,
+        max_nfev: int,
+        restarts: Restarts | None,
+        callback,
+    ) -> None:
+        self.cost, self.parametrization = cost, parametrization
+        self.polish_every, self.polish_nfev = polish_every, polish_nfev
+        self.max_nfev, self.restarts, self.callback = max_nfev, restarts, callback
+        patient = isinstance(restarts, PatientRestarts)
+        self.patience = restarts.patience if patient else None
+        self.rtol = restarts.rtol if self.patience is not None else RTOL
+        # With `patience` a population whose best falls by less than `rtol`
+        # has converged as far as the search can tell (the final polish
+        # takes it further, to its tolerances); without, only a 1e-9 fall
+        # is none.
+        self.progress = 1e-9 if self.patience is None else max(float(self.rtol), 1e-9)
+        self.n_dim = parametrization.bounds.shape[0]
+        self.n_polish = 0
+        self.stalled, self.before = 0, np.inf
+        # The best cost when the current population started, and how many
+        # populations in a row have ended without lowering it (`patience`).
+        self.populations: list[tuple[int, float]] = []
+        self.at_start, self.idle = np.inf, 0
+        self.converged, self.ended = False, False
+        self.tail = (0, np.inf)
+
+    def __call__(self, intermediate):
+        called = time.perf_counter()
+        search: SpiralSearch = intermediate.search
+        self._polish(search)
+        if self._restart(search):
+            return True
+        if self.callback is None:
+            return False
+        # The caller's callback sees the search after the polish and restart.
+        now = search.result(
+            "running", intermediate.elapsed + time.perf_counter() - called
         )
-    if res.history.size:
-        res.history[-1] = min(res.history[-1], res.fun)
-    return res
+        now.search = search
+        return self.callback(now)
+
+    def _polish(self, search: SpiralSearch) -> None:
+        """Polish the centre when it is due and the budget allows."""
+        due = self.polish_every and search.nit % self.polish_every == 0
+        if due and search.nfev + self.polish_nfev <= self.max_nfev:
+            res = gauss_newton_polish(
+                self.cost, self.parametrization, search.centre, self.polish_nfev
+            )
+            self.n_polish += search.move_centre(res.x, res.fun, nfev=res.nfev)
+
+    def _restart(self, search: SpiralSearch) -> bool:
+        """Restart a stalled population; whether the patience stops the
+        search."""
+        # Progress is a fall of the best cost by more than `progress` of it:
+        # the polish moves the centre by less at every call near a minimum,
+        # and that must not keep a stalled population alive.
+        if search.fun < self.before * (1.0 - self.progress):
+            self.stalled = 0
+        else:
+            self.stalled += 1
+        self.before = min(self.before, search.fun)
+        self.tail = (search.nfev, search.centre_cost)
+        restarts = self.restarts
+        if restarts is None or self.stalled < restarts.stall_for(self.n_dim):
+            return False
+        if not self.ended:
+            self.ended = True
+            self.populations.append((search.nfev, search.centre_cost))
+            # A population that ends within `rtol` of the best it started
+            # from found no new basin (the first starts from none, so it
+            # always counts as new).
+            no_new = search.fun >= self.at_start * (1.0 - self.rtol)
+            self.idle = self.idle + 1 if no_new else 0
+            self.at_start = min(self.at_start, search.fun)
+            if self.patience is not None and self.idle >= self.patience:
+                self.converged = True
+                return True
+        size = restarts.next_size(search.n_points)
+        if search.nfev + 2 * size - 1 <= self.max_nfev:
+            search.restart(size)
+            self.stalled, self.ended = 0, False
+        return False
+
+    def finish(self, res: OptimiserResult, t_start: float) -> OptimiserResult:
+        """`res` of the search completed: the final polish of its best
+        point (budget allowing), the ARX theta and the record."""
+        cost, par = self.cost, self.parametrization
+        z, nfev = res.x, res.nfev
+        if not self.ended and np.isfinite(self.tail[1]):
+            self.populations.append(self.tail)
+        if (
+            self.polish_every
+            and (res.status != 0 or self.converged)
+            and nfev + self.polish_nfev <= self.max_nfev
+        ):
+            end = gauss_newton_polish(cost, par, z, self.polish_nfev)
+            nfev += end.nfev
+            if end.fun < res.fun:
+                z = end.x
+                self.n_polish += 1
+        f_best, b_best = cost.evaluate(par.to_denominator(z)[None, :])
+        res.update(
+            x=np.r_[par.to_denominator(z), b_best[0]],
+            fun=float(f_best[0]),
+            z=z,
+            nfev=nfev,
+            n_polish=self.n_polish,
+            populations=self.populations,
+            converged=self.converged,
+            elapsed=time.perf_counter() - t_start,
+        )
+        if self.converged:
+            res.message = (
+                f"Converged: {self.patience} population(s) in a row found no "
+                f"basin lower than the best by more than {self.rtol:g} of its "
+                "cost."
+            )
+        if res.history.size:
+            res.history[-1] = min(res.history[-1], res.fun)
+        return res

@@ -233,9 +233,9 @@ def _estimate_recommended(
 
     try:
         _parse_method(rule)
-    except ValueError:
+    except (TypeError, ValueError) as err:
         # Named as this method's option, not as minimize's `method`.
-        raise ValueError(
+        raise type(err)(
             f"`rule` of method 'spiral' must be one of {', '.join(RULES)}, a "
             f"SpiralRule or a StepRateRule instance; got {rule!r}"
         ) from None
@@ -258,6 +258,12 @@ def _estimate_recommended(
         )
     if frequency_seeds:
         frequency_seeds = integer(frequency_seeds, "frequency_seeds", 0)
+    # Checked before the work shares compute with them, so that a bad size
+    # or budget is named rather than failing in arithmetic; the search
+    # checks them again against each other.
+    integer(n_points, "n_points", 2)
+    if max_nfev is not None:
+        integer(max_nfev, "max_nfev", n_points)
     settings = dict(
         rule=rule,
         n_points=n_points,
