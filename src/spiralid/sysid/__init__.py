@@ -47,9 +47,7 @@ from .validation.correlation import whiteness_test as whiteness_test
 from .validation.higher_order import BillingsVoon as BillingsVoon
 from .validation.higher_order import billings_voon as billings_voon
 from .validation.nonlinear import NonlinearChecks as NonlinearChecks
-from .validation.outputs import OutputsValidation as OutputsValidation
 from .validation.outputs import joint_fit as joint_fit
-from .validation.outputs import validate_outputs as validate_outputs
 from .validation.selection import choose as choose
 from .validation.selection import choose_order as choose_order
 from .validation.selection import fits_by_order as fits_by_order
@@ -78,7 +76,6 @@ __all__ = [
     "ModeTable",
     "NARXModel",
     "NonlinearChecks",
-    "OutputsValidation",
     "PaperCost",
     "ParetoIdentification",
     "PolynomialNARX",
@@ -118,7 +115,6 @@ __all__ = [
     "step_up",
     "subspace_denominator",
     "validate",
-    "validate_outputs",
     "validation_fits",
     "whiteness_test",
 ]

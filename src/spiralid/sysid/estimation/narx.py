@@ -64,8 +64,7 @@ from spiralid.optim import MINIMIZE_OPTIONS, SpiralSearch, minimize
 from spiralid.optim.result import OptimiserResult
 
 from ..data import IOData
-from ..models.narx import NARXModel, PolynomialNARX
-from .frols import frols
+from ..models.narx import NARXModel
 from .levenberg import levenberg_marquardt
 from .narx_problem import (
     _TOL,
@@ -181,8 +180,6 @@ def estimate_ls(
     -------
     OptimiserResult
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        return frols(problem)
     t0 = time.perf_counter()
     start, refit, linear, what = _starts(problem, "ls")
     options = stopping_options(max_rounds, patience, patience_share)
@@ -226,11 +223,6 @@ def estimate_oe(
         ``linear_cost`` the linear start and its cost, ``kept_linear``
         whether training ended at it.
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        raise ValueError(
-            "method 'oe' trains an MLP NARX; a PolynomialNARX is estimated by "
-            "method 'ls' (forward-regression orthogonal least squares)"
-        )
     t0 = time.perf_counter()
     start, refit, linear, what = _starts(problem)
     options = stopping_options(max_rounds, patience, patience_share)
@@ -283,11 +275,6 @@ def estimate_search(problem: NARXProblem, *, rule: str, **options) -> OptimiserR
     -------
     OptimiserResult
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        raise ValueError(
-            "a PolynomialNARX is estimated by method 'ls' (FROLS); searches "
-            "train an MLP NARX"
-        )
     t0 = time.perf_counter()
     opts = dict(options)
     opts.setdefault("max_nfev", 10_000)
@@ -364,10 +351,6 @@ def estimate_spiral(
     OptimiserResult
         ``start`` names the point whose final polish won.
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        # The default method takes every structure: a polynomial's terms
-        # are chosen by forward regression, which a search would not improve.
-        return frols(problem)
     t0 = time.perf_counter()
     n_points = integer(n_points, "n_points", 2)
     max_nfev = integer(max_nfev, "max_nfev", n_points)

@@ -58,7 +58,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-__all__ = ["FittedModelProtocol"]
+__all__ = ["FittedModelProtocol", "check_fitted", "is_fitted"]
 
 
 @runtime_checkable
@@ -96,3 +96,19 @@ class FittedModelProtocol(Protocol):
     def from_dict(cls, d: dict) -> FittedModelProtocol: ...
 
     def summary(self) -> str: ...
+
+
+def is_fitted(value) -> bool:
+    """Whether `value` implements :class:`FittedModelProtocol` (has every
+    member; a type checker verifies their types)."""
+    return isinstance(value, FittedModelProtocol)
+
+
+def check_fitted(value, name: str = "model") -> None:
+    """`value` implements :class:`FittedModelProtocol`, or a one-line
+    ValueError naming the argument `name` and what `value` is."""
+    if not is_fitted(value):
+        raise ValueError(
+            f"`{name}` must be a fitted model (from identify() or load_model); "
+            f"got {type(value).__name__}"
+        )
