@@ -76,7 +76,7 @@ def identify_ls(data, structure):
 
 @pytest.mark.parametrize("family", FAMILIES)
 def test_the_fit_implements_the_protocol(fitted, family):
-    model, est, _ = fitted[family]
+    model = fitted[family][0]
     assert is_fitted(model)
     assert family_of(model.structure, len(model.output_names)) == family
     assert model.params.ndim == 1 and np.all(np.isfinite(model.params))
@@ -110,7 +110,10 @@ def test_the_json_form_reads_back(fitted, family, tmp_path):
     model, est, _ = fitted[family]
     path = tmp_path / "model.json"
     path.write_text(json.dumps(model.to_dict()))
-    for back in (sid.load_model(json.loads(path.read_text())), sid.load_model(path)):
+    for back in (
+        sid.sysid.load_model(json.loads(path.read_text())),
+        sid.sysid.load_model(path),
+    ):
         assert type(back) is type(model)
         np.testing.assert_array_equal(back.params, model.params)
         np.testing.assert_allclose(back.simulate(est.u), model.simulate(est.u))
@@ -142,7 +145,11 @@ def test_bad_input_is_refused_in_one_line(fitted, family):
 def test_the_command_line_identifies_then_validates(family, tmp_path):
     _, outputs, flags = CASES[family]
     rec = _record(outputs)
-    columns = {"y": rec.y} if outputs == 1 else dict(zip(rec.output_names, rec.y.T))
+    columns = (
+        {"y": rec.y}
+        if outputs == 1
+        else dict(zip(rec.output_names, rec.y.T, strict=True))
+    )
     np.savez(tmp_path / "rec.npz", u=rec.u, ts=rec.ts, **columns)
     out = run("identify", "rec.npz", "--method", "ls", *flags, "--out", "m",
               "--quiet", cwd=tmp_path)  # fmt: skip

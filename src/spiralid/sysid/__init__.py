@@ -33,6 +33,7 @@ from .models.polynomials import max_pole_radius as max_pole_radius
 from .models.polynomials import random_stable_polynomial as random_stable_polynomial
 from .models.polynomials import step_down as step_down
 from .models.polynomials import step_up as step_up
+from .models.protocol import FittedModelProtocol as FittedModelProtocol
 from .models.shared import SharedDenominatorModel as SharedDenominatorModel
 from .models.shared import SharedModes as SharedModes
 
@@ -70,6 +71,7 @@ __all__ = [
     "CorrelationTest",
     "EstimatorResult",
     "FittedModel",
+    "FittedModelProtocol",
     "IOData",
     "IdentifiedModel",
     "ModalParametrization",

@@ -1,8 +1,12 @@
-"""Estimators: one function per method, chosen by name from :data:`METHODS`.
+"""The ARX estimators: one function per method, chosen by name from
+:data:`METHODS`.
 
-As ``scipy.optimize`` has one ``_minimize_<method>`` per method,
-:func:`~spiralid.sysid.identify` checks its arguments, gathers them in a
-:class:`Problem` and calls ``METHODS[method].estimate(problem, **options)``.
+As ``scipy.optimize`` has one ``_minimize_<method>`` per method, the ARX
+family's fit (:func:`~spiralid.sysid.estimation.arx_fit.fit_arx`, the ARX
+entries of :data:`~spiralid.sysid.estimation.families.ESTIMATORS`) gathers
+identify's checked arguments in a :class:`Problem` and calls
+``METHODS[method].estimate(problem, **options)``. Other families' estimators
+are their entries in that table.
 Every estimator returns an :class:`EstimatorResult`, an ``OptimizeResult``
 whose ``x`` is the ARX theta.
 
