@@ -56,7 +56,7 @@ from .frols import frols
 from .problem import IDENTIFY_DEFAULTS
 from .shared import SHARED_METHODS, identify_shared, shared_options
 
-__all__ = ["ESTIMATORS", "Estimator", "estimator", "family_of"]
+__all__ = ["ESTIMATORS", "Estimator", "arx_estimator", "estimator", "family_of"]
 
 
 @dataclass(frozen=True)
@@ -101,6 +101,13 @@ def _arx_options(method: str, refine=False) -> tuple[str, ...]:
     if spec.cancel:
         out.append("cancel")
     return (*out, *method_options(method))
+
+
+def arx_estimator(method: str) -> Estimator:
+    """The ARX family's entry for `method`, a key of
+    :data:`~.estimators.METHODS` (a method added to that table joins this
+    one through it)."""
+    return Estimator(fit_arx, partial(_arx_options, method))
 
 
 # -- NARX and polynomial NARX ---------------------------------------------------
@@ -179,10 +186,7 @@ def _fit_shared(data, structure, method, given):
 
 #: ``(family, method) -> Estimator``: the one table identify reads.
 ESTIMATORS: dict[tuple[str, str], Estimator] = {
-    **{
-        ("arx", name): Estimator(fit_arx, partial(_arx_options, name))
-        for name in METHODS
-    },
+    **{("arx", name): arx_estimator(name) for name in METHODS},
     **{
         ("narx", name): _narx_entry(
             partial(_narx.estimate_search, rule=name), _MINIMIZE_OPTIONS
@@ -221,10 +225,12 @@ def family_of(structure, n_outputs: int = 1) -> str | None:
     takes one output); a one-line ValueError for what is not a
     structure."""
     family = getattr(structure, "family", None)
-    if not any(f == family for f, _ in ESTIMATORS):
+    families = tuple(dict.fromkeys(f for f, _ in ESTIMATORS))
+    if family not in families:
         raise ValueError(
-            "`structure` must be a model structure (ARX, NARX, PolynomialNARX); "
-            f"got {type(structure).__name__}"
+            "`structure` must be a model structure of a family of the estimator "
+            f"table {families} (ARX, NARX, PolynomialNARX...); got "
+            f"{type(structure).__name__}"
         )
     return structure.outputs_family if n_outputs > 1 else family
 

@@ -57,6 +57,7 @@ from spiralid._checks import refuse_options
 from ..data import IOData, single_output_record
 from ..models.arx import ARX
 from ..models.identified import IdentifiedModel
+from ..models.narx import NARX, PolynomialNARX
 from ..models.protocol import FittedModelProtocol
 from .estimators import DEFAULT_METHOD
 from .families import estimator, family_of
@@ -86,7 +87,7 @@ __all__ = [
 
 def identify(
     data: IOData,
-    structure: ARX,
+    structure: ARX | NARX | PolynomialNARX,
     method: str = DEFAULT_METHOD,
     *,
     predictor: str = "simulation",

@@ -64,7 +64,17 @@ __all__ = ["FittedModelProtocol", "check_fitted", "is_fitted"]
 @runtime_checkable
 class FittedModelProtocol(Protocol):
     """What every fitted model answers, whatever its family (see the
-    module docstring for each name's meaning)."""
+    module docstring for each name's meaning).
+
+    A protocol is not instantiated: ``isinstance(model,
+    FittedModelProtocol)`` (or :func:`is_fitted`) asks whether a model has
+    every member.
+
+    Parameters
+    ----------
+    *args, **kwargs
+        None taken (a protocol class cannot be instantiated).
+    """
 
     method: str
     ts: float

@@ -83,19 +83,27 @@ def validate(
 
     Parameters
     ----------
-    model : IdentifiedModel or NARXModel
+    model : FittedModelProtocol
         From :func:`~spiralid.sysid.identify` or
-        :func:`~spiralid.sysid.load_model`: an ARX model (anything with
-        ``theta``, ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
-        ``predict(data)``, ``poles``, ``zeros``) or a nonlinear one (its
-        ``structure.is_linear`` false: NARX, polynomial NARX). Both get the
-        same :class:`Validation`; a linear model's has its poles, modes and
-        realisation tests, a nonlinear model's its ``nonlinear`` part (the
-        Billings-Voon tests, the network's gain over its linear start).
-        `max_damping` (modes from poles) does not apply to a nonlinear
-        model: a value other than its default is refused in one line.
+        :func:`~spiralid.sysid.load_model`, of any family (it implements
+        :class:`~spiralid.sysid.models.protocol.FittedModelProtocol`): a
+        linear model (ARX) or a nonlinear one (``is_linear`` false: NARX,
+        polynomial NARX). Every model gets the same :class:`Validation`; a
+        linear model's has its poles, modes and realisation tests, a
+        nonlinear model's its ``nonlinear`` part (the Billings-Voon tests,
+        the network's gain over its linear start). `max_damping` (modes
+        from poles) does not apply to a nonlinear model: a value other than
+        its default is refused in one line. A model of several outputs
+        (:class:`~spiralid.sysid.SharedDenominatorModel`) is validated
+        output by output (``model.output_model(name)`` on ``data.output(name)``,
+        with every option here): its :class:`Validation` holds each
+        output's in ``outputs``, the joint fit as ``fit_percent``
+        (:func:`~spiralid.sysid.validation.outputs.joint_fit`) and the
+        model's modes as ``mode_table``.
     data : IOData
-        The validation record, usually the last third (the paper's split).
+        The validation record, usually the last third (the paper's split);
+        for a model of several outputs, a record holding each of them by
+        name.
         The model is run from zero initial conditions over it.
     lags : int, default 25
         Correlation lags: autocorrelation at ``1..lags``, cross-correlation at
@@ -138,7 +146,8 @@ def validate(
     Returns
     -------
     Validation
-        One type for every structure (see :class:`Validation`).
+        One type for every model, of one output or several (see
+        :class:`Validation`).
 
     Raises
     ------
