@@ -10,7 +10,7 @@ from scipy import signal
 from spiralid.report.output import _html, results_dict
 from spiralid.reproduction import Configuration, reproduce
 from spiralid.sysid import ARX, IdentifiedModel, IOData, validate
-from spiralid.sysid.estimation import estimators, families
+from spiralid.sysid.estimation import estimators
 from spiralid.sysid.models.polynomials import format_pole_radius
 
 # The best Eb-SDA (w x 0.1) model of a default `spiralid reproduce` run: a
@@ -83,10 +83,6 @@ def test_results_json_and_the_report_say_the_same(data, monkeypatch):
     monkeypatch.setitem(
         estimators.METHODS, "unstable", _fixed(_outside(MARGINAL, 1 + 1e-6))
     )
-    for name in ("marginal", "unstable"):
-        monkeypatch.setitem(
-            families.ESTIMATORS, ("arx", name), families.arx_estimator(name)
-        )
     rep = reproduce(
         data,
         seeds=1,
