@@ -12,6 +12,7 @@ import numpy as np
 
 from ..models.modes import ModeTable
 from ..models.polynomials import format_pole_radius
+from ..models.shared import SharedModes
 from ..spectra import PSD, Modes, Peaks
 from .correlation import CorrelationTest
 from .fit import _format_fit
@@ -118,10 +119,11 @@ class Validation:
         spiral searches): the noise is not modelled, so the whiteness test
         does not apply to it and its one-step prediction is not what it
         promises (the summary leaves both out and says why).
-    mode_table : ModeTable or None
+    mode_table : ModeTable, SharedModes or None
         *Linear.* The model's modes with 95 % intervals and flags
         (:attr:`~spiralid.sysid.IdentifiedModel.modes`), when the model has
-        a covariance.
+        a covariance; for a model of several outputs, its shared modes with
+        each one's share per output.
     reduction : str or None
         *Linear.* What the estimation's pole-zero cancellation removed
         (:attr:`~spiralid.sysid.IdentifiedModel.reduction`), or None.
@@ -184,7 +186,7 @@ class Validation:
     fit_percent_measured: float = float("nan")
     diverged: bool = False
     output_error: bool = False
-    mode_table: ModeTable | None = None
+    mode_table: ModeTable | SharedModes | None = None
     reduction: str | None = None
     choice: str | None = None
     nonlinear: NonlinearChecks | None = None
