@@ -34,7 +34,7 @@ from scipy.signal import lfilter
 
 import spiralid.datasets
 from spiralid.sysid import ARX, IOData, PaperCost, identify, validate
-from spiralid.sysid.estimation.parametrizations import (
+from spiralid.sysid.estimation.linear.parametrizations import (
     default_bounds,
     feasible_initial_points,
 )

@@ -97,11 +97,11 @@ import numpy as np
 
 from spiralid.optim import Restarts, minimize
 from spiralid.sysid import ARX, IOData, PaperCost, identify
-from spiralid.sysid.estimation.identify import default_bounds
-from spiralid.sysid.estimation.memetic import projected_spiral
-from spiralid.sysid.estimation.modal import ModalParametrization
-from spiralid.sysid.estimation.spiral_method import SPIRAL_STOPS
-from spiralid.sysid.estimation.varpro import ProjectedCost
+from spiralid.sysid.estimation.core.identify import default_bounds
+from spiralid.sysid.estimation.linear.modal import ModalParametrization
+from spiralid.sysid.estimation.linear.varpro import ProjectedCost
+from spiralid.sysid.estimation.spiral.projected import projected_spiral
+from spiralid.sysid.estimation.spiral.recommended import SPIRAL_STOPS
 from spiralid.sysid.models.polynomials import fold_reflection, step_up
 from spiralid.sysid.validation.validate import fit_percent
 
@@ -226,7 +226,7 @@ def _identify(method, parametrization=None, budget_cap=None, **kw):
 def _cma_coefficients(est, seed, budget):
     import cma
 
-    from spiralid.sysid.estimation.parametrizations import Coefficients
+    from spiralid.sysid.estimation.linear.parametrizations import Coefficients
 
     cost = PaperCost(ARX_8, est)
     box = default_bounds(est, ARX_8)

@@ -11,7 +11,7 @@ against the gradient baseline ``"oe"`` and the default ``"spiral"``
 ``--budget`` cost evaluations (a free run of the network each).
 
 (b) **The spiral over the choices.** ``choose_narx``
-(:mod:`spiralid.sysid.estimation.narx_choice`): a learned-metric search
+(:mod:`spiralid.sysid.estimation.narx.choice`): a learned-metric search
 over the lags (1-8), hidden units (1-16) and log10 weight decay (-5 to -1,
 half decades), each point a gradient (``"oe"``) training on the first 3/4
 of the estimation record scored by its free-run fit on the last 1/4; the
@@ -86,8 +86,8 @@ def seeded_search(problem, *, rule: str = "learned-metric", max_nfev: int = 3000
     the linear model's), in the box widened to hold it; no gradient step.
     The NARX estimator protocol of identify_narx (``estimate(problem,
     **options)``)."""
-    from spiralid.sysid.estimation import narx as nx
-    from spiralid.sysid.estimation import narx_starts
+    from spiralid.sysid.estimation.narx import starts as narx_starts
+    from spiralid.sysid.estimation.narx import training as nx
 
     t0 = time.perf_counter()
     linear, what = narx_starts._linear_start(problem)
@@ -115,8 +115,8 @@ def seeded_search(problem, *, rule: str = "learned-metric", max_nfev: int = 3000
 
 
 def fit_weights(method: str, est: IOData, st: NARX, seed: int, budget: int):
-    from spiralid.sysid.estimation.identify import _default_arx
-    from spiralid.sysid.estimation.narx import identify_narx
+    from spiralid.sysid.estimation.core.identify import _default_arx
+    from spiralid.sysid.estimation.narx.training import identify_narx
 
     if method.startswith("learned-metric, seeded"):
         if method.endswith("x budget"):
@@ -209,7 +209,7 @@ def grid_choice(est: IOData, k: int, seed: int, trainings: int):
 def random_choice(est: IOData, k: int, seed: int, trainings: int):
     """`trainings` distinct uniform choices in choose_narx's box, each
     scored as choose_narx scores them; the best refitted."""
-    from spiralid.sysid.estimation.narx_choice import _held_back_fit, round_choice
+    from spiralid.sysid.estimation.narx.choice import _held_back_fit, round_choice
 
     rng = np.random.default_rng(seed)
     train, end = _split(est)
@@ -232,7 +232,7 @@ def random_choice(est: IOData, k: int, seed: int, trainings: int):
 
 
 def spiral_choice(est, k, seed, trainings, rule="learned-metric"):
-    from spiralid.sysid.estimation.narx_choice import choose_narx
+    from spiralid.sysid.estimation.narx.choice import choose_narx
 
     res = choose_narx(
         est,

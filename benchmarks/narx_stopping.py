@@ -36,8 +36,9 @@ from _cli import seed_list
 
 from spiralid.fms import nonlinear_rig, paper_experiment
 from spiralid.sysid import ARX, NARX, fit_percent, identify
-from spiralid.sysid.estimation import narx as narx_mod
-from spiralid.sysid.estimation import narx_problem, narx_starts
+from spiralid.sysid.estimation.narx import problem as narx_problem
+from spiralid.sysid.estimation.narx import starts as narx_starts
+from spiralid.sysid.estimation.narx import training as narx_mod
 
 RECORDS = {
     "nonlinear acc": (True, "end_acceleration", 0),

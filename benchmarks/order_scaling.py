@@ -35,8 +35,8 @@ import numpy as np
 from scipy import optimize, signal
 
 from spiralid.sysid import ARX, identify
-from spiralid.sysid.estimation.cost import auto_gain
-from spiralid.sysid.estimation.outputerror import error_functions
+from spiralid.sysid.estimation.core.cost import auto_gain
+from spiralid.sysid.estimation.linear.outputerror import error_functions
 from spiralid.sysid.models.arx import arx_least_squares
 from spiralid.sysid.validation.validate import fit_percent
 

@@ -290,8 +290,8 @@ def fair_stopping(est: IOData, st: NARX, seed: int):
     part (``holdout=0``). Uses private training code (``narx_starts._with_hidden``,
     ``NARXProblem.polish``); ``st`` without integrator.
     """
-    from spiralid.sysid.estimation.narx_problem import NARXProblem
-    from spiralid.sysid.estimation.narx_starts import _with_hidden
+    from spiralid.sysid.estimation.narx.problem import NARXProblem
+    from spiralid.sysid.estimation.narx.starts import _with_hidden
 
     prob = NARXProblem(est, st, "simulation", "rest", 0.2, np.random.default_rng(seed))
     prob.decay = 1e-3

@@ -17,7 +17,7 @@ hub angle), and the machine load.
 The multistart: least squares, Steiglitz-McBride and 48 random stable
 denominators (``random_stable_polynomial``, seed 0), each with the numerator
 least squares gives for it, polished by output error's local method
-(``estimation.outputerror.local_polish``); the lowest estimation cost.
+(``estimation.linear.outputerror.local_polish``); the lowest estimation cost.
 
 Run: ``python benchmarks/rig_outputs.py [--starts 50]``.
 """
@@ -35,7 +35,7 @@ from scipy import signal
 from spiralid.fms import FlexibleManipulator, paper_experiment
 from spiralid.fms.rig import _OUTPUTS
 from spiralid.sysid import ARX, PaperCost, identify, steiglitz_mcbride, validate
-from spiralid.sysid.estimation.outputerror import local_polish
+from spiralid.sysid.estimation.linear.outputerror import local_polish
 from spiralid.sysid.models.arx import arx_least_squares
 from spiralid.sysid.models.polynomials import random_stable_polynomial
 

@@ -73,7 +73,7 @@ from scipy import stats
 
 from spiralid.fms import FlexibleManipulator, paper_experiment
 from spiralid.sysid import ARX, identify
-from spiralid.sysid.estimation.subspace import subspace_denominator
+from spiralid.sysid.estimation.shared.subspace import subspace_denominator
 from spiralid.sysid.models.modes import mode_table
 
 ZETA = 0.02

@@ -165,7 +165,7 @@ def _oe_variant(data, arx, theta0, initial, kmax=1.0 - 1e-6):
     from scipy import optimize, signal
 
     from spiralid.sysid import step_up
-    from spiralid.sysid.estimation.parametrizations import stabilise
+    from spiralid.sysid.estimation.linear.parametrizations import stabilise
 
     na, t0 = arx.na, arx.max_lag
     ulags = arx.input_lags(data.u)
@@ -208,7 +208,7 @@ def oe_initial_state_study() -> None:
     (from rest over the whole record, last third) and the largest pole
     radius.
     """
-    import spiralid.sysid.estimation.outputerror as mod
+    import spiralid.sysid.estimation.linear.outputerror as mod
     from spiralid.sysid import (
         IdentifiedModel,
         arx_least_squares,

@@ -46,7 +46,7 @@ def _files(sub: str) -> list[Path]:
 
 def test_the_import_reader_sees_relative_imports():
     # Guards the helper the checks below rely on.
-    found = _imports(ROOT / "sysid" / "estimation" / "cost.py")
+    found = _imports(ROOT / "sysid" / "estimation" / "core" / "cost.py")
     assert "spiralid.sysid.models.arx" in found
     assert "spiralid.sysid.data" in found
 

@@ -91,6 +91,17 @@ def test_readme_own_data_commands_run_and_model_json_loads(
     assert "z^8" in capsys.readouterr().out  # the transfer function
 
 
+def test_readme_first_identification_gives_its_figures(tmp_path):
+    run_commands(block(README, "first-identification"), tmp_path)
+    out = tmp_path / "arm-model"
+    validation = json.loads((out / "validation.json").read_text())["validation"]
+    # The README's figures: a fit of 89.7 % and modes at 5.84 and 12.67 Hz.
+    assert abs(validation["fit_percent"] - 89.7) <= 0.5
+    freq = validation["modes"]["frequency_hz"]
+    for f in (5.84, 12.67):
+        assert min(abs(g - f) for g in freq) < 0.05
+
+
 def test_readme_several_outputs_commands_give_the_rigs_modes(tmp_path):
     run_commands(block(README, "outputs-commands"), tmp_path)
     model = json.loads((tmp_path / "rig-modes" / "model.json").read_text())

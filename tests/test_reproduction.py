@@ -144,7 +144,7 @@ def test_bad_input(data):
         reproduce(data, seeds=[], arx=ARX(2, 2, 1))
     with pytest.raises(ValueError, match="`max_nfev`"):
         reproduce(data, max_nfev=1, arx=ARX(2, 2, 1))
-    with pytest.raises(ValueError, match="`data`"):
+    with pytest.raises(TypeError, match="`data`"):
         reproduce(np.zeros(10))
 
 

@@ -79,7 +79,7 @@ def test_off_by_default_and_bad_values_refused_in_one_line():
     rng = np.random.default_rng(7)
     u = rng.standard_normal(300)
     data = IOData(u, lfilter([0.0, 0.5], [1.0, -0.5], u), ts=0.01)
-    with pytest.raises(ValueError) as bad:
+    with pytest.raises(TypeError) as bad:
         reproduce(all_outputs="yes", **SMALL)
     assert str(bad.value).startswith("`all_outputs` must be True or False")
     assert "\n" not in str(bad.value)

@@ -1,17 +1,21 @@
 """Argument checks shared across the package (private leaf): numbers,
 integers, arrays, boxes, a choice among names, options.
 
-Each raises a ``ValueError`` that starts with the argument's name in
-backticks, says what is allowed and shows what came in, so that bad input
-never surfaces as a NumPy or Numba traceback from deep inside a kernel.
+Each raises an error that starts with the argument's name in backticks,
+says what is allowed and shows what came in, so that bad input never
+surfaces as a NumPy or Numba traceback from deep inside a kernel. As in
+SciPy, a value of the wrong type (a string where a number goes, a float
+where an integer goes) is a ``TypeError`` and a value of the right type
+but out of range (a negative size, a NaN, a name not among the choices) a
+``ValueError``; both messages read the same.
 
 This module imports nothing of ours, so ``optim`` and ``fms`` can both use it
 and still depend on nothing else in the package (docs/design-notes.md,
 "Layout and dependencies").
 
 A scalar is a Python or NumPy real number or a 0-d array; strings, bools
-and sequences are refused, and every message says "a finite number" (with
-the allowed range when there is one).
+and sequences are of the wrong type, and every message says "a finite
+number" (with the allowed range when there is one).
 """
 
 from __future__ import annotations
@@ -24,26 +28,25 @@ import numpy as np
 
 def real(value, name: str) -> float:
     """``value`` as a finite Python float."""
-    v = _as_float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"`{name}` must be a finite number; got {value!r}")
-    return v
+    return _ranged(value, name, "", lambda v: True)
 
 
-def _as_float(value) -> float:
-    """``float(value)`` for a real scalar, NaN for anything else."""
+def _as_float(value) -> float | None:
+    """``float(value)`` for a real scalar, None for any other type."""
     if isinstance(value, str | bytes | bool | np.bool_) or np.ndim(value) != 0:
-        return math.nan
+        return None
     try:
         return float(value)
     except (TypeError, ValueError):
-        return math.nan
+        return None
 
 
 def _ranged(value, name: str, allowed: str, ok) -> float:
     v = _as_float(value)
-    if not (math.isfinite(v) and ok(v)):
-        raise ValueError(f"`{name}` must be a finite number {allowed}; got {value!r}")
+    if v is None or not (math.isfinite(v) and ok(v)):
+        error = TypeError if v is None else ValueError
+        what = f"a finite number {allowed}" if allowed else "a finite number"
+        raise error(f"`{name}` must be {what}; got {value!r}")
     return v
 
 
@@ -58,13 +61,14 @@ def nonneg(value, name: str) -> float:
 
 
 def integer(value, name: str, minimum: int) -> int:
-    """``value`` as an int >= ``minimum``; bools and floats are refused."""
+    """``value`` as an int >= ``minimum``; bools and floats are refused
+    (a TypeError)."""
     try:
         if isinstance(value, bool | np.bool_):
             raise TypeError
         out = operator.index(value)
     except TypeError:
-        raise ValueError(
+        raise TypeError(
             f"`{name}` must be an integer >= {minimum}; got {value!r}"
         ) from None
     if out < minimum:
@@ -74,11 +78,12 @@ def integer(value, name: str, minimum: int) -> int:
 
 def one_of(value, name: str, choices) -> str:
     """``value`` if it is one of the strings ``choices`` (a sequence, or a
-    mapping's keys); anything else, a non-string included, is refused with
-    the choices listed."""
+    mapping's keys); anything else is refused with the choices listed: a
+    non-string a TypeError, another string a ValueError."""
     allowed = tuple(choices)
     if not isinstance(value, str) or value not in allowed:
-        raise ValueError(f"`{name}` must be one of {allowed}; got {value!r}")
+        error = ValueError if isinstance(value, str) else TypeError
+        raise error(f"`{name}` must be one of {allowed}; got {value!r}")
     return value
 
 
@@ -97,7 +102,7 @@ def named_index(value, name: str, names) -> int:
                 f"{names}; got {value!r}"
             )
         return int(value)
-    raise ValueError(f"`{name}` must be an index or one of {names}; got {value!r}")
+    raise TypeError(f"`{name}` must be an index or one of {names}; got {value!r}")
 
 
 def is_integer(value) -> bool:
@@ -106,7 +111,8 @@ def is_integer(value) -> bool:
 
 
 def real_array(value, name: str) -> np.ndarray:
-    """``value`` as a float64 array; strings, None, ragged and complex refused.
+    """``value`` as a float64 array; strings, None and complex are refused
+    with a TypeError, ragged sequences with a ValueError.
 
     Cheap for float64 arrays (the hot path of the search): no copy, no
     conversion, no warning filters.
@@ -120,31 +126,37 @@ def real_array(value, name: str) -> np.ndarray:
     # Kinds b, i, u, f convert exactly enough; complex would lose its
     # imaginary part and object/str arrays would fail or become NaN.
     if arr is None or arr.dtype.kind not in "biuf":
-        raise ValueError(
-            f"`{name}` must be an array of real numbers; got {value!r:.80}"
-        )
+        # The message only when refused: the repr of a long record is slow.
+        error = ValueError if arr is None else TypeError
+        raise error(f"`{name}` must be an array of real numbers; got {value!r:.80}")
     return arr.astype(np.float64, copy=False)
 
 
 def generator(rng) -> np.random.Generator:
-    """``numpy.random.default_rng(rng)``, with a clear error for bad seeds."""
+    """``numpy.random.default_rng(rng)``, with a clear error for bad seeds:
+    a TypeError for a seed of the wrong type (a float, a string), a
+    ValueError for a negative integer, as NumPy raises."""
     if isinstance(rng, np.random.Generator):
         return rng
+    what = (
+        "`rng` must be None, a non-negative integer, a SeedSequence or a "
+        f"numpy.random.Generator; got {rng!r}"
+    )
     try:
         if isinstance(rng, bool | float | str | bytes):
             raise TypeError
         return np.random.default_rng(rng)
-    except (TypeError, ValueError):
-        raise ValueError(
-            "`rng` must be None, a non-negative integer, a SeedSequence or a "
-            f"numpy.random.Generator; got {rng!r}"
-        ) from None
+    except TypeError:
+        raise TypeError(what) from None
+    except ValueError:
+        raise ValueError(what) from None
 
 
 def box_bounds(bounds, n: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(low, high)`` of a box given as (low, high) pairs, an (n, 2) array
     or a ``scipy.optimize.Bounds``: finite, ``low < high``, finite widths,
-    and `n` dimensions when `n` is given."""
+    and `n` dimensions when `n` is given. Anything else, or entries that
+    are not numbers, is a TypeError; a wrong shape or values a ValueError."""
     from scipy.optimize import Bounds
 
     what = (
@@ -162,6 +174,8 @@ def box_bounds(bounds, n: int | None = None) -> tuple[np.ndarray, np.ndarray]:
                 )
             lo, hi = (np.array(a) for a in np.broadcast_arrays(lo, hi))
         else:
+            if not isinstance(bounds, list | tuple | np.ndarray):
+                raise TypeError
             arr = np.asarray(bounds, dtype=np.float64)
             if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
                 raise ValueError(f"{what}; got shape {arr.shape}")
@@ -169,7 +183,7 @@ def box_bounds(bounds, n: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     except (TypeError, ValueError) as err:
         if str(err).startswith("`bounds`"):
             raise
-        raise ValueError(f"{what}; got {bounds!r}") from None
+        raise TypeError(f"{what}; got {bounds!r:.80}") from None
     if n is not None and lo.size != n:
         raise ValueError(
             f"`bounds` must have {n} (low, high) pairs; got {lo.size} pairs"

@@ -38,8 +38,8 @@ from spiralid.sysid import (
     arx_least_squares,
     identify,
 )
-from spiralid.sysid.estimation.parametrizations import DEFAULT_PARAMETRIZATION
-from spiralid.sysid.estimation.searches import search_options
+from spiralid.sysid.estimation.linear.parametrizations import DEFAULT_PARAMETRIZATION
+from spiralid.sysid.estimation.spiral.population import search_options
 from spiralid.sysid.validation.validate import Validation, validate
 
 __all__ = [
@@ -108,7 +108,7 @@ class Configuration:
         Polish the search's result locally.
     safe_start : bool or None, default None
         None takes the method's default (off for the paper's methods, see
-        :mod:`spiralid.sysid.estimation.estimators`).
+        :mod:`spiralid.sysid.estimation.core.estimators`).
     """
 
     label: str
@@ -526,7 +526,7 @@ def reproduce(
     max_nfev : int, default 20000
         Budget of cost evaluations of every search run, the same for all so
         that the algorithms compare at equal cost; no iteration cap stops a
-        run first (:func:`spiralid.sysid.estimation.searches.search_options`).
+        run first (:func:`spiralid.sysid.estimation.spiral.population.search_options`).
     n_points : int, default 50
         Search points ``m``.
     arx : ARX, default ARX(8, 8, 0)
@@ -623,7 +623,7 @@ def _all_outputs_record(data, all_outputs) -> IOData | None:
     """The rig's record of every sensor when `all_outputs` asks for it
     (the same run as :func:`default_data`'s), after its checks."""
     if not isinstance(all_outputs, bool | np.bool_):
-        raise ValueError(f"`all_outputs` must be True or False; got {all_outputs!r}")
+        raise TypeError(f"`all_outputs` must be True or False; got {all_outputs!r}")
     if is_default(all_outputs, False):
         return None
     if data is not None:
@@ -637,7 +637,7 @@ def _all_outputs_record(data, all_outputs) -> IOData | None:
 def _checked_seeds(data, seeds, n_points, max_nfev) -> list[int]:
     """The seeds as a list, after :func:`reproduce`'s argument checks."""
     if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData or None; got {type(data)!r}")
+        raise TypeError(f"`data` must be an IOData or None; got {type(data)!r}")
     seed_list = list(range(seeds)) if isinstance(seeds, int) else list(seeds)
     if not seed_list:
         raise ValueError(f"`seeds` must give at least one seed; got {seeds!r}")

@@ -127,5 +127,5 @@ def test_paper_experiment_defaults_are_consistent():
     ],
 )
 def test_bad_signal_arguments_raise(call, match):
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         call()

@@ -73,5 +73,5 @@ def test_callback_stops_the_search_and_seeds_reproduce():
 )
 def test_bad_input(kwargs, match):
     args = {"bounds": [(-1, 1)] * 2, **kwargs}
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         differential_evolution(sphere, **args)

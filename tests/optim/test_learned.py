@@ -390,7 +390,7 @@ def test_x0_seeds_the_first_poll():
     ],
 )
 def test_bad_settings_are_named(kwargs, match):
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         LearnedMetricSpiral(**kwargs)
 
 

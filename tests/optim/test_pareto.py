@@ -322,7 +322,7 @@ def test_learned_metric_poll_finds_the_segment_between_two_rotated_minima():
 
 
 def test_archive_must_be_a_bool():
-    with pytest.raises(ValueError, match="`archive` must be True or False"):
+    with pytest.raises(TypeError, match="`archive` must be True or False"):
         minimize_pareto(_zdt1, [(0, 1)] * 2, n_points=10, max_nfev=40, archive=1)
 
 

@@ -12,7 +12,7 @@ from spiralid.optim import (
     minimize,
 )
 from spiralid.sysid import ARX, IOData, identify
-from spiralid.sysid.estimation.levenberg import levenberg_marquardt
+from spiralid.sysid.estimation.linear.levenberg import levenberg_marquardt
 
 KEYS = ("x", "fun", "status", "success", "message", "nit", "nfev", "n_restarts")
 BOX = [(-5.0, 5.0)] * 3

@@ -102,15 +102,27 @@ def test_rotate_accepts_non_contiguous_and_integer_input():
     )
 
 
-@pytest.mark.parametrize("n", [0, -1, 2.0, True, "3"])
-def test_bad_n(n):
-    with pytest.raises(ValueError, match=r"^`n` must be an integer >= 1; got"):
+@pytest.mark.parametrize(
+    ("n", "error"),
+    [
+        (0, ValueError),
+        (-1, ValueError),
+        (2.0, TypeError),
+        (True, TypeError),
+        ("3", TypeError),
+    ],
+)
+def test_bad_n(n, error):
+    with pytest.raises(error, match=r"^`n` must be an integer >= 1; got"):
         rotation_matrix(n, 0.1)
 
 
-@pytest.mark.parametrize("theta", [np.nan, np.inf, "x", None])
-def test_bad_theta(theta):
-    with pytest.raises(ValueError, match=r"^`theta` must be a finite number"):
+@pytest.mark.parametrize(
+    ("theta", "error"),
+    [(np.nan, ValueError), (np.inf, ValueError), ("x", TypeError), (None, TypeError)],
+)
+def test_bad_theta(theta, error):
+    with pytest.raises(error, match=r"^`theta` must be a finite number"):
         rotation_matrix(3, theta)
 
 
@@ -133,9 +145,9 @@ def test_rotate_rejects_non_finite_and_non_real_input():
         rotate([[np.nan, 1.0]], 0.1)
     with pytest.raises(ValueError, match=r"^`v` must be finite"):
         rotate([1.0, np.inf], 0.1)
-    with pytest.raises(ValueError, match=r"^`v` must be an array of real numbers"):
+    with pytest.raises(TypeError, match=r"^`v` must be an array of real numbers"):
         rotate("ab", 0.1)
-    with pytest.raises(ValueError, match=r"^`v` must be an array of real numbers"):
+    with pytest.raises(TypeError, match=r"^`v` must be an array of real numbers"):
         rotate(np.ones((2, 3)) + 1j, 0.1)
-    with pytest.raises(ValueError, match=r"^`theta` must be an array of real numbers"):
+    with pytest.raises(TypeError, match=r"^`theta` must be an array of real numbers"):
         rotate(np.zeros((2, 3)), "a")

@@ -8,7 +8,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import Bounds
 
-import spiralid.optim
 from spiralid.optim import (
     ConstantSpiral,
     ExponentialSpiral,
@@ -346,22 +345,14 @@ def test_the_callback_may_move_the_centre_of_the_search_it_is_given():
     assert res.nfev == 50 + 4 * 49 + 5
 
 
-def test_the_removed_hook_and_alias_name_their_replacement():
-    with pytest.raises(TypeError, match=r"^`on_iteration` was removed: use `callback`"):
-        minimize(sphere, [(-5, 5)] * 2, on_iteration=print)
-    with pytest.raises(TypeError, match="unexpected keyword argument 'callbak'"):
-        minimize(sphere, [(-5, 5)] * 2, callbak=print)
-    for name in ("max_time", "target", "bounds_policy"):
-        with pytest.raises(TypeError) as moved:
+def test_an_unknown_keyword_is_python_s_one_line_type_error():
+    # The settings of `options` are keys of that mapping, not keywords.
+    for name in ("callbak", "max_time", "target", "bounds_policy"):
+        with pytest.raises(TypeError) as refused:
             minimize(sphere, [(-5, 5)] * 2, **{name: None})
-        message = str(moved.value)
-        assert "\n" not in message
-        assert message.startswith(
-            f"`{name}` of minimize() is now a key of its `options`"
+        assert str(refused.value) == (
+            f"minimize() got an unexpected keyword argument {name!r}"
         )
-    with pytest.raises(AttributeError, match="returns `OptimiserResult`"):
-        spiralid.optim.SpiralResult  # noqa: B018
-    assert "SpiralResult" not in spiralid.optim.__all__
 
 
 def test_callback_sees_the_iteration_that_reaches_the_target():
@@ -609,7 +600,7 @@ B2 = [(-1, 1)] * 2
 def test_bad_input(kwargs, match):
     args = dict(fun=lambda x: float(x @ x), bounds=B2)
     args.update(kwargs)
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         minimize(args.pop("fun"), args.pop("bounds"), **args)
 
 
@@ -714,5 +705,5 @@ class _Returns(SpiralRule):
 )
 def test_custom_rule_bad_output(out, match):
     search = SpiralSearch(sphere, B2, _Returns(out), n_points=4, vectorized=True)
-    with pytest.raises(ValueError, match=match):
+    with pytest.raises((TypeError, ValueError), match=match):
         search.step()

@@ -83,7 +83,7 @@ def test_bad_values_are_named(p):
         p.fun([1.0, np.nan])
     with pytest.raises(ValueError, match=rf"^`x` must be finite for {p.name}"):
         p.fun(np.full((2, 3), np.inf))
-    with pytest.raises(ValueError, match=r"^`x` must be an array of real numbers"):
+    with pytest.raises(TypeError, match=r"^`x` must be an array of real numbers"):
         p.fun("ab")
     with pytest.raises(ValueError, match=r"^`x` must be an array of real numbers"):
         p.fun([[1.0, 2.0], [3.0]])

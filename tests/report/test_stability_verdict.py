@@ -10,7 +10,7 @@ from scipy import signal
 from spiralid.report.output import _html, results_dict
 from spiralid.reproduction import Configuration, reproduce
 from spiralid.sysid import ARX, IdentifiedModel, IOData, validate
-from spiralid.sysid.estimation import estimators
+from spiralid.sysid.estimation.core import estimators
 from spiralid.sysid.models.polynomials import format_pole_radius
 
 # The best Eb-SDA (w x 0.1) model of a default `spiralid reproduce` run: a

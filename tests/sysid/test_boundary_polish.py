@@ -9,14 +9,14 @@ from scipy import linalg, optimize
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IOData
-from spiralid.sysid.estimation.levenberg import _constrained_step
-from spiralid.sysid.estimation.outputerror import (
+from spiralid.sysid.estimation.linear.levenberg import _constrained_step
+from spiralid.sysid.estimation.linear.outputerror import (
     _clip_into_bound,
     _pole_rows,
     error_functions,
     local_polish,
 )
-from spiralid.sysid.estimation.parametrizations import KMAX
+from spiralid.sysid.estimation.linear.parametrizations import KMAX
 
 
 def _qp(upper, qtr, lam, g, h):

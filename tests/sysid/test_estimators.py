@@ -10,19 +10,22 @@ from scipy import optimize, signal
 from spiralid.cli import build_parser
 from spiralid.datasets import robot_arm
 from spiralid.sysid import ARX, IOData, PaperCost, identify, step_up
-from spiralid.sysid.estimation import (
-    estimators,
-    local_estimators,
-    outputerror,
-    parametrizations,
-)
-from spiralid.sysid.estimation.estimators import (
+from spiralid.sysid.estimation.core import estimators
+from spiralid.sysid.estimation.core.estimators import (
     METHODS,
     STATUS,
     EstimatorResult,
     search_options,
 )
-from spiralid.sysid.estimation.parametrizations import PARAMETRIZATIONS, stabilise
+from spiralid.sysid.estimation.linear import (
+    local_estimators,
+    outputerror,
+    parametrizations,
+)
+from spiralid.sysid.estimation.linear.parametrizations import (
+    PARAMETRIZATIONS,
+    stabilise,
+)
 
 SEARCHES = [name for name, m in METHODS.items() if m.search]
 
@@ -194,7 +197,7 @@ def test_polish_says_when_it_stopped_at_its_evaluation_cap(record, monkeypatch):
 
 
 def test_bad_safe_start_is_rejected(record):
-    with pytest.raises(ValueError, match="`safe_start` must be True, False or None"):
+    with pytest.raises(TypeError, match="`safe_start` must be True, False or None"):
         identify(record, ARX4, method="sda", safe_start="yes")
 
 

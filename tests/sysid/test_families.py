@@ -15,7 +15,7 @@ from clitools import run
 from scipy.signal import lfilter
 
 import spiralid as sid
-from spiralid.sysid.estimation.families import ESTIMATORS, family_of
+from spiralid.sysid.estimation.core.families import ESTIMATORS, family_of
 from spiralid.sysid.models.protocol import is_fitted
 
 N = 400

@@ -90,10 +90,6 @@ def test_load_model_reads_a_shared_denominator_model():
     back = load_model(json.loads(json.dumps(model.to_dict())))
     assert isinstance(back, SharedDenominatorModel)
     np.testing.assert_array_equal(back.b, model.b)
-    # A file written when the field was called "kind".
-    old = model.to_dict()
-    old["kind"] = old.pop("model")
-    assert isinstance(load_model(old), SharedDenominatorModel)
 
 
 def _shared(**provenance):

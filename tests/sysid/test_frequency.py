@@ -5,7 +5,7 @@ import pytest
 from scipy.signal import freqz, lfilter
 
 from spiralid.sysid import ARX, IOData
-from spiralid.sysid.estimation.frequency import FrequencyError, h1_estimate
+from spiralid.sysid.estimation.linear.frequency import FrequencyError, h1_estimate
 
 A = [1.0, -1.5, 0.7]
 B = [0.0, 1.0, 0.5]

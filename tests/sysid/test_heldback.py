@@ -1,14 +1,14 @@
 """The recommended method's choice among its distinct minima on the
 held-back end of the estimation record (issue 27, item 3;
-`spiralid.sysid.estimation.heldback`)."""
+`spiralid.sysid.estimation.spiral.heldback`)."""
 
 import numpy as np
 import pytest
 from scipy import signal
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, validate
-from spiralid.sysid.estimation import heldback
-from spiralid.sysid.estimation.cost import PaperCost
+from spiralid.sysid.estimation.core.cost import PaperCost
+from spiralid.sysid.estimation.spiral import heldback
 
 
 def _record(seed=0, n=600, drift=0.0):

@@ -3,7 +3,7 @@ best when another minimum validated better and was not chosen."""
 
 import numpy as np
 
-from spiralid.sysid.estimation import heldback
+from spiralid.sysid.estimation.spiral import heldback
 
 
 def _c(name, held, cost, capped=False):

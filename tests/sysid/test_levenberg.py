@@ -7,7 +7,7 @@ import pytest
 from scipy import optimize
 
 import spiralid
-from spiralid.sysid.estimation.levenberg import (
+from spiralid.sysid.estimation.linear.levenberg import (
     STOPS,
     damped_descent,
     levenberg_marquardt,

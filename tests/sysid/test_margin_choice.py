@@ -1,5 +1,5 @@
 """Keeping or lifting the default stability margin by the held-back end
-(:mod:`spiralid.sysid.estimation.margin_choice`): a plant that needs a pole
+(:mod:`spiralid.sysid.estimation.spiral.margin_choice`): a plant that needs a pole
 slower than the record gets it back, a drift does not, and a time constant
 the user gave is never lifted."""
 
@@ -10,7 +10,7 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, fit_percent, identify, validate
-from spiralid.sysid.estimation.margin_choice import LIFT, slowest_time_constant
+from spiralid.sysid.estimation.spiral.margin_choice import LIFT, slowest_time_constant
 
 TS = 0.002
 

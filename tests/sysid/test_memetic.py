@@ -6,13 +6,13 @@ from scipy.signal import lfilter
 
 from spiralid.optim import Restarts
 from spiralid.sysid import ARX, IOData
-from spiralid.sysid.estimation.memetic import (
+from spiralid.sysid.estimation.linear.modal import ModalParametrization
+from spiralid.sysid.estimation.linear.varpro import ProjectedCost
+from spiralid.sysid.estimation.spiral.projected import (
     PatientRestarts,
     frequency_seeds,
     projected_spiral,
 )
-from spiralid.sysid.estimation.modal import ModalParametrization
-from spiralid.sysid.estimation.varpro import ProjectedCost
 
 # A pure spiral search over the modes; tests set what they exercise.
 PLAIN = dict(n_points=50, polish_every=None, polish_nfev=10, restarts=None)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from spiralid.sysid import is_stable_polynomial
-from spiralid.sysid.estimation.modal import ModalParametrization
+from spiralid.sysid.estimation.linear.modal import ModalParametrization
 
 
 def _roots(a):

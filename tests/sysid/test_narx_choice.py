@@ -8,7 +8,7 @@ import pytest
 from scipy.signal import lfilter
 
 import spiralid as sid
-from spiralid.sysid.estimation.narx_choice import choose_narx, round_choice
+from spiralid.sysid.estimation.narx.choice import choose_narx, round_choice
 
 BOX = dict(lags=(1, 3), hidden=(1, 2), log_decay=(-3.0, -3.0))
 
@@ -113,5 +113,5 @@ def test_bad_arguments_are_refused_by_name(second_order, kwargs, name):
 
 
 def test_data_must_be_a_record():
-    with pytest.raises(ValueError, match="`data` must be an IOData"):
+    with pytest.raises(TypeError, match="`data` must be an IOData"):
         choose_narx(np.zeros(10))

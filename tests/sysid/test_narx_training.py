@@ -9,9 +9,9 @@ from scipy.signal import lfilter
 
 from spiralid.optim.result import OptimiserResult
 from spiralid.sysid import NARX, IOData, identify
-from spiralid.sysid.estimation import narx_problem
-from spiralid.sysid.estimation.narx_problem import NARXProblem
-from spiralid.sysid.estimation.options import identify_options
+from spiralid.sysid.estimation.core.options import identify_options
+from spiralid.sysid.estimation.narx import problem as narx_problem
+from spiralid.sysid.estimation.narx.problem import NARXProblem
 
 
 def _problem(holdout=0.2):
@@ -127,8 +127,8 @@ def test_early_stopping_starts_from_the_training_parts_linear_model():
     # training start is the default ARX of the training part, drawn from
     # the generator after the whole record's (the refit's) start.
     from spiralid.sysid import ARX
-    from spiralid.sysid.estimation.families import _default_arx
-    from spiralid.sysid.estimation.narx_starts import _linear_starts
+    from spiralid.sysid.estimation.core.families import _default_arx
+    from spiralid.sysid.estimation.narx.starts import _linear_starts
 
     data = _linear_record()
     problem = NARXProblem(

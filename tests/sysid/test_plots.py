@@ -98,7 +98,7 @@ def test_pole_zero_map_with_unit_circle_and_several_models():
     assert "1 outside the view, largest |z| = 47" in far.get_title()
     with pytest.raises(ValueError, match="`radius` must be a finite number > 0"):
         plots.plot_pole_zero({"A": ([0.5], [])}, radius=0.0)
-    with pytest.raises(ValueError, match="`models` must be a mapping"):
+    with pytest.raises(TypeError, match="`models` must be a mapping"):
         plots.plot_pole_zero([0.5])
     with pytest.raises(ValueError, match="`models` values must be"):
         plots.plot_pole_zero({"A": 0.5})

@@ -1,5 +1,5 @@
 """One denominator for several outputs (issue 30): the shared-denominator
-cost, estimate and model (`sysid/estimation/shared.py`,
+cost, estimate and model (`sysid/estimation/shared/denominator.py`,
 `sysid/models/shared.py`)."""
 
 import numpy as np
@@ -8,7 +8,7 @@ from scipy import signal
 from two_modes import MODES, TS, A, B, record
 
 from spiralid.sysid import ARX, IOData, PaperCost, identify, validate
-from spiralid.sysid.estimation.shared import SharedProjectedCost
+from spiralid.sysid.estimation.shared.denominator import SharedProjectedCost
 from spiralid.sysid.models.shared import SharedDenominatorModel
 
 
@@ -238,8 +238,11 @@ def test_the_subspace_poles_are_the_true_ones_and_a_short_record_is_refused():
 
 
 def test_output_error_starts_from_the_subspace_poles_too():
-    from spiralid.sysid.estimation.modal import ModalParametrization
-    from spiralid.sysid.estimation.shared import SharedProjectedCost, _subspace_start
+    from spiralid.sysid.estimation.linear.modal import ModalParametrization
+    from spiralid.sysid.estimation.shared.denominator import (
+        SharedProjectedCost,
+        _subspace_start,
+    )
 
     data = record(31)
     par = ModalParametrization(4, TS)

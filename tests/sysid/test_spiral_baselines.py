@@ -13,8 +13,8 @@ import pytest
 from scipy import signal
 
 from spiralid.sysid import ARX, IOData, PaperCost, identify, steiglitz_mcbride
-from spiralid.sysid.estimation.cancellation import CANCEL_COST_SHARE
-from spiralid.sysid.estimation.parametrizations import stabilise
+from spiralid.sysid.estimation.linear.parametrizations import stabilise
+from spiralid.sysid.estimation.spiral.cancellation import CANCEL_COST_SHARE
 from spiralid.sysid.models.polynomials import step_up
 
 ARX441 = ARX(4, 4, 1)
@@ -83,7 +83,7 @@ def _runs(kind: str) -> list[tuple[object, dict[str, float]]]:
 
 def _lowest_cost(fit) -> float:
     """The estimate's cost before the cancellation, or the lowest-cost
-    minimum's when the held-back choice (estimation/heldback.py) took
+    minimum's when the held-back choice (estimation/spiral/heldback.py) took
     another."""
     sel = fit.selection
     if sel is not None and sel["chosen"] != sel["lowest_cost"]:
@@ -108,7 +108,7 @@ def test_spiral_never_ends_above_the_best_baseline(kind):
     assert not above
     for fit, _ in _runs(kind):
         before = fit.result.get("fun_full", fit.cost)
-        # Acting on the modes table's flags (estimation/spurious.py) then
+        # Acting on the modes table's flags (estimation/spiral/spurious.py) then
         # trades at most its likelihood-ratio test's tolerance, the last
         # removal's, on top of the cancellation's share.
         removed = (fit.diagnosis or {}).get("removed") or [{"tolerance": 0.0}]
@@ -159,7 +159,7 @@ def test_output_error_ends_where_no_local_step_improves():
     # (one round of 900 evaluations of the former polish did). Without the
     # stability margin (max_time_constant=None), which would stop that
     # valley at |z| = exp(-ts / T).
-    from spiralid.sysid.estimation import outputerror
+    from spiralid.sysid.estimation.linear import outputerror
 
     est = _lowpass_noise_record(2).split(2 / 3)[0]
     fit = identify(est, ARX441, method="oe", max_time_constant=None)

@@ -16,10 +16,10 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify, validate
-from spiralid.sysid.estimation import spurious
-from spiralid.sysid.estimation.cost import PaperCost
-from spiralid.sysid.estimation.outputerror import local_polish
-from spiralid.sysid.estimation.spurious import (
+from spiralid.sysid.estimation.core.cost import PaperCost
+from spiralid.sysid.estimation.linear.outputerror import local_polish
+from spiralid.sysid.estimation.spiral import spurious
+from spiralid.sysid.estimation.spiral.spurious import (
     LEVEL,
     effective_samples,
     flagged_poles,

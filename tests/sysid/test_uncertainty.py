@@ -13,7 +13,7 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IdentifiedModel, IOData, identify
-from spiralid.sysid.estimation.uncertainty import parameter_covariance
+from spiralid.sysid.estimation.core.uncertainty import parameter_covariance
 from spiralid.sysid.models.modes import mode_table
 
 TS = 0.01

@@ -272,9 +272,9 @@ def test_validate_bad_input():
             validate(m, data, gain=bad)
     with pytest.raises(ValueError, match="`warmup` sample time must match"):
         validate(m, data, warmup=IOData(data.u, data.y, ts=0.5))
-    with pytest.raises(ValueError, match="`data` must be an IOData"):
+    with pytest.raises(TypeError, match="`data` must be an IOData"):
         validate(m, (data.u, data.y))
-    with pytest.raises(ValueError, match="`warmup` must be an IOData"):
+    with pytest.raises(TypeError, match="`warmup` must be an IOData"):
         validate(m, data, warmup=(data.u, data.y))
 
 

@@ -6,8 +6,8 @@ import pytest
 from scipy.signal import lfilter
 
 from spiralid.sysid import ARX, IOData, PaperCost, random_stable_polynomial
-from spiralid.sysid.estimation.modal import ModalParametrization
-from spiralid.sysid.estimation.varpro import ProjectedCost, gauss_newton_polish
+from spiralid.sysid.estimation.linear.modal import ModalParametrization
+from spiralid.sysid.estimation.linear.varpro import ProjectedCost, gauss_newton_polish
 
 
 def _record(n=400, seed=0, noise=0.1):

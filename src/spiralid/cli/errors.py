@@ -49,11 +49,15 @@ def is_user_error(exc: BaseException) -> bool:
 
     A usage error, an operating-system error (a missing file, a full disk,
     a permission) and a ``ValueError`` raised by spiralid's own checks are
-    the user's; a ``ValueError`` raised from inside another library means
-    an input got past our checks, and any other exception is a bug."""
+    the user's, and so is a ``TypeError`` of those checks (a message that
+    starts with the argument's name in backticks, which Python's own
+    TypeErrors never do); a ``ValueError`` raised from inside another
+    library means an input got past our checks, and any other exception is
+    a bug."""
     if isinstance(exc, UsageError | OSError):
         return True
-    if not isinstance(exc, ValueError):
+    named = isinstance(exc, TypeError) and str(exc).startswith("`")
+    if not (isinstance(exc, ValueError) or named):
         return False
     tb = exc.__traceback__
     if tb is None:

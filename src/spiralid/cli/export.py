@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from .errors import UsageError
-from .options import _add_quiet_option, _HelpFormatter
+from .options import _add_output_options, _command, _HelpFormatter
 
 # --to, and the suffix of the file each writes.
 _SUFFIXES = {"tf": ".txt", "json": ".json", "npz": ".npz", "mat": ".mat"}
@@ -178,11 +178,13 @@ def run(args, argv: list[str]) -> int:
 
 
 def add_parser(sub) -> None:
-    p = sub.add_parser(
+    p = _command(
+        sub,
         "export",
-        formatter_class=_Formatter,
-        help="write a model's transfer function as text, JSON, NPZ or MAT",
-        description=_DESCRIPTION,
+        "write a model's transfer function as text, JSON, NPZ or MAT",
+        _DESCRIPTION,
+        run,
+        _Formatter,
     )
     p.add_argument(
         "model", help="a model.json written by `spiralid identify` or `spiralid pareto`"
@@ -193,12 +195,10 @@ def add_parser(sub) -> None:
         default=None,
         help="format (default: from --out's suffix, .json, .npz or .mat; else tf)",
     )
-    p.add_argument(
-        "--out",
-        default=None,
+    _add_output_options(
+        p,
+        None,
+        "file to write (default: none, standard output; needed by npz and mat)",
+        "overwrite --out",
         metavar="FILE",
-        help="file to write (default: none, standard output; needed by npz and mat)",
     )
-    p.add_argument("--force", action="store_true", help="overwrite --out")
-    _add_quiet_option(p)
-    p.set_defaults(run=run)

@@ -2,27 +2,34 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 import shlex
 
 from .errors import UsageError
 from .options import (
+    _add_by_fit_option,
     _add_data_options,
     _add_detrend_option,
+    _add_fraction_option,
     _add_initial_option,
-    _add_quiet_option,
+    _add_method_option,
+    _add_order_options,
+    _add_output_options,
+    _add_parametrization_option,
+    _add_points_option,
+    _add_seed_option,
+    _command,
     _detrended,
-    _fraction,
     _given,
-    _HelpFormatter,
+    _interval,
     _listing,
     _load_data,
-    _nonneg_float,
-    _nonneg_int,
     _open_folder,
     _orders,
     _positive_int,
     _progress,
+    _refuse_inapplicable,
     _refuse_unused,
     _save_figures,
 )
@@ -34,16 +41,7 @@ def _structure(args):
     return ARX(args.na, args.nb, args.nk)
 
 
-def _holdout(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not 0.0 <= v < 0.5:
-        import argparse
-
-        raise argparse.ArgumentTypeError(f"must be a number in [0, 0.5); got {text!r}")
-    return v
+_holdout = _interval(0.0, 0.5)
 
 
 def _time_constant(text: str) -> float | str | None:
@@ -464,7 +462,7 @@ def _option_values(args) -> dict:
 def _identify_options(args, structure) -> dict:
     """What `run` passes to identify(): the options that apply to the
     method and structure (identify_options), less the budgets not given."""
-    from spiralid.sysid.estimation.identify import identify_options
+    from spiralid.sysid.estimation.core.identify import identify_options
 
     takes = identify_options(args.method, structure, args.refine)
     return {
@@ -501,7 +499,10 @@ def _check_candidates(args) -> None:
 def _check_shared_options(args, est) -> None:
     """The method and typed flags a fit of several outputs takes (the
     library's table, shared_options), refused by their flags."""
-    from spiralid.sysid.estimation.shared import SHARED_METHODS, shared_options
+    from spiralid.sysid.estimation.shared.denominator import (
+        SHARED_METHODS,
+        shared_options,
+    )
 
     outputs = f"{est.n_outputs} outputs (one shared denominator)"
     if args.method not in SHARED_METHODS:
@@ -511,13 +512,9 @@ def _check_shared_options(args, est) -> None:
         )
     takes = shared_options(args.method)
     refused = [f for f in _given(args, *_OPTION_FLAGS) if _OPTION_FLAGS[f] not in takes]
-    if refused:
-        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
-        verb = "does" if len(refused) == 1 else "do"
-        raise UsageError(
-            f"{', '.join(refused)} {verb} not apply to --method {args.method} on "
-            f"{outputs}; the options that do: {', '.join(able)}"
-        )
+    _refuse_inapplicable(
+        refused, _OPTION_FLAGS, takes, f"--method {args.method} on {outputs}"
+    )
 
 
 def _check_options(args) -> None:
@@ -525,8 +522,11 @@ def _check_options(args) -> None:
     do, and every typed option identify() would refuse from Python for this
     method and structure (identify_options, the one table), with the
     options that do apply."""
-    from spiralid.sysid.estimation.families import ESTIMATORS, methods_of
-    from spiralid.sysid.estimation.identify import identify_options, refused_options
+    from spiralid.sysid.estimation.core.families import ESTIMATORS, methods_of
+    from spiralid.sysid.estimation.core.identify import (
+        identify_options,
+        refused_options,
+    )
 
     model, method = args.model, args.method
     _check_candidates(args)
@@ -552,13 +552,8 @@ def _check_options(args) -> None:
     if refused:
         flags = [f for f, name in _OPTION_FLAGS.items() if name in refused]
         takes = identify_options(method, structure, args.refine)
-        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
         kind = "" if model == "arx" else f" --model {model}"
-        verb = "does" if len(flags) == 1 else "do"
-        raise UsageError(
-            f"{', '.join(flags)} {verb} not apply to --method {method}{kind}; "
-            f"the options that do: {', '.join(able)}"
-        )
+        _refuse_inapplicable(flags, _OPTION_FLAGS, takes, f"--method {method}{kind}")
 
 
 def run(args, argv: list[str]) -> int:
@@ -603,23 +598,28 @@ def run(args, argv: list[str]) -> int:
     return 0
 
 
-def add_parser(sub) -> None:
-    # Names only: building the parser loads no estimator (`spiralid --help`
-    # stays quick).
-    from spiralid.choices import DEFAULT_METHOD, METHOD_NAMES, PARAMETRIZATION_NAMES
+_DESCRIPTION = (
+    "Estimate an ARX model on the first --fraction of DATA and validate it "
+    "on the rest; write model.json, validation.json, summary.txt and figures "
+    "into --out."
+)
 
-    p = sub.add_parser(
-        "identify",
-        formatter_class=_HelpFormatter,
-        help="identify an ARX model from a data file",
-        description="Estimate an ARX model on the first --fraction of DATA and "
-        "validate it on the rest; write model.json, validation.json, "
-        "summary.txt and figures into --out.",
-    )
-    p.add_argument(
-        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+
+def add_parser(sub) -> None:
+    p = _command(
+        sub, "identify", "identify an ARX model from a data file", _DESCRIPTION, run
     )
     _add_data_options(p)
+    _add_model_options(p)
+    _add_order_options(p)
+    _add_method_options(p)
+    _add_search_options(p)
+    _add_fraction_option(p)
+    _add_output_options(p, "spiralid-identify")
+
+
+def _add_model_options(p: argparse.ArgumentParser) -> None:
+    """--model, and the options of the NARX families."""
     p.add_argument(
         "--model",
         choices=["arx", "narx", "polynomial"],
@@ -640,12 +640,9 @@ def add_parser(sub) -> None:
         help="NARX: several lag counts n (e.g. 2,4,8), each --na n --nb n, for "
         "--by-fit to choose among (default: --na and --nb)",
     )
-    p.add_argument(
-        "--by-fit",
-        type=_nonneg_float,
-        default=None,
-        metavar="POINTS",
-        help="--model narx or polynomial: fit and validate every --lags and "
+    _add_by_fit_option(
+        p,
+        "--model narx or polynomial: fit and validate every --lags and "
         "--hidden candidate, list each, and keep the smallest (fewest parameters; "
         "of equal sizes, the better fit) whose validation fit is within POINTS of "
         "the best (default: none, one structure)",
@@ -669,15 +666,20 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--terms", type=_positive_int, default=10, help="polynomial NARX terms"
     )
-    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
-    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
-    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
-    p.add_argument(
-        "--method",
-        type=str.lower,
-        choices=METHOD_NAMES,
-        default=DEFAULT_METHOD,
-        help="estimator: a search over the paper's cost, least squares or output error",
+
+
+def _add_method_options(p: argparse.ArgumentParser) -> None:
+    """--method and what shapes its cost: predictor, parametrisation, initial
+    condition, detrending, polish, stability margin, integrators."""
+    # Names only: building the parser loads no estimator (`spiralid --help`
+    # stays quick).
+    from spiralid.choices import DEFAULT_METHOD, METHOD_NAMES
+
+    _add_method_option(
+        p,
+        METHOD_NAMES,
+        DEFAULT_METHOD,
+        "estimator: a search over the paper's cost, least squares or output error",
     )
     p.add_argument(
         "--predictor",
@@ -685,11 +687,10 @@ def add_parser(sub) -> None:
         default="simulation",
         help="error of the cost: free-run simulation or one-step prediction",
     )
-    p.add_argument(
-        "--parametrization",
-        choices=PARAMETRIZATION_NAMES,
-        default=None,
-        help="what a search moves: the ARX coefficients (the paper), the "
+    _add_parametrization_option(
+        p,
+        None,
+        "what a search moves: the ARX coefficients (the paper), the "
         "denominator's reflection coefficients or modal frequencies and dampings "
         "(every candidate stable); default the method's own (modal for spiral)",
     )
@@ -719,7 +720,11 @@ def add_parser(sub) -> None:
         "estimates the other poles; with several --output columns one count "
         "each (2,1,0,0), outside the shared --na poles",
     )
-    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+
+
+def _add_search_options(p: argparse.ArgumentParser) -> None:
+    """A search's size, budget and seed."""
+    _add_points_option(p)
     p.add_argument(
         "--iterations",
         type=_positive_int,
@@ -735,14 +740,4 @@ def add_parser(sub) -> None:
         "evaluations for spiral and every NARX search; the others stop at "
         "--iterations)",
     )
-    p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
-    p.add_argument(
-        "--fraction",
-        type=_fraction,
-        default="2/3",
-        help="share of the record that estimates; the rest validates",
-    )
-    p.add_argument("--out", default="spiralid-identify", help="output directory")
-    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    _add_quiet_option(p)
-    p.set_defaults(run=run)
+    _add_seed_option(p)

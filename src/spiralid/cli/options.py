@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -41,6 +42,21 @@ def _refuse_unused(flags: list[str], where: str) -> None:
     if flags:
         verb = "applies" if len(flags) == 1 else "apply"
         raise UsageError(f"{', '.join(flags)} {verb} {where}")
+
+
+def _refuse_inapplicable(
+    flags: list[str], table: dict[str, str], takes: Collection[str], where: str
+) -> None:
+    """Refuse `flags`, which do not apply to `where` (e.g. "--method ls"),
+    naming the options that do: those of `table` (flag -> the library's
+    option name) whose names are in `takes`."""
+    if flags:
+        able = [f for f, name in table.items() if name in takes]
+        verb = "does" if len(flags) == 1 else "do"
+        raise UsageError(
+            f"{', '.join(flags)} {verb} not apply to {where}; "
+            f"the options that do: {', '.join(able)}"
+        )
 
 
 def _column(value: str) -> str | int:
@@ -97,6 +113,24 @@ def _ratio(text: str) -> float:
 _fraction = _number(_ratio, "in (0, 1), e.g. 0.5 or 2/3", lambda v: 0 < v < 1)
 
 
+def _interval(low: float, high: float) -> Callable[[str], float]:
+    """An argparse type: a number in [`low`, `high`), with one message for
+    text that is not a number and for a number outside."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not low <= value < high:
+            raise argparse.ArgumentTypeError(
+                f"must be a number in [{low:g}, {high:g}); got {text!r}"
+            )
+        return value
+
+    return parse
+
+
 def _orders(text: str) -> list[int]:
     """``2:12`` (both ends included) or ``2,4,8``: orders, lags or sizes,
     distinct integers >= 1 (``8`` is one)."""
@@ -114,6 +148,119 @@ def _orders(text: str) -> list[int]:
             f"ranges); got {text!r}"
         )
     return values
+
+
+# -- the options several subcommands share, each defined here once -----------
+# Functions, not argparse parents: a parent's options come first in --help,
+# while each subcommand lists the shared ones among its own.
+
+_DATA_HELP = "CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+_NON_EMPTY = "write into a non-empty --out"
+
+
+def _command(
+    sub: argparse._SubParsersAction,
+    name: str,
+    summary: str,
+    description: str,
+    run: Callable[[argparse.Namespace, list[str]], int],
+    formatter: type[argparse.HelpFormatter] = _HelpFormatter,
+) -> argparse.ArgumentParser:
+    """The parser of subcommand `name`, which runs `run(args, argv)`;
+    `summary` is its line in ``spiralid --help``."""
+    p = sub.add_parser(
+        name, formatter_class=formatter, help=summary, description=description
+    )
+    p.set_defaults(run=run)
+    return p
+
+
+def _add_order_options(p: argparse.ArgumentParser) -> None:
+    """--na, --nb, --nk: the ARX orders and the input delay."""
+    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
+    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
+    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
+
+
+def _add_points_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+
+
+def _add_seed_option(
+    p: argparse.ArgumentParser, help: str = "seed of the search"
+) -> None:
+    p.add_argument("--seed", type=_nonneg_int, default=0, help=help)
+
+
+def _add_fraction_option(
+    p: argparse.ArgumentParser,
+    default: str | None = "2/3",
+    help: str = "share of the record that estimates; the rest validates",
+) -> None:
+    p.add_argument("--fraction", type=_fraction, default=default, help=help)
+
+
+def _add_by_fit_option(p: argparse.ArgumentParser, help: str) -> None:
+    """--by-fit POINTS: choose among candidates by their validation fit."""
+    p.add_argument(
+        "--by-fit", type=_nonneg_float, default=None, metavar="POINTS", help=help
+    )
+
+
+def _add_method_option(
+    p: argparse.ArgumentParser, names: Sequence[str], default: str, help: str
+) -> None:
+    """--method among `names` (case-insensitive)."""
+    p.add_argument(
+        "--method", type=str.lower, choices=names, default=default, help=help
+    )
+
+
+def _add_parametrization_option(
+    p: argparse.ArgumentParser, default: str | None, help: str
+) -> None:
+    """--parametrization: what a search moves."""
+    # Names only: building the parser loads no estimator.
+    from spiralid.choices import PARAMETRIZATION_NAMES
+
+    p.add_argument(
+        "--parametrization", choices=PARAMETRIZATION_NAMES, default=default, help=help
+    )
+
+
+def _add_out_option(
+    p: argparse.ArgumentParser,
+    default: str | None,
+    help: str = "output directory",
+    metavar: str | None = None,
+) -> None:
+    p.add_argument("--out", default=default, metavar=metavar, help=help)
+
+
+def _add_force_option(p: argparse.ArgumentParser, help: str = _NON_EMPTY) -> None:
+    p.add_argument("--force", action="store_true", help=help)
+
+
+def _add_quiet_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help="print no progress, summary or warnings (errors still print)",
+    )
+
+
+def _add_output_options(
+    p: argparse.ArgumentParser,
+    default: str | None,
+    help: str = "output directory",
+    force: str = _NON_EMPTY,
+    metavar: str | None = None,
+) -> None:
+    """--out (`default`, `help`, `metavar`), --force (`force` its help) and
+    --quiet: where a command writes and how much it says."""
+    _add_out_option(p, default, help, metavar)
+    _add_force_option(p, force)
+    _add_quiet_option(p)
 
 
 def _add_initial_option(p: argparse.ArgumentParser) -> None:
@@ -137,9 +284,14 @@ def _one_column(value: str) -> str | int:
     return _column(value)
 
 
-def _add_data_options(p: argparse.ArgumentParser, several_outputs: bool = True) -> None:
-    """--input, --output (several only where the command models several),
-    --ts and the units."""
+def _add_data_options(
+    p: argparse.ArgumentParser, several_outputs: bool = True, positional: bool = True
+) -> None:
+    """DATA, --input, --output (several only where the command models
+    several), --ts and the units. `positional` False leaves DATA out, for a
+    command whose record is an option of its own (``reproduce --data``)."""
+    if positional:
+        p.add_argument("data", help=_DATA_HELP)
     p.add_argument(
         "--input",
         type=_column,
@@ -224,14 +376,6 @@ def _open_folder(path: str, force: bool):
 def _save_figures(figures: dict, folder: Path, prefix: str = "") -> None:
     for name, fig in figures.items():
         fig.savefig(folder / f"{prefix}{name}.png", dpi=110)
-
-
-def _add_quiet_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--quiet",
-        action="store_true",
-        help="print no progress, summary or warnings (errors still print)",
-    )
 
 
 def _progress(args):

@@ -9,13 +9,20 @@ import json
 from .errors import UsageError
 from .identify import _validated, _write_timings, write_arx_model
 from .options import (
+    _add_by_fit_option,
     _add_data_options,
     _add_detrend_option,
-    _add_quiet_option,
+    _add_fraction_option,
+    _add_method_option,
+    _add_order_options,
+    _add_output_options,
+    _add_parametrization_option,
+    _add_points_option,
+    _add_seed_option,
+    _command,
     _detrended,
-    _fraction,
     _given,
-    _HelpFormatter,
+    _interval,
     _listing,
     _load_data,
     _nonneg_float,
@@ -24,6 +31,7 @@ from .options import (
     _orders,
     _positive_int,
     _progress,
+    _refuse_inapplicable,
 )
 
 
@@ -31,14 +39,7 @@ def _objectives(text: str) -> tuple[str, ...]:
     return tuple(v.strip() for v in text.split(",") if v.strip())
 
 
-def _coherence(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        v = float("nan")
-    if not 0.0 <= v < 1.0:
-        raise argparse.ArgumentTypeError(f"must be a number in [0, 1); got {text!r}")
-    return v
+_coherence = _interval(0.0, 1.0)
 
 
 # Each objective as front.csv names its column (with its unit, as the
@@ -164,7 +165,7 @@ def _option_values(args) -> dict:
 def _passed(args) -> dict:
     """What `run` passes to identify_pareto: the options that apply to the
     objectives (pareto_options), as the flags set them."""
-    from spiralid.sysid.estimation.pareto_settings import pareto_options
+    from spiralid.sysid.estimation.pareto.options import pareto_options
 
     takes = pareto_options(args.objectives)
     return {name: v for name, v in _option_values(args).items() if name in takes}
@@ -174,7 +175,7 @@ def _check_options(args) -> None:
     """Refuse every typed flag whose option identify_pareto would refuse
     from Python for these objectives (refused_pareto_options, from the same
     table, pareto_options), naming the flags that do apply."""
-    from spiralid.sysid.estimation.pareto_settings import (
+    from spiralid.sysid.estimation.pareto.options import (
         pareto_options,
         refused_pareto_options,
     )
@@ -187,12 +188,8 @@ def _check_options(args) -> None:
     if refused:
         flags = [f for f, name in _OPTION_FLAGS.items() if name in refused]
         takes = pareto_options(args.objectives)
-        able = [f for f, name in _OPTION_FLAGS.items() if name in takes]
-        verb = "does" if len(flags) == 1 else "do"
-        raise UsageError(
-            f"{', '.join(flags)} {verb} not apply to --objectives "
-            f"{','.join(args.objectives)}; the options that do: {', '.join(able)}"
-        )
+        where = f"--objectives {','.join(args.objectives)}"
+        _refuse_inapplicable(flags, _OPTION_FLAGS, takes, where)
 
 
 def _structures(args) -> tuple:
@@ -256,61 +253,27 @@ def _headline(args, front, chosen: int, why: str) -> str:
     )
 
 
-def add_parser(sub) -> None:
-    from spiralid.choices import (
-        DEFAULT_PARETO_METHOD,
-        OBJECTIVES,
-        PARAMETRIZATION_NAMES,
-        PARETO_METHOD_NAMES,
-    )
+_DESCRIPTION = (
+    "Search a Pareto front of stable ARX models on the first --fraction of "
+    "DATA by the multi-objective spiral search; write front.csv, front.png "
+    "and point-<i>/model.json, and validate the knee (or the --max-frequency "
+    "choice) as `spiralid identify` does."
+)
 
-    p = sub.add_parser(
+
+def add_parser(sub) -> None:
+    p = _command(
+        sub,
         "pareto",
-        formatter_class=_HelpFormatter,
-        help="a Pareto front of ARX models (time and frequency errors)",
-        description="Search a Pareto front of stable ARX models on the first "
-        "--fraction of DATA by the multi-objective spiral search; write "
-        "front.csv, front.png and point-<i>/model.json, and validate the knee "
-        "(or the --max-frequency choice) as `spiralid identify` does.",
-    )
-    p.add_argument(
-        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
+        "a Pareto front of ARX models (time and frequency errors)",
+        _DESCRIPTION,
+        run,
     )
     _add_data_options(p, several_outputs=False)
-    p.add_argument("--na", type=_nonneg_int, default=8, help="poles")
-    p.add_argument("--nb", type=_positive_int, default=8, help="numerator terms")
-    p.add_argument("--nk", type=_nonneg_int, default=0, help="input delay (samples)")
-    p.add_argument(
-        "--orders",
-        type=_orders,
-        default=None,
-        help="several orders n, each ARX(n, n, nk), e.g. 2:12 or 2,4,8; adds the "
-        "number of parameters as an objective (default: none, the one ARX(--na, "
-        "--nb, --nk))",
-    )
-    p.add_argument(
-        "--objectives",
-        type=_objectives,
-        default=("cost", "frequency"),
-        help=f"comma-separated, among {', '.join(OBJECTIVES)} "
-        "(default: cost,frequency)",
-    )
-    p.add_argument(
-        "--method",
-        type=str.lower,
-        choices=PARETO_METHOD_NAMES,
-        default=DEFAULT_PARETO_METHOD,
-        help="spiral rule of the search (ebsda: the paper's Eb-SDA)",
-    )
-    p.add_argument(
-        "--parametrization",
-        choices=PARAMETRIZATION_NAMES,
-        default="modal",
-        help="what the search moves (modal: the denominator's modes, numerator "
-        "projected out)",
-    )
+    _add_order_options(p)
+    _add_front_options(p)
     _add_detrend_option(p)
-    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+    _add_points_option(p)
     p.add_argument(
         "--budget",
         type=_positive_int,
@@ -334,6 +297,53 @@ def add_parser(sub) -> None:
         default=0.5,
         help="frequency bins with lower input-output coherence are not scored",
     )
+    _add_choice_options(p)
+    _add_seed_option(p)
+    _add_fraction_option(p)
+    _add_output_options(p, "spiralid-pareto")
+
+
+def _add_front_options(p: argparse.ArgumentParser) -> None:
+    """What the front spans (--orders, --objectives) and the search that
+    finds it (--method, --parametrization)."""
+    # Names only: building the parser loads no estimator.
+    from spiralid.choices import (
+        DEFAULT_PARETO_METHOD,
+        OBJECTIVES,
+        PARETO_METHOD_NAMES,
+    )
+
+    p.add_argument(
+        "--orders",
+        type=_orders,
+        default=None,
+        help="several orders n, each ARX(n, n, nk), e.g. 2:12 or 2,4,8; adds the "
+        "number of parameters as an objective (default: none, the one ARX(--na, "
+        "--nb, --nk))",
+    )
+    p.add_argument(
+        "--objectives",
+        type=_objectives,
+        default=("cost", "frequency"),
+        help=f"comma-separated, among {', '.join(OBJECTIVES)} "
+        "(default: cost,frequency)",
+    )
+    _add_method_option(
+        p,
+        PARETO_METHOD_NAMES,
+        DEFAULT_PARETO_METHOD,
+        "spiral rule of the search (ebsda: the paper's Eb-SDA)",
+    )
+    _add_parametrization_option(
+        p,
+        "modal",
+        "what the search moves (modal: the denominator's modes, numerator "
+        "projected out)",
+    )
+
+
+def _add_choice_options(p: argparse.ArgumentParser) -> None:
+    """Which point of the front is validated, instead of the knee."""
     p.add_argument(
         "--max-frequency",
         type=_nonneg_float,
@@ -341,23 +351,9 @@ def add_parser(sub) -> None:
         help="validate the lowest-cost point with a frequency error at most this "
         "many dB instead of the knee (default: none, the knee)",
     )
-    p.add_argument(
-        "--by-fit",
-        type=_nonneg_float,
-        default=None,
-        metavar="POINTS",
-        help="validate the lowest order whose lowest-cost model's validation fit "
+    _add_by_fit_option(
+        p,
+        "validate the lowest order whose lowest-cost model's validation fit "
         "is within POINTS of the best order's, instead of the knee (with "
         "--orders; default: none, the knee)",
     )
-    p.add_argument("--seed", type=_nonneg_int, default=0, help="seed of the search")
-    p.add_argument(
-        "--fraction",
-        type=_fraction,
-        default="2/3",
-        help="share of the record that estimates; the rest validates",
-    )
-    p.add_argument("--out", default="spiralid-pareto", help="output directory")
-    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    _add_quiet_option(p)
-    p.set_defaults(run=run)

@@ -9,8 +9,9 @@ from .errors import UsageError
 from .options import (
     _add_data_options,
     _add_initial_option,
-    _add_quiet_option,
-    _HelpFormatter,
+    _add_output_options,
+    _add_points_option,
+    _command,
     _load_data,
     _nonneg_int,
     _open_folder,
@@ -71,22 +72,28 @@ def run(args, argv: list[str]) -> int:
     return 0
 
 
+_DESCRIPTION = (
+    "Identify ARX(8, 8, 0) by SDA and Eb-SDA (paper-faithful and reflection "
+    "parametrisations, refine, gain sensitivity) over several seeds at an "
+    "equal budget, beside least squares and output error; write Table-2, "
+    "Figures 6-7, results.json and report.html into --out."
+)
+
+
 def add_parser(sub) -> None:
-    p = sub.add_parser(
+    p = _command(
+        sub,
         "reproduce",
-        formatter_class=_HelpFormatter,
-        help="the paper's SDA vs Eb-SDA experiment with baselines and statistics",
-        description="Identify ARX(8, 8, 0) by SDA and Eb-SDA (paper-faithful and "
-        "reflection parametrisations, refine, gain sensitivity) over several "
-        "seeds at an equal budget, beside least squares and output error; write "
-        "Table-2, Figures 6-7, results.json and report.html into --out.",
+        "the paper's SDA vs Eb-SDA experiment with baselines and statistics",
+        _DESCRIPTION,
+        run,
     )
     p.add_argument("--seeds", type=_positive_int, default=6, help="number of seeds")
     p.add_argument("--first-seed", type=_nonneg_int, default=0, help="first seed")
     p.add_argument(
         "--budget", type=_positive_int, default=20_000, help="cost evaluations per run"
     )
-    p.add_argument("--points", type=_positive_int, default=50, help="search points")
+    _add_points_option(p)
     p.add_argument(
         "--workers",
         type=_positive_int,
@@ -99,7 +106,7 @@ def add_parser(sub) -> None:
         help="your own CSV/NPZ/MAT record, or 'robot_arm' (the shipped DaISy arm) "
         "(default: the simulated rig's paper experiment)",
     )
-    _add_data_options(p, several_outputs=False)
+    _add_data_options(p, several_outputs=False, positional=False)
     _add_initial_option(p)
     p.add_argument(
         "--all-outputs",
@@ -109,7 +116,4 @@ def add_parser(sub) -> None:
         "one denominator, ARX(10, 10, 1), integrators 2,1,0,0) beside the "
         "paper's single-output model; the simulated rig only",
     )
-    p.add_argument("--out", default="spiralid-reproduce", help="output directory")
-    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    _add_quiet_option(p)
-    p.set_defaults(run=run)
+    _add_output_options(p, "spiralid-reproduce")

@@ -6,10 +6,10 @@ from pathlib import Path
 
 from .errors import UsageError
 from .options import (
-    _add_quiet_option,
-    _HelpFormatter,
+    _add_output_options,
+    _add_seed_option,
+    _command,
     _nonneg_float,
-    _nonneg_int,
     _positive_float,
     _progress,
 )
@@ -124,14 +124,20 @@ def _write_record(rec, path: Path, suffix: str) -> None:
         )
 
 
+_DESCRIPTION = (
+    "Drive the finite-element flexible manipulator rig with a torque signal "
+    "and write time, torque, hub angle, hub velocity and end-point "
+    "acceleration (CSV header carries the units)."
+)
+
+
 def add_parser(sub) -> None:
-    p = sub.add_parser(
+    p = _command(
+        sub,
         "simulate",
-        formatter_class=_HelpFormatter,
-        help="simulate the flexible manipulator rig and write a CSV or NPZ",
-        description="Drive the finite-element flexible manipulator rig with a "
-        "torque signal and write time, torque, hub angle, hub velocity and "
-        "end-point acceleration (CSV header carries the units).",
+        "simulate the flexible manipulator rig and write a CSV or NPZ",
+        _DESCRIPTION,
+        run,
     )
     p.add_argument(
         "--signal",
@@ -189,8 +195,5 @@ def add_parser(sub) -> None:
         default=None,
         help="amplifier saturation (N m); default none",
     )
-    p.add_argument("--seed", type=_nonneg_int, default=0, help="noise seed")
-    p.add_argument("--out", default="rig.csv", help="output file, .csv or .npz")
-    p.add_argument("--force", action="store_true", help="overwrite --out")
-    _add_quiet_option(p)
-    p.set_defaults(run=run)
+    _add_seed_option(p, "noise seed")
+    _add_output_options(p, "rig.csv", "output file, .csv or .npz", "overwrite --out")

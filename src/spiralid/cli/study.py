@@ -7,8 +7,11 @@ from pathlib import Path
 
 from .errors import UsageError
 from .options import (
+    _add_force_option,
+    _add_out_option,
+    _add_output_options,
     _add_quiet_option,
-    _HelpFormatter,
+    _command,
     _positive_int,
     _progress,
 )
@@ -207,16 +210,33 @@ def _check_study_dir(out: Path, store: Path, force: bool) -> None:
         )
 
 
+# A rerun of a study finds its own files in --out (see _check_study_dir).
+_OTHER_FILES = "write into an --out with other files"
+
+
+_DESCRIPTION = (
+    "Run every optimiser of SPEC (a TOML file; default the paper's grid) on "
+    "every reading (record x predictor x parametrisation) and seed, on a Dask "
+    "cluster; each finished run is committed to a SQLite store, so rerunning "
+    "the same command after an interruption computes only what is missing. "
+    "Then write the 'where the claim holds' report."
+)
+
+
+_REPORT_DESCRIPTION = (
+    "Analyse a study's SQLite store: per reading, Eb-SDA against SDA "
+    "(rank-sum test, A12, Holm correction), convergence bands, results.json "
+    "and report.html."
+)
+
+
 def add_parser(sub) -> None:
-    p = sub.add_parser(
+    p = _command(
+        sub,
         "study",
-        formatter_class=_HelpFormatter,
-        help="a study over every reading of the paper's cost, on Dask, resumable",
-        description="Run every optimiser of SPEC (a TOML file; default the "
-        "paper's grid) on every reading (record x predictor x parametrisation) "
-        "and seed, on a Dask cluster; each finished run is committed to a SQLite "
-        "store, so rerunning the same command after an interruption computes "
-        "only what is missing. Then write the 'where the claim holds' report.",
+        "a study over every reading of the paper's cost, on Dask, resumable",
+        _DESCRIPTION,
+        _cmd_study,
     )
     p.add_argument(
         "spec",
@@ -230,7 +250,7 @@ def add_parser(sub) -> None:
         action="store_true",
         help="print the default specification (the paper's grid) and exit",
     )
-    p.add_argument("--out", default="spiralid-study", help="output directory")
+    _add_out_option(p, "spiralid-study")
     p.add_argument(
         "--store",
         default=None,
@@ -254,26 +274,17 @@ def add_parser(sub) -> None:
         help="worker processes of the local cluster (default: CPU count)",
     )
     p.add_argument("--no-report", action="store_true", help="only run and store")
-    p.add_argument(
-        "--force", action="store_true", help="write into an --out with other files"
-    )
+    _add_force_option(p, _OTHER_FILES)
     _add_quiet_option(p)
-    p.set_defaults(run=_cmd_study)
 
-    p = sub.add_parser(
+    p = _command(
+        sub,
         "study-report",
-        formatter_class=_HelpFormatter,
-        help="the report of a study's store",
-        description="Analyse a study's SQLite store: per reading, Eb-SDA "
-        "against SDA (rank-sum test, A12, Holm correction), convergence bands, "
-        "results.json and report.html.",
+        "the report of a study's store",
+        _REPORT_DESCRIPTION,
+        _cmd_study_report,
     )
     p.add_argument("store", help="SQLite store written by `spiralid study`")
-    p.add_argument(
-        "--out", default=None, help="output directory (default: the store's folder)"
+    _add_output_options(
+        p, None, "output directory (default: the store's folder)", _OTHER_FILES
     )
-    p.add_argument(
-        "--force", action="store_true", help="write into an --out with other files"
-    )
-    _add_quiet_option(p)
-    p.set_defaults(run=_cmd_study_report)

@@ -9,10 +9,10 @@ from .errors import UsageError
 from .options import (
     _add_data_options,
     _add_detrend_option,
-    _add_quiet_option,
+    _add_fraction_option,
+    _add_output_options,
+    _command,
     _detrended,
-    _fraction,
-    _HelpFormatter,
     _listing,
     _load_data,
     _open_folder,
@@ -236,24 +236,22 @@ def run(args, argv: list[str]) -> int:
     return 0
 
 
+_DESCRIPTION = (
+    "Fit %, error range, residual tests, spectra, modes, stability and "
+    "realisation tests of MODEL on DATA."
+)
+
+
 def add_parser(sub) -> None:
-    p = sub.add_parser(
-        "validate",
-        formatter_class=_HelpFormatter,
-        help="validate a saved model on a data file",
-        description="Fit %, error range, residual tests, spectra, modes, "
-        "stability and realisation tests of MODEL on DATA.",
+    p = _command(
+        sub, "validate", "validate a saved model on a data file", _DESCRIPTION, run
     )
     p.add_argument("model", help="model.json written by `spiralid identify`")
-    p.add_argument(
-        "data", help="CSV, NPZ or MAT file, or 'robot_arm' (the shipped DaISy arm)"
-    )
     _add_data_options(p)
-    p.add_argument(
-        "--fraction",
-        type=_fraction,
-        default=None,
-        help="run the model over the whole record but score only the part after "
+    _add_fraction_option(
+        p,
+        None,
+        "run the model over the whole record but score only the part after "
         "this share (e.g. 2/3 for the validation third); default: score all",
     )
     _add_detrend_option(
@@ -261,12 +259,9 @@ def add_parser(sub) -> None:
         "; a model.json that records its offsets has them applied anyway, and "
         "one estimated without --detrend refuses it",
     )
-    p.add_argument(
-        "--out",
-        default=None,
-        help="directory for validation.json, summary.txt and figures (default: "
+    _add_output_options(
+        p,
+        None,
+        "directory for validation.json, summary.txt and figures (default: "
         "none, only the summary is printed)",
     )
-    p.add_argument("--force", action="store_true", help="write into a non-empty --out")
-    _add_quiet_option(p)
-    p.set_defaults(run=run)

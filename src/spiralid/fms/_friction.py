@@ -1,7 +1,7 @@
 """Compiled time stepping of the rig with hub friction (Coulomb, Stribeck).
 
 Friction makes the rig nonlinear, so the closed-form linear simulation of
-:func:`spiralid.fms._zoh.simulate_discrete` no longer applies. Each sample
+:func:`spiralid.fms._zoh.simulate_discrete` does not apply. Each sample
 is split into ``m`` sub-steps of the exact zero-order-hold model; on every
 sub-step the friction torque is held constant and chosen implicitly: the
 torque that would stop the hub at the end of the sub-step, clipped to the

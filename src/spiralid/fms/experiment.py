@@ -122,9 +122,7 @@ class Experiment:
         if rig is None:
             rig = FlexibleManipulator()
         elif not isinstance(rig, FlexibleManipulator):
-            raise ValueError(
-                f"`rig` must be a FlexibleManipulator or None; got {rig!r}"
-            )
+            raise TypeError(f"`rig` must be a FlexibleManipulator or None; got {rig!r}")
         return rig.simulate(self.torque(), fs=self.fs, rng=rng, sensors=self.sensors())
 
 

@@ -291,14 +291,15 @@ class FlexibleManipulator:
             "friction_substeps",
             integer(self.friction_substeps, "friction_substeps", 1),
         )
+        what = f"`damping_ratio` must be in [0, 1); got {self.damping_ratio!r}"
         try:
             z = nonneg(self.damping_ratio, "damping_ratio")
+        except TypeError:
+            raise TypeError(what) from None
         except ValueError:
             z = math.nan
         if not z < 1.0:
-            raise ValueError(
-                f"`damping_ratio` must be in [0, 1); got {self.damping_ratio!r}"
-            )
+            raise ValueError(what)
         object.__setattr__(self, "damping_ratio", z)
         object.__setattr__(
             self, "n_elements", integer(self.n_elements, "n_elements", 1)
@@ -660,41 +661,39 @@ class FlexibleManipulator:
         1.0
         """
         fs_v = positive(fs, "fs")
-        u = real_array(torque, "torque")
-        if u.ndim == 2 and u.shape[1] == 1:
-            u = u[:, 0]
-        if u.ndim != 1 or u.size == 0:
-            raise ValueError(
-                "`torque` must be a non-empty 1-D array or (N, 1); "
-                f"got shape {np.shape(torque)}"
-            )
-        if not np.all(np.isfinite(u)):
-            bad = int(np.flatnonzero(~np.isfinite(u))[0])
-            raise ValueError(
-                f"`torque` must be finite; got {float(u[bad])!r} at index {bad}"
-            )
+        u = _torque(torque)
         if sensors is None:
             sensors = Sensors()
         elif not isinstance(sensors, Sensors):
-            raise ValueError(f"`sensors` must be a Sensors or None; got {sensors!r}")
-        n = self.ndof
-        if x0 is None:
-            x0v = np.zeros(2 * n)
-        else:
-            x0v = real_array(x0, "x0")
-            if x0v.shape != (2 * n,) or not np.all(np.isfinite(x0v)):
-                raise ValueError(
-                    f"`x0` must hold {2 * n} finite numbers (q, q'), shape "
-                    f"({2 * n},); got {x0!r:.80}"
-                )
+            raise TypeError(f"`sensors` must be a Sensors or None; got {sensors!r}")
+        x0v = _initial_state(x0, self.ndof)
         if not isinstance(return_state, bool | np.bool_):
-            raise ValueError(
+            raise TypeError(
                 f"`return_state` must be True or False; got {return_state!r}"
             )
         # Checked even without noise, so a bad seed never goes unnoticed.
         gen = generator(rng)
-
         ts = 1.0 / fs_v
+        y, s, scale = self._outputs(u, x0v, ts, sensors, return_state)
+        if not np.all(np.isfinite(y)):
+            # Only absurd inputs get here (a sample time of 1e300 s, torques
+            # near the float limit): say so rather than return NaN.
+            raise ValueError(
+                "`torque` and `fs` drive the model beyond the float range "
+                f"(non-finite samples); got fs={fs!r}, "
+                f"max |torque|={float(np.max(np.abs(u))):g}"
+            )
+        state = None
+        if s is not None:
+            n, phi = self.ndof, self._modal[1]
+            state = np.hstack([s[:, :n] @ phi.T, (s[:, n : 2 * n] * scale) @ phi.T])
+        return _recording(u, y, ts, sensors, gen, state)
+
+    def _outputs(self, u, x0v, ts: float, sensors: Sensors, return_state: bool):
+        """The exact sensor outputs (before noise and quantisation) for the
+        torque `u` from the state `x0v`, the modal states when asked for
+        (else None), and the velocity scale of the modal states."""
+        n = self.ndof
         Ad, Bd, C, D, scale = _discrete(
             self,
             ts,
@@ -705,8 +704,7 @@ class FlexibleManipulator:
         )
         _, phi = self._modal
         M = self.mass_matrix
-        nx = Ad.shape[0]
-        s0 = np.zeros(nx)
+        s0 = np.zeros(Ad.shape[0])
         s0[:n] = phi.T @ (M @ x0v[:n])
         s0[n : 2 * n] = (phi.T @ (M @ x0v[n:])) / scale
         if self.torque_limit is not None:
@@ -715,46 +713,9 @@ class FlexibleManipulator:
             u_applied = u
         if self.has_friction:
             y, s = self._simulate_friction(u_applied, s0, ts, sensors)
-            s = s if return_state else None
-        else:
-            y, s = simulate_discrete(Ad, Bd, C, D, u_applied, s0, return_state)
-        if not np.all(np.isfinite(y)):
-            # Only absurd inputs get here (a sample time of 1e300 s, torques
-            # near the float limit): say so rather than return NaN.
-            raise ValueError(
-                "`torque` and `fs` drive the model beyond the float range "
-                f"(non-finite samples); got fs={fs!r}, "
-                f"max |torque|={float(np.max(np.abs(u))):g}"
-            )
-
-        hub_velocity = y[:, 1]
-        acc = y[:, 2]
-        if sensors.tach_noise > 0.0:
-            hub_velocity = hub_velocity + gen.normal(0.0, sensors.tach_noise, u.size)
-        if sensors.accel_noise > 0.0:
-            acc = acc + gen.normal(0.0, sensors.accel_noise, u.size)
-        nd = len(sensors.deflection_at)
-        further = y[:, 4 + nd :].copy() if sensors.acceleration_at else None
-        if further is not None and sensors.accel_noise > 0.0:
-            # Drawn after the other channels, so their noise is unchanged.
-            further += gen.normal(0.0, sensors.accel_noise, further.shape[::-1]).T
-        state = None
-        if s is not None:
-            state = np.hstack([s[:, :n] @ phi.T, (s[:, n : 2 * n] * scale) @ phi.T])
-        return Recording(
-            t=np.arange(u.size) * ts,
-            u=u.copy(),
-            hub_angle=quantise(y[:, 0], sensors.encoder_resolution),
-            hub_velocity=hub_velocity,
-            end_acceleration=acc,
-            tip_deflection=y[:, 3].copy(),
-            ts=ts,
-            state=state,
-            deflection_at=sensors.deflection_at,
-            deflection=y[:, 4 : 4 + nd].copy() if nd else None,
-            acceleration_at=sensors.acceleration_at,
-            acceleration=further,
-        )
+            return y, (s if return_state else None), scale
+        y, s = simulate_discrete(Ad, Bd, C, D, u_applied, s0, return_state)
+        return y, s, scale
 
     def _simulate_friction(self, u, s0, ts: float, sensors: Sensors):
         """Outputs and states with hub friction, sub-stepped (see
@@ -826,6 +787,70 @@ def nonlinear_rig(**overrides) -> FlexibleManipulator:
     }
     fields.update(overrides)
     return FlexibleManipulator(**fields)
+
+
+def _torque(torque) -> np.ndarray:
+    """`torque` of :meth:`FlexibleManipulator.simulate` as a finite,
+    non-empty 1-D float array (an (N, 1) column is flattened)."""
+    u = real_array(torque, "torque")
+    if u.ndim == 2 and u.shape[1] == 1:
+        u = u[:, 0]
+    if u.ndim != 1 or u.size == 0:
+        raise ValueError(
+            "`torque` must be a non-empty 1-D array or (N, 1); "
+            f"got shape {np.shape(torque)}"
+        )
+    if not np.all(np.isfinite(u)):
+        bad = int(np.flatnonzero(~np.isfinite(u))[0])
+        raise ValueError(
+            f"`torque` must be finite; got {float(u[bad])!r} at index {bad}"
+        )
+    return u
+
+
+def _initial_state(x0, n: int) -> np.ndarray:
+    """`x0` of :meth:`FlexibleManipulator.simulate`: ``(q, q')`` of `n`
+    generalised coordinates, rest when None."""
+    if x0 is None:
+        return np.zeros(2 * n)
+    x0v = real_array(x0, "x0")
+    if x0v.shape != (2 * n,) or not np.all(np.isfinite(x0v)):
+        raise ValueError(
+            f"`x0` must hold {2 * n} finite numbers (q, q'), shape "
+            f"({2 * n},); got {x0!r:.80}"
+        )
+    return x0v
+
+
+def _recording(u, y, ts: float, sensors: Sensors, gen, state) -> Recording:
+    """The recording of the exact outputs `y`: the encoder's quantisation
+    and the sensors' noise, drawn in a fixed order (tachometer,
+    accelerometer, then the further accelerometers) so that adding a
+    channel leaves the others' noise unchanged."""
+    hub_velocity = y[:, 1]
+    acc = y[:, 2]
+    if sensors.tach_noise > 0.0:
+        hub_velocity = hub_velocity + gen.normal(0.0, sensors.tach_noise, u.size)
+    if sensors.accel_noise > 0.0:
+        acc = acc + gen.normal(0.0, sensors.accel_noise, u.size)
+    nd = len(sensors.deflection_at)
+    further = y[:, 4 + nd :].copy() if sensors.acceleration_at else None
+    if further is not None and sensors.accel_noise > 0.0:
+        further += gen.normal(0.0, sensors.accel_noise, further.shape[::-1]).T
+    return Recording(
+        t=np.arange(u.size) * ts,
+        u=u.copy(),
+        hub_angle=quantise(y[:, 0], sensors.encoder_resolution),
+        hub_velocity=hub_velocity,
+        end_acceleration=acc,
+        tip_deflection=y[:, 3].copy(),
+        ts=ts,
+        state=state,
+        deflection_at=sensors.deflection_at,
+        deflection=y[:, 4 : 4 + nd].copy() if nd else None,
+        acceleration_at=sensors.acceleration_at,
+        acceleration=further,
+    )
 
 
 @lru_cache(maxsize=16)

@@ -135,18 +135,19 @@ class Sensors:
             object.__setattr__(self, name, nonneg(getattr(self, name), name))
         order = self.antialias_order
         if not is_integer(order) or not 0 <= order <= 12:
-            raise ValueError(
+            raise (ValueError if is_integer(order) else TypeError)(
                 "`antialias_order` must be an integer in [0, 12]; "
                 f"got {self.antialias_order!r}"
             )
+        what = f"`antialias_cutoff` must be in (0, 1]; got {self.antialias_cutoff!r}"
         try:
             c = real(self.antialias_cutoff, "antialias_cutoff")
+        except TypeError:
+            raise TypeError(what) from None
         except ValueError:
             c = math.nan
         if not 0.0 < c <= 1.0:
-            raise ValueError(
-                f"`antialias_cutoff` must be in (0, 1]; got {self.antialias_cutoff!r}"
-            )
+            raise ValueError(what)
         object.__setattr__(self, "antialias_cutoff", c)
         for name in ("deflection_at", "acceleration_at"):
             object.__setattr__(self, name, _positions(getattr(self, name), name))
@@ -189,18 +190,22 @@ class Sensors:
 
 def _positions(value, name: str) -> tuple[float, ...]:
     """`name` as a tuple of distinct fractions in (0, 1]."""
-    values = list(value) if isinstance(value, list | tuple | np.ndarray) else None
+    what = (
+        f"`{name}` must be a tuple of positions along the beam, "
+        f"fractions of its length in (0, 1]; got {value!r}"
+    )
+    if not isinstance(value, list | tuple | np.ndarray):
+        raise TypeError(what)
     out = []
-    for v in values if values is not None else [None]:
+    for v in list(value):
         try:
             x = real(v, name)
+        except TypeError:
+            raise TypeError(what) from None
         except ValueError:
             x = math.nan
-        if values is None or not 0.0 < x <= 1.0:
-            raise ValueError(
-                f"`{name}` must be a tuple of positions along the beam, "
-                f"fractions of its length in (0, 1]; got {value!r}"
-            )
+        if not 0.0 < x <= 1.0:
+            raise ValueError(what)
         out.append(x)
     names = [f"{x:g}" for x in out]
     if len(set(names)) != len(names):

@@ -72,12 +72,3 @@ __all__ = [
     "testfunctions",
     "thin_front",
 ]
-
-
-def __getattr__(name: str):
-    # One public name per type: the alias is gone, so say which name to use.
-    if name == "SpiralResult":
-        raise AttributeError(
-            "`SpiralResult` was removed: every optimiser returns `OptimiserResult`"
-        )
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -6,7 +6,6 @@ objective's output and keep points in the box the same way, so a caller
 reads either result alike.
 """
 
-import inspect
 import math
 from collections.abc import Mapping
 
@@ -64,9 +63,9 @@ def check_costs(raw, shape: tuple, what: str) -> np.ndarray:
 def check_objective(fun, vectorized) -> bool:
     """Check `fun` is callable and `vectorized` a flag; return the flag."""
     if not callable(fun):
-        raise ValueError(f"`fun` must be callable; got {fun!r}")
+        raise TypeError(f"`fun` must be callable; got {fun!r}")
     if not isinstance(vectorized, bool | np.bool_):
-        raise ValueError(f"`vectorized` must be True or False; got {vectorized!r}")
+        raise TypeError(f"`vectorized` must be True or False; got {vectorized!r}")
     return bool(vectorized)
 
 
@@ -196,41 +195,9 @@ def settings(options, defaults: dict, where: str) -> dict:
     if options is None:
         return dict(defaults)
     if not isinstance(options, Mapping):
-        raise ValueError(
+        raise TypeError(
             f"`options` must be a mapping of {', '.join(defaults)} or None; "
             f"got {options!r:.80}"
         )
     refuse_options(options, defaults, where)
     return {**defaults, **options}
-
-
-def refuse_keywords(function, given: dict, method, nested: dict, moved: dict) -> None:
-    """A one-line TypeError for the first keyword in `given` that `function`
-    does not take: what replaced it if it was `moved` (name: message),
-    otherwise the method and the options that apply, those of its `options`
-    mapping (`nested`) in braces. Every rule takes all of them."""
-    for name in given:
-        if name in moved:
-            raise TypeError(moved[name])
-        takes = [
-            p.name if p.name != "options" else f"options={{{', '.join(nested)}}}"
-            for p in inspect.signature(function).parameters.values()
-            if p.kind is inspect.Parameter.KEYWORD_ONLY
-        ]
-        raise TypeError(
-            f"{function.__name__}() got an unexpected keyword argument {name!r}; "
-            f"method {method!r} takes {', '.join(takes)}"
-        )
-
-
-def moved_into_options(function: str, names) -> dict:
-    """The one-line message for each keyword of `function` that moved into
-    its `options` mapping."""
-    return {
-        name: (
-            f"`{name}` of {function}() is now a key of its `options`: "
-            f"{function}(..., options={{{name!r}: ...}}), as "
-            "scipy.optimize.minimize takes its solvers' settings"
-        )
-        for name in names
-    }

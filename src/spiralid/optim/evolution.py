@@ -90,7 +90,7 @@ def differential_evolution(
         max_nfev = integer(max_nfev, "max_nfev", 2 * n_points)
         generations = min(max_iter, max_nfev // n_points - 1)
     if callback is not None and not callable(callback):
-        raise ValueError(f"`callback` must be callable or None; got {callback!r}")
+        raise TypeError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
     n = box.shape[0]
     seeds = np.empty((0, n))

@@ -191,7 +191,7 @@ class LearnedMetricSpiral:
             "extend_closing",
         ):
             if not isinstance(getattr(self, name), bool):
-                raise ValueError(f"`{name}` must be True or False")
+                raise TypeError(f"`{name}` must be True or False")
         for name, allowed in (
             ("sampling", _SAMPLINGS),
             ("path_frame", _PATH_FRAMES),

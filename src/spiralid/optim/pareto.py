@@ -65,8 +65,6 @@ from spiralid.optim._loop import (
     STOPS,
     check_max_time,
     check_objective,
-    moved_into_options,
-    refuse_keywords,
     settings,
 )
 from spiralid.optim.front import (
@@ -252,8 +250,6 @@ def _first_population(fun, x: np.ndarray, vectorized: bool, k: int | None):
 # minimize_pareto()'s rarely used settings and their defaults: keys of its
 # `options` mapping, as minimize() keeps its own (MINIMIZE_OPTIONS).
 PARETO_OPTIONS = {"max_time": None, "neighbours": 10, "ref_point": None}
-# Keywords minimize_pareto() no longer takes, and what replaced each.
-_MOVED = moved_into_options("minimize_pareto", PARETO_OPTIONS)
 
 
 def minimize_pareto(
@@ -269,7 +265,6 @@ def minimize_pareto(
     callback: Callable | None = None,
     x0=None,
     options: dict | None = None,
-    **_unknown,
 ) -> OptimiserResult:
     """Approximate the Pareto front of a vector objective by a spiral search.
 
@@ -348,10 +343,6 @@ def minimize_pareto(
             tenth of its range. Its length tells the objective count before
             any evaluation.
 
-        They were keywords of their own; passing one so is a one-line
-        TypeError saying to use ``options``, and any other unknown keyword
-        one naming the method and the options that apply.
-
     Returns
     -------
     OptimiserResult
@@ -382,7 +373,6 @@ def minimize_pareto(
     (1, True)
     """
     t_start = time.perf_counter()
-    refuse_keywords(minimize_pareto, _unknown, method, PARETO_OPTIONS, _MOVED)
     opts = settings(options, PARETO_OPTIONS, "the options of minimize_pareto()")
     lo, hi = box_bounds(bounds)
     rule = _parse_rule(method)
@@ -394,9 +384,9 @@ def minimize_pareto(
     max_time = check_max_time(opts["max_time"])
     neighbours = integer(opts["neighbours"], "neighbours", 2)
     if not isinstance(archive, bool):
-        raise ValueError(f"`archive` must be True or False; got {archive!r}")
+        raise TypeError(f"`archive` must be True or False; got {archive!r}")
     if callback is not None and not callable(callback):
-        raise ValueError(f"`callback` must be callable or None; got {callback!r}")
+        raise TypeError(f"`callback` must be callable or None; got {callback!r}")
     gen = generator(rng)
     vectorized = check_objective(fun, vectorized)
     ref = _check_ref_point(opts["ref_point"])

@@ -97,6 +97,6 @@ def parse_restarts(restarts) -> Restarts | None:
         return restarts
     if isinstance(restarts, bool | np.bool_):
         return Restarts() if restarts else None
-    raise ValueError(
+    raise TypeError(
         f"`restarts` must be True, False or a Restarts instance; got {restarts!r}"
     )

@@ -255,7 +255,7 @@ class ExponentialSpiral(SpiralRule):
         r_l, r_u = _check_interval(self.r_l, self.r_u, "r_l", "r_u", radius=True)
         th_l, th_u = _check_interval(self.th_l, self.th_u, "th_l", "th_u", radius=False)
         if not isinstance(self.scale_free, bool | np.bool_):
-            raise ValueError(
+            raise TypeError(
                 f"`scale_free` must be True or False; got {self.scale_free!r}"
             )
         object.__setattr__(self, "scale_free", bool(self.scale_free))

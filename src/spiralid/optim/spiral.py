@@ -36,9 +36,7 @@ from spiralid.optim._loop import (
     apply_bounds,
     check_max_time,
     finite_or_inf,
-    moved_into_options,
     point_in_box,
-    refuse_keywords,
     seed_points,
     settings,
     stop_report,
@@ -78,14 +76,20 @@ require_names(_METHODS, RULE_NAMES, "spiralid.optim.RULES")
 RULES = _METHODS
 
 
-def _parse_method(method) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
+def _parse_method(
+    method, name: str = "method"
+) -> SpiralRule | StepRateRule | LearnedMetricSpiral:
+    """The rule `method` names or is; refused naming `name`, the argument
+    the caller took it as (an estimator's ``rule``, say)."""
     if isinstance(method, SpiralRule | StepRateRule | LearnedMetricSpiral):
         return method
     if isinstance(method, str) and method.lower() in _METHODS:
         return _METHODS[method.lower()]()
     names = ", ".join(repr(name) for name in _METHODS)
-    raise ValueError(
-        f"`method` must be {names}, a SpiralRule or a StepRateRule instance; "
+    # An unknown name is a wrong value; anything else a wrong type.
+    error = ValueError if isinstance(method, str) else TypeError
+    raise error(
+        f"`{name}` must be {names}, a SpiralRule or a StepRateRule instance; "
         f"got {method!r}"
     )
 
@@ -406,15 +410,6 @@ def _fixed_rotation(rule: StepRateRule, n: int) -> np.ndarray:
 # `options` mapping, as scipy.optimize.minimize takes its solvers' settings.
 MINIMIZE_OPTIONS = {"max_time": None, "target": None, "bounds_policy": "none"}
 
-# Keywords minimize() no longer takes, and what replaced each.
-_REMOVED = {
-    "on_iteration": (
-        "`on_iteration` was removed: use `callback`, whose "
-        "`intermediate_result.search` is the search the hook received"
-    ),
-    **moved_into_options("minimize", MINIMIZE_OPTIONS),
-}
-
 
 def _target(target) -> float | None:
     """`target` as a float (None: no target), or a ValueError naming it."""
@@ -531,7 +526,6 @@ def minimize(
     callback: Callable | None = None,
     restarts: bool | Restarts = False,
     options: dict | None = None,
-    **_removed,
 ) -> OptimiserResult:
     """Minimise ``fun`` with a spiral dynamic algorithm (SDA, Eb-SDA, LASDA).
 
@@ -611,9 +605,6 @@ def minimize(
             What to do with points that leave the box. The paper has no
             bound handling, so ``"none"`` (the default) lets them go.
 
-        They were keywords of their own; passing one so is a one-line
-        TypeError saying to use ``options``.
-
     Returns
     -------
     OptimiserResult
@@ -648,13 +639,12 @@ def minimize(
     ('Target cost reached.', True)
     """
     start = time.perf_counter()
-    refuse_keywords(minimize, _removed, method, MINIMIZE_OPTIONS, _REMOVED)
     opts = settings(options, MINIMIZE_OPTIONS, "the options of minimize()")
     budget = _Budget.check(
         max_iter, n_points, max_nfev, opts["max_time"], opts["target"], start
     )
     if callback is not None and not callable(callback):
-        raise ValueError(f"`callback` must be callable or None; got {callback!r}")
+        raise TypeError(f"`callback` must be callable or None; got {callback!r}")
     restarts = parse_restarts(restarts)
     rule = _parse_method(method)
     n = box_bounds(bounds)[0].size

@@ -143,8 +143,8 @@ def results_dict(rep: Reproduction, command: str | None = None) -> dict:
         },
         "baselines": {k: r.to_dict() for k, r in rep.baselines.items()},
         "runs": {k: [r.to_dict() for r in runs] for k, runs in rep.runs.items()},
-        # Only with reproduce(all_outputs=True): the paper's run writes the
-        # same keys as before.
+        # Only with reproduce(all_outputs=True), so that the paper's run
+        # writes the paper's keys alone.
         **(
             {}
             if rep.shared is None

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from spiralid.sysid.estimation.pareto import OBJECTIVES, ParetoIdentification
+from spiralid.sysid.estimation.pareto.identify import OBJECTIVES, ParetoIdentification
 
 __all__ = ["front_figure"]
 

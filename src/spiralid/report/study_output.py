@@ -322,8 +322,8 @@ def study_results_dict(res: StudyResults, spec_text: str, command=None) -> dict:
             for (d, p), rows in res.baselines.items()
             for label, row in rows.items()
         ],
-        # Only for rig records with all_outputs: a study without them writes
-        # the same keys as before.
+        # Only for rig records with all_outputs, so that a study without
+        # them writes the single-output keys alone.
         **(
             {
                 "modes_from_every_sensor": {

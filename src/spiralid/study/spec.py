@@ -315,12 +315,12 @@ def _optimizer(entry: Any, methods, where: str) -> OptimizerSpec:
     options = entry.get("options", {})
     if not isinstance(options, dict):
         _fail(where, f"[[optimizer]] {label!r}: `options` must be a table")
-    from spiralid.sysid.estimation.identify import check_method_options
+    from spiralid.sysid.estimation.core.identify import check_method_options
 
     try:
         # Checked here, before any run, as identify() would check each.
         check_method_options(method, options)
-    except ValueError as exc:
+    except (TypeError, ValueError) as exc:
         _fail(where, f"[[optimizer]] {label!r}: {exc}")
     return OptimizerSpec(label, method, refine, float(scale), safe_start, dict(options))
 

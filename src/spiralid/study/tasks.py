@@ -191,7 +191,7 @@ def run_task(task: Task, data, detail: bool = False) -> dict:
     time of every history entry, for Figure 6a), which a store does not keep.
     """
     from spiralid.sysid import ARX, PaperCost, fit_percent, identify
-    from spiralid.sysid.estimation.searches import search_options
+    from spiralid.sysid.estimation.spiral.population import search_options
 
     arx = ARX(*task.arx)
     est, _ = data.split(task.fraction)

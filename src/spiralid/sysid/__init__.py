@@ -6,17 +6,17 @@ before it."""
 
 # --- core (data, arx, cost, identify) ---
 from .data import IOData as IOData
-from .estimation.cost import PaperCost as PaperCost
-from .estimation.estimators import METHODS as METHODS
-from .estimation.identify import identify as identify
-from .estimation.narx_choice import choose_narx as choose_narx
-from .estimation.outputerror import steiglitz_mcbride as steiglitz_mcbride
-from .estimation.parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
-from .estimation.parametrizations import default_bounds as default_bounds
-from .estimation.pareto import ParetoIdentification as ParetoIdentification
-from .estimation.pareto import identify_pareto as identify_pareto
-from .estimation.problem import EstimatorResult as EstimatorResult
-from .estimation.subspace import subspace_denominator as subspace_denominator
+from .estimation.core.cost import PaperCost as PaperCost
+from .estimation.core.estimators import METHODS as METHODS
+from .estimation.core.identify import identify as identify
+from .estimation.core.problem import EstimatorResult as EstimatorResult
+from .estimation.linear.outputerror import steiglitz_mcbride as steiglitz_mcbride
+from .estimation.linear.parametrizations import PARAMETRIZATIONS as PARAMETRIZATIONS
+from .estimation.linear.parametrizations import default_bounds as default_bounds
+from .estimation.narx.choice import choose_narx as choose_narx
+from .estimation.pareto.identify import ParetoIdentification as ParetoIdentification
+from .estimation.pareto.identify import identify_pareto as identify_pareto
+from .estimation.shared.subspace import subspace_denominator as subspace_denominator
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.files import load_model as load_model
@@ -124,9 +124,9 @@ __all__ = [
 # The modal search's building blocks, loaded on first use (identify loads
 # them itself when a method needs them).
 _LAZY = {
-    "ModalParametrization": ".estimation.modal",
-    "ProjectedCost": ".estimation.varpro",
-    "projected_spiral": ".estimation.memetic",
+    "ModalParametrization": ".estimation.linear.modal",
+    "ProjectedCost": ".estimation.linear.varpro",
+    "projected_spiral": ".estimation.spiral.projected",
 }
 
 

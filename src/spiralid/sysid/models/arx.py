@@ -96,7 +96,7 @@ class ARX:
     is_linear = True
 
     #: The family whose estimators fit this structure: the first key of
-    #: the estimator table (:data:`~spiralid.sysid.estimation.families.
+    #: the estimator table (:data:`~spiralid.sysid.estimation.core.families.
     #: ESTIMATORS`), on a record of one output and of several.
     family = "arx"
     outputs_family = "shared-denominator"

@@ -28,9 +28,7 @@ MODEL_KINDS = {
 
 def model_kind(d: dict) -> str:
     """The kind a model file's dict names (``"arx"`` when it names none)."""
-    # Shared-denominator files written before the field was "model" name it
-    # in "kind".
-    kind = d.get("model", d.get("kind", "arx"))
+    kind = d.get("model", "arx")
     if kind not in MODEL_KINDS:
         raise ValueError(
             f"field 'model' must be one of {', '.join(MODEL_KINDS)}; got {kind!r}"

@@ -65,7 +65,7 @@ class Provenance:
     ----------
     method : str
         The estimation method (a name of
-        :data:`~spiralid.sysid.estimation.estimators.METHODS`).
+        :data:`~spiralid.sysid.estimation.core.estimators.METHODS`).
     predictor : {"simulation", "one-step"}
         The error the cost measured.
     initial : {"rest", "measured"}
@@ -177,7 +177,7 @@ class FittedModel(Provenance):
     ----------
     method : str
         The estimation method (a name of
-        :data:`~spiralid.sysid.estimation.estimators.METHODS`).
+        :data:`~spiralid.sysid.estimation.core.estimators.METHODS`).
     predictor : {"simulation", "one-step"}
         The error the cost measured.
     initial : {"rest", "measured"}

@@ -66,7 +66,7 @@ class IdentifiedModel(FittedModel):
         The paper's cost, eq. (2)-(3), of ``theta`` on the estimation data.
     result : EstimatorResult or None
         What the estimator returned
-        (:class:`~spiralid.sysid.estimation.estimators.EstimatorResult`, an
+        (:class:`~spiralid.sysid.estimation.core.estimators.EstimatorResult`, an
         ``OptimizeResult`` whose ``x`` is ``theta``; ``status`` says whether
         it stopped at an evaluation cap, ``start`` which start ``"oe"`` kept);
         ``None`` after :meth:`from_dict`.
@@ -93,7 +93,8 @@ class IdentifiedModel(FittedModel):
         stable by design, not unstable. 0 (or False): none.
     covariance : ndarray or None, shape (p', p')
         The covariance of the estimated parameters, ``s^2 (J^T J)^-1`` at the
-        optimum (:func:`~spiralid.sysid.estimation.uncertainty.parameter_covariance`),
+        optimum
+        (:func:`~spiralid.sysid.estimation.core.uncertainty.parameter_covariance`),
         over ``[free_denominator, b]`` (``p' = p - integrator``: a known
         integrator's pole is not estimated); None when not computed.
     covariance_factor : ndarray or None, shape (k, p')
@@ -106,7 +107,7 @@ class IdentifiedModel(FittedModel):
     cancellations : tuple of dict
         The near-cancelling pole-zero pairs removed after the estimation
         (``identify(cancel=True)``,
-        :mod:`~spiralid.sysid.estimation.cancellation`): each with the
+        :mod:`~spiralid.sysid.estimation.spiral.cancellation`): each with the
         ``pole`` and ``zero`` (``[re, im]``, the upper one of a complex
         pair), its ``order`` (1 real, 2 a complex pair), their
         ``distance``, the ``tolerance`` and the ``cost_increase`` (a share
@@ -118,14 +119,14 @@ class IdentifiedModel(FittedModel):
     selection : dict or None
         How the recommended method chose among its distinct minima on the
         held-back end of the estimation record
-        (:mod:`~spiralid.sysid.estimation.heldback`): the ``holdback``
+        (:mod:`~spiralid.sysid.estimation.spiral.heldback`): the ``holdback``
         share, ``n_held`` samples, the ``candidates`` (``start``,
         ``held_back_rms``, whole-record ``cost``), the ``chosen`` one, the
         ``lowest_cost`` one and a ``note`` in words; None when the method
         chose by the cost alone.
     margin : dict or None
         What the held-back end said of the default stability margin where it
-        bound a pole (:mod:`~spiralid.sysid.estimation.margin_choice`): the
+        bound a pole (:mod:`~spiralid.sysid.estimation.spiral.margin_choice`): the
         margin's ``time_constant`` and the bound pole's (``slowest``, in
         seconds), the released minimum's ``released_cost`` as a share of
         the margined one's, the ``holdback`` share and ``n_held`` samples, the
@@ -136,7 +137,7 @@ class IdentifiedModel(FittedModel):
     diagnosis : dict or None
         What the recommended method did with the poles its modes table
         flags (an interval that reaches ``|z| = 1``, a cancelling zero;
-        :mod:`~spiralid.sysid.estimation.spurious`): the poles ``removed``
+        :mod:`~spiralid.sysid.estimation.spiral.spurious`): the poles ``removed``
         (also in :attr:`cancellations`, with a ``reason``) and ``kept``
         (each with the ``cost_increase`` its removal took and the test's
         ``tolerance``), the record's ``n_samples`` and the error's

@@ -10,7 +10,7 @@ Two maps are built:
   (``linear=True``: ``F = l^T phi + v^T sigma(W phi + b) + c``). The bypass is
   the ARX model, so a network whose output weights are zero is exactly the
   least-squares ARX and training starts from it (see
-  :mod:`spiralid.sysid.estimation.narx`).
+  :mod:`spiralid.sysid.estimation.narx.training`).
 * :class:`PolynomialNARX`: a sum of monomials of the regressors up to
   ``degree`` whose terms are chosen by forward-regression orthogonal least
   squares (Billings, *Nonlinear System Identification*, Wiley, 2013, ch. 3),

@@ -30,7 +30,12 @@ class NARX(_Lags):
     nu : int
         Past inputs in the regressor (>= 1).
     nk : int
-        Input delay: the newest input is ``u(t - nk)`` (>= 0).
+        Input delay: the newest input is ``u(t - nk)`` (>= 0). The default
+        is 1, where :class:`ARX`'s is 0: the paper's ARX(8, 8, 0) of
+        eq. (6) lets the torque act within the sample, while a NARX is
+        strictly causal by convention (Billings' regressors start at
+        ``u(t - 1)``), and the pinned NARX results are at ``nk = 1``.
+        Pass ``nk`` explicitly to compare the two on the same lags.
     hidden : tuple of int
         Hidden-layer sizes: one layer ``(h,)``, or ``()`` for no network
         (then the model is the linear bypass alone, i.e. an ARX model).
@@ -85,7 +90,7 @@ class NARX(_Lags):
         )
         one_of(self.activation, "activation", ACTIVATIONS)
         if not isinstance(self.linear, bool | np.bool_):
-            raise ValueError(f"`linear` must be True or False; got {self.linear!r}")
+            raise TypeError(f"`linear` must be True or False; got {self.linear!r}")
         object.__setattr__(self, "linear", bool(self.linear))
         object.__setattr__(self, "integrator", _integrators(self.integrator))
         if not self.hidden and not self.linear:

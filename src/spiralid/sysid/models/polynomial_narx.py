@@ -20,7 +20,8 @@ class PolynomialNARX(_Lags):
     Parameters
     ----------
     ny, nu, nk : int
-        Lags as for :class:`NARX`.
+        Lags as for :class:`NARX` (``nk`` defaults to 1, as there, where
+        :class:`ARX`'s is 0).
     degree : int
         Largest total degree of a term (1..3).
     n_terms : int or None

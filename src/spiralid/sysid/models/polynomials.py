@@ -22,9 +22,9 @@ coefficients. Its margin is zero: a model is stable when every pole has
 ``|z| < 1`` strictly, as eq. (2)-(3) put the penalty on ``|z| >= 1``. It
 never looks at roots from ``numpy.roots``: for clustered poles near the
 circle those are wrong by far more than the distance to the circle (an
-eightfold pole moves by ~eps^(1/8) ~ 0.01), which is how a model with a
-pole at ``|z| = 1 - 4e-7`` used to be stable for ``is_stable`` and unstable
-for ``validate``. A positive margin would call unstable the models the
+eightfold pole moves by ~eps^(1/8) ~ 0.01), so two tests, one of them on
+roots, could call a model with a pole at ``|z| = 1 - 4e-7`` stable and
+unstable. A positive margin would call unstable the models the
 reflection parametrisation and output error build stable by construction
 (``|k_j| <= 1 - 1e-6`` allows poles within ~1e-12 of the circle).
 :func:`max_pole_radius` reports the largest ``|z|`` from the same test (by

@@ -147,7 +147,7 @@ class SharedDenominatorModel(Provenance):
         The estimator.
     cost : float
         The weighted joint cost the estimator minimised (percent RMS error,
-        see :class:`~spiralid.sysid.estimation.shared.SharedProjectedCost`).
+        see :class:`~spiralid.sysid.estimation.shared.denominator.SharedProjectedCost`).
     weights : ndarray, shape (p,)
         The outputs' weights in that cost (``1 / sigma_i^2``).
     costs : ndarray, shape (p,)
@@ -455,8 +455,7 @@ class SharedDenominatorModel(Provenance):
         wrong type or out of range raises a ValueError that names it."""
         if not isinstance(d, dict):
             raise ValueError(f"a model must be a JSON object; got {type(d).__name__}")
-        # Files written before the field was called "model" name it "kind".
-        kind = d.get("model", d.get("kind"))
+        kind = d.get("model")
         if kind != "shared-denominator":
             raise ValueError(
                 f"field 'model' must be 'shared-denominator'; got {kind!r}"

@@ -12,8 +12,8 @@ import numpy as np
 
 from spiralid._checks import positive
 
-from ..estimation.cost import auto_gain
-from ..estimation.outputerror import error_functions
+from ..estimation.core.cost import auto_gain
+from ..estimation.linear.outputerror import error_functions
 from ..signals import check_pair
 
 __all__ = ["fit_from_measured", "fit_percent", "rmse"]
@@ -81,7 +81,7 @@ def rmse(y, yhat) -> float:
 def _signals_of(data, name: str = "data"):
     for attr in ("u", "y", "ts"):
         if not hasattr(data, attr):
-            raise ValueError(
+            raise TypeError(
                 f"`{name}` must be an IOData (with .u, .y, .ts); "
                 f"got {type(data).__name__}"
             )
@@ -140,8 +140,10 @@ def _gain(gain, model, y: np.ndarray) -> float:
         return w
     try:
         return positive(gain, "gain")
-    except ValueError:
-        raise ValueError(
+    except (TypeError, ValueError) as err:
+        # A string other than the two is a wrong value, not a wrong type.
+        error = ValueError if isinstance(gain, str) else type(err)
+        raise error(
             f"`gain` must be 'auto', 'model' or a finite number > 0; got {gain!r}"
         ) from None
 

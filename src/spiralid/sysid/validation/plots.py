@@ -308,7 +308,7 @@ def plot_pole_zero(models, *, radius: float | None = None) -> Figure:
     1
     """
     if not isinstance(models, Mapping):
-        raise ValueError(
+        raise TypeError(
             f"`models` must be a mapping of label to (poles, zeros); "
             f"got {type(models).__name__}"
         )

@@ -35,7 +35,7 @@ import numpy as np
 from spiralid._checks import nonneg, one_of
 from spiralid.optim.front import knee_point
 
-from ..estimation.pareto import ParetoIdentification
+from ..estimation.pareto.identify import ParetoIdentification
 from ..models.protocol import is_fitted
 from .validate import validate
 

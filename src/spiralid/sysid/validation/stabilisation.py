@@ -23,7 +23,7 @@ import numpy as np
 from spiralid._checks import integer, positive
 
 from ..data import IOData
-from ..estimation.identify import identify
+from ..estimation.core.identify import identify
 from ..models.arx import ARX
 
 __all__ = ["StabilisationDiagram", "stabilisation"]

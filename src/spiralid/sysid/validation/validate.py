@@ -28,7 +28,7 @@ import numpy as np
 
 from spiralid._checks import one_of, refuse_options
 
-from ..estimation.cost import cost_of_errors
+from ..estimation.core.cost import cost_of_errors
 from ..models.protocol import check_fitted
 from ..signals import check_pair
 from ..spectra import find_resonances, psd
@@ -333,7 +333,7 @@ def _choice_notes(model) -> str | None:
 def _fitted_error(model) -> str:
     """The error `model`'s estimate minimised: its method's (least squares:
     the one-step error), else the predictor its cost used."""
-    from ..estimation.estimators import METHODS
+    from ..estimation.core.estimators import METHODS
 
     method = METHODS.get(str(getattr(model, "method", "")))
     predictor = getattr(model, "predictor", None) or "simulation"
