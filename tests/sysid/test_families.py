@@ -130,15 +130,23 @@ def test_an_option_that_does_not_apply_is_refused_in_one_line(family):
 
 @pytest.mark.parametrize("family", FAMILIES)
 def test_bad_input_is_refused_in_one_line(fitted, family):
-    structure, _, _ = CASES[family]
+    # A wrong type is a TypeError, a wrong value a ValueError (as SciPy),
+    # each one line that names the argument.
+    structure, outputs, _ = CASES[family]
     model = fitted[family][0]
     for call in (
         lambda: sid.identify("data.csv", structure, method="ls"),
         lambda: sid.validate(model, "data.csv"),
     ):
-        with pytest.raises(ValueError) as refused:
+        with pytest.raises(TypeError) as refused:
             call()
-        assert "\n" not in str(refused.value)
+        message = str(refused.value)
+        assert "\n" not in message and "`data`" in message
+    rec = _record(outputs)
+    too_short = sid.IOData(rec.u[:3], rec.y[:3], ts=rec.ts, output_name=rec.output_name)
+    with pytest.raises(ValueError) as refused:
+        sid.identify(too_short, structure, method="ls")
+    assert "\n" not in str(refused.value)
 
 
 @pytest.mark.parametrize("family", FAMILIES)

@@ -50,7 +50,7 @@ def check_output_records(model, data, warmup) -> None:
         if record is None:
             continue
         if not isinstance(record, IOData):
-            raise ValueError(f"`{name}` must be an IOData; got {type(record).__name__}")
+            raise TypeError(f"`{name}` must be an IOData; got {type(record).__name__}")
         missing = [o for o in model.output_names if o not in record.output_names]
         if missing:
             raise ValueError(
