@@ -37,8 +37,12 @@ Names and meanings
     family; for a NARX its linear start, or None without a linear bypass.
 ``is_linear``
     Whether the model is linear in the signals: then it has ``modes``
-    (its modes table with intervals) and ``is_stable`` (from its poles);
-    a nonlinear model has neither (its free run, in
+    (its modes table with intervals), ``is_stable`` (from its poles),
+    ``poles``, ``zeros``, ``polynomials`` (its transfer function's
+    numerator and denominator in ``z^-1``) and ``free_denominator`` (the
+    denominator without the poles at ``z = 1`` it has by design), which
+    :func:`~spiralid.sysid.validate` reads for its linear checks; a
+    nonlinear model has none of them (its free run, in
     :func:`~spiralid.sysid.validate`, says whether it stays bounded).
 ``output_names``, ``output_model(which)``
     The outputs the model predicts, and the model of one of them: the
