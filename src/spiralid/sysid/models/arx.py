@@ -45,9 +45,9 @@ INITIAL_CONDITIONS = ("rest", "measured")
 
 def check_arx(value, name: str = "arx") -> None:
     """`value` is an ARX structure (its ``family`` is ``"arx"``), or a
-    one-line ValueError naming the argument `name`."""
+    one-line TypeError naming the argument `name`."""
     if getattr(value, "family", None) != "arx":
-        raise ValueError(f"`{name}` must be an ARX; got {type(value).__name__}")
+        raise TypeError(f"`{name}` must be an ARX; got {type(value).__name__}")
 
 
 @dataclass(frozen=True)

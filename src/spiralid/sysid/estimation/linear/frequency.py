@@ -220,7 +220,7 @@ class FrequencyError:
     def __init__(self, arx: ARX, estimate: FrequencyEstimate) -> None:
         check_arx(arx)
         if not isinstance(estimate, FrequencyEstimate):
-            raise ValueError(
+            raise TypeError(
                 f"`estimate` must be a FrequencyEstimate; got {type(estimate).__name__}"
             )
         self.arx = arx
