@@ -42,7 +42,7 @@ print(model.modes)
 
 # %%
 # Each sensor's fit on the validation third, and the joint fit.
-report = sid.sysid.validate_outputs(model, val, warmup=est)
+report = sid.validate(model, val, warmup=est)
 print(report.summary(modes=False))
 
 # %%

@@ -51,12 +51,13 @@ def test_minimize_pareto_checks_vectorized_as_minimize_does():
 
 import re  # noqa: E402
 
-import spiralid.sysid.estimation.core.identify as identify_module  # noqa: E402
+import spiralid.sysid.estimation.core.arx_fit as arx_fit_module  # noqa: E402
 import spiralid.sysid.estimation.narx.training as narx_module  # noqa: E402
 from spiralid.cli import build_parser  # noqa: E402
 from spiralid.cli.errors import UsageError  # noqa: E402
 from spiralid.cli.identify import _OPTION_FLAGS, _check_options  # noqa: E402
 from spiralid.sysid import METHODS  # noqa: E402
+from spiralid.sysid.estimation.core.families import ESTIMATORS  # noqa: E402
 from spiralid.sysid.estimation.core.identify import (  # noqa: E402
     identify_options,
     refused_options,
@@ -91,6 +92,7 @@ EVERY_OPTION = sorted(
         name
         for method in METHODS
         for structure in STRUCTURES.values()
+        if (structure.family, method) in ESTIMATORS
         for refine in (False, True)
         for name in identify_options(method, structure, refine)
     }
@@ -101,7 +103,7 @@ CASES = [
     for method in METHODS
     for kind in STRUCTURES
     if kind == "arx"
-    or (METHODS[method].narx is not None and (kind == "narx" or method == "ls"))
+    or (("narx", method) in ESTIMATORS and (kind == "narx" or method == "ls"))
     for option in EVERY_OPTION
 ]
 
@@ -116,7 +118,7 @@ def _reach(*args, **kwargs):
 
 @pytest.fixture
 def stop_before_estimating(monkeypatch):
-    monkeypatch.setattr(identify_module, "_problem", _reach)
+    monkeypatch.setattr(arx_fit_module, "_problem", _reach)
     monkeypatch.setattr(narx_module, "identify_narx", _reach)
 
 
@@ -195,7 +197,7 @@ def _cli_args(method: str, kind: str, flag: str | None):
         for method in METHODS
         for kind in STRUCTURES
         if kind == "arx"
-        or (METHODS[method].narx is not None and (kind == "narx" or method == "ls"))
+        or (("narx", method) in ESTIMATORS and (kind == "narx" or method == "ls"))
         for flag in _OPTION_FLAGS
         if not (flag == "--integrator" and kind != "arx")
     ],

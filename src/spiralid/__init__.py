@@ -33,7 +33,6 @@ _NAMES = {
     "choose_order": "sysid",
     "validate": "sysid",
     "SharedDenominatorModel": "sysid",
-    "validate_outputs": "sysid",
 }
 __all__ = ["__version__", *_SUBPACKAGES, *_NAMES]
 

@@ -144,7 +144,7 @@ def test_bad_theta_short_record_constant_input():
         arx.simulate(np.zeros(5), np.ones(10))
     with pytest.raises(ValueError, match="`u` must be finite; got nan at sample 2"):
         arx.simulate(np.zeros(16), [0.0, 1.0, np.nan])
-    with pytest.raises(ValueError, match="`data` must be an IOData; got tuple"):
+    with pytest.raises(TypeError, match="`data` must be an IOData; got tuple"):
         arx.predict(np.zeros(16), (np.ones(30), np.ones(30)))
     short = IOData(np.arange(20.0), np.arange(20.0), ts=1.0)
     with pytest.raises(

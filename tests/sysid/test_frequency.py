@@ -87,11 +87,11 @@ def test_bad_arguments_are_named(kwargs, match):
 
 def test_bad_inputs_of_the_error_are_named(record):
     est = h1_estimate(record)
-    with pytest.raises(ValueError, match="`arx`"):
+    with pytest.raises(TypeError, match="`arx`"):
         FrequencyError("ARX(2, 2, 1)", est)
-    with pytest.raises(ValueError, match="`estimate`"):
+    with pytest.raises(TypeError, match="`estimate`"):
         FrequencyError(ARX(2, 2, 1), None)
     with pytest.raises(ValueError, match="`thetas`"):
         FrequencyError(ARX(2, 2, 1), est)([1.0, 2.0])
-    with pytest.raises(ValueError, match="`data`"):
+    with pytest.raises(TypeError, match="`data`"):
         h1_estimate(np.zeros(10))

@@ -127,7 +127,7 @@ def test_early_stopping_starts_from_the_training_parts_linear_model():
     # training start is the default ARX of the training part, drawn from
     # the generator after the whole record's (the refit's) start.
     from spiralid.sysid import ARX
-    from spiralid.sysid.estimation.core.identify import _default_arx
+    from spiralid.sysid.estimation.core.families import _default_arx
     from spiralid.sysid.estimation.narx.starts import _linear_starts
 
     data = _linear_record()

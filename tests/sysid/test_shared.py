@@ -77,24 +77,23 @@ def test_to_control_is_a_simo_system():
 
 
 def test_each_output_is_validated_and_the_joint_fit_combines_them():
-    from spiralid.sysid import joint_fit, validate_outputs
+    from spiralid.sysid import joint_fit
 
     est, val = record(5).split(2 / 3)
     fit = identify(est, ARX(4, 4, 1), rng=0, max_nfev=1000)
-    report = validate_outputs(fit, val, warmup=est)
+    report = validate(fit, val, warmup=est)
     fits = [v.fit_percent for v in report.outputs.values()]
     assert list(report.outputs) == ["near", "far"] and min(fits) > 90
     # By hand: the normalised RMS error over the outputs.
     miss = 1 - np.array(fits) / 100
-    assert report.joint_fit_percent == pytest.approx(
-        100 * (1 - np.sqrt(np.mean(miss**2)))
-    )
+    assert report.fit_percent == pytest.approx(100 * (1 - np.sqrt(np.mean(miss**2))))
     assert joint_fit([fits[0]]) == pytest.approx(fits[0])
     one = validate(fit.output_model("far"), val.output("far"), warmup=est.output("far"))
     assert report.outputs["far"].fit_percent == pytest.approx(one.fit_percent)
     assert "joint fit %" in report.summary() and "far" in report.summary()
+    assert type(report) is type(one) and one.outputs is None
     with pytest.raises(ValueError, match="`data` must hold the model's outputs"):
-        validate_outputs(fit, val.output("far"))
+        validate(fit, val.output("far"))
 
 
 def test_output_error_and_least_squares_for_the_same_structure():

@@ -53,21 +53,22 @@ def _model(name: str):
     from .validate import _read_model
 
     model, _, _ = _read_model(name)
-    if hasattr(model, "to_dlti"):
-        return model
     takes = (
         "export takes the single-output ARX models of `spiralid identify` and "
         "`spiralid pareto`"
     )
-    if hasattr(model, "output_model"):
+    if not model.is_linear:
         raise UsageError(
-            f"{name!r} is a model of {model.n_outputs} outputs "
-            f"({', '.join(model.output_names)}) with one denominator; {takes} (in "
+            f"{name!r} is a NARX model: it has no transfer function to export ({takes})"
+        )
+    outputs = model.output_names
+    if len(outputs) > 1:
+        raise UsageError(
+            f"{name!r} is a model of {len(outputs)} outputs "
+            f"({', '.join(outputs)}) with one denominator; {takes} (in "
             "Python, SharedDenominatorModel.output_model(name) gives each output's)"
         )
-    raise UsageError(
-        f"{name!r} is a NARX model: it has no transfer function to export ({takes})"
-    )
+    return model
 
 
 def transfer_function(model) -> dict:

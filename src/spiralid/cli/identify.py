@@ -301,17 +301,15 @@ def _run_shared(args, progress, arx, est, val, options, argv) -> int:
     output with a joint fit; report.html holds the modes, the fits, each
     output's figures and a stabilisation diagram."""
     from spiralid.report.shared_output import write_shared_report
-    from spiralid.sysid import identify, stabilisation, validate_outputs
+    from spiralid.sysid import identify, stabilisation, validate
 
     with _open_folder(args.out, args.force) as folder:
         progress.phase("estimation", f"estimating {arx} for {est.n_outputs} outputs")
         model = identify(est, arx, method=args.method, **options)
         model.fraction = args.fraction
         progress.phase("validation", "validating every output on both parts")
-        v_est = validate_outputs(model, est, label=f"{args.method} (estimation)")
-        v_val = validate_outputs(
-            model, val, warmup=est, label=f"{args.method} (validation)"
-        )
+        v_est = validate(model, est, label=f"{args.method} (estimation)")
+        v_val = validate(model, val, warmup=est, label=f"{args.method} (validation)")
         orders = _stabilisation_orders(arx, est)
         progress.phase("stabilisation", f"output error at orders {orders}")
         same = {k: v for k, v in options.items() if k in _STABILISATION_OPTIONS}
@@ -524,7 +522,7 @@ def _check_options(args) -> None:
     do, and every typed option identify() would refuse from Python for this
     method and structure (identify_options, the one table), with the
     options that do apply."""
-    from spiralid.sysid import METHODS
+    from spiralid.sysid.estimation.core.families import ESTIMATORS, methods_of
     from spiralid.sysid.estimation.core.identify import (
         identify_options,
         refused_options,
@@ -532,8 +530,8 @@ def _check_options(args) -> None:
 
     model, method = args.model, args.method
     _check_candidates(args)
-    if model != "arx" and METHODS[method].narx is None:
-        able = ", ".join(n for n, m in METHODS.items() if m.narx is not None)
+    if model != "arx" and ("narx", method) not in ESTIMATORS:
+        able = ", ".join(methods_of("narx"))
         raise UsageError(f"--method {method} does not train NARX models: {able}")
     if model == "polynomial" and method != "ls":
         raise UsageError("--model polynomial is estimated by --method ls (FROLS)")

@@ -54,12 +54,12 @@ def _read_model(name: str):
 def _outputs_of(model) -> list[str]:
     """The outputs a model was estimated on: one, or several of a shared
     denominator."""
-    return list(getattr(model, "output_names", None) or [model.output_name])
+    return list(model.output_names)
 
 
 def _offsets_of(model) -> tuple[float, ...]:
     """The output offsets the model file records, one per output."""
-    return tuple(getattr(model, "y_offsets", None) or (model.y_offset,))
+    return tuple(model.output_model(name).y_offset for name in model.output_names)
 
 
 def _names_in(name: str) -> set[str] | None:
@@ -179,17 +179,15 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
 def _validation(model, data, warm):
     """The model's validation on `data` (after `warm`): one output's, or
     each output's and the joint fit of a shared denominator."""
-    from spiralid.sysid import SharedDenominatorModel, validate, validate_outputs
+    from spiralid.sysid import validate
 
-    if isinstance(model, SharedDenominatorModel):
-        return validate_outputs(model, data, warmup=warm, label=model.method)
     return validate(model, data, warmup=warm, label=model.method)
 
 
 def _figures(v) -> dict:
     """The validation's figures by file stem (each output's, prefixed by
     its name, for several outputs)."""
-    if not hasattr(v, "outputs"):
+    if v.outputs is None:
         return v.plot()
     from spiralid.report.shared_output import output_stems
 

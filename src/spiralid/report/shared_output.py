@@ -5,7 +5,7 @@
 each one's share in each output, every output's fit on both parts and the
 joint fit, each output's validation figures, and a stabilisation diagram
 over a range of orders. The numbers are computed in :mod:`spiralid.sysid`
-(the model's ``modes``, ``validate_outputs``, ``stabilisation``); this
+(the model's ``modes``, ``validate``, ``stabilisation``); this
 module only lays them out. The "modes from every sensor" section of the
 reproduction's and the study's reports (:func:`every_sensor_section`,
 :func:`every_sensor_lines`) uses the same tables (:func:`modes_table`,
@@ -101,8 +101,9 @@ def fits_table(v_est, v_val) -> tuple[list[str], list[list[str]]]:
 
     Parameters
     ----------
-    v_est, v_val : OutputsValidation
-        :func:`~spiralid.sysid.validate_outputs` on the two parts.
+    v_est, v_val : Validation
+        :func:`~spiralid.sysid.validate` on the two parts (each output's
+        and the joint fit).
 
     Returns
     -------
@@ -113,7 +114,7 @@ def fits_table(v_est, v_val) -> tuple[list[str], list[list[str]]]:
     def numbers(v) -> dict:
         return {
             "outputs": {name: o.fit_percent for name, o in v.outputs.items()},
-            "joint": v.joint_fit_percent,
+            "joint": v.fit_percent,
             "diverged": [name for name, o in v.outputs.items() if o.diverged],
         }
 
@@ -336,7 +337,7 @@ def shared_report(
     Parameters
     ----------
     model : SharedDenominatorModel
-    v_est, v_val : OutputsValidation
+    v_est, v_val : Validation
         The validations on the estimation and validation parts.
     headline : str
         The page's first line (what was identified on which record).
@@ -415,7 +416,7 @@ def write_shared_report(staged: Path, model, v_est, v_val, **kwargs) -> None:
     staged : Path
         The (staging) folder.
     model : SharedDenominatorModel
-    v_est, v_val : OutputsValidation
+    v_est, v_val : Validation
     **kwargs
         :func:`shared_report`'s keyword arguments (``headline`` first).
     """

@@ -20,10 +20,10 @@ import numpy as np
 from spiralid.sysid import (
     ARX,
     IOData,
-    OutputsValidation,
     SharedDenominatorModel,
+    Validation,
     identify,
-    validate_outputs,
+    validate,
 )
 
 __all__ = [
@@ -54,13 +54,14 @@ MODE_WINDOW = 0.10
 _PARTS = ("estimation", "validation")
 
 
-def fit_percents(estimation: OutputsValidation, validation: OutputsValidation) -> dict:
+def fit_percents(estimation: Validation, validation: Validation) -> dict:
     """Each output's free-run fit (%) and the joint fit on the two parts.
 
     Parameters
     ----------
-    estimation, validation : OutputsValidation
-        :func:`~spiralid.sysid.validate_outputs` on the two parts.
+    estimation, validation : Validation
+        :func:`~spiralid.sysid.validate` on the two parts (each output's
+        and the joint fit).
 
     Returns
     -------
@@ -72,7 +73,7 @@ def fit_percents(estimation: OutputsValidation, validation: OutputsValidation) -
     return {
         part: {
             "outputs": {n: float(v.fit_percent) for n, v in ov.outputs.items()},
-            "joint": float(ov.joint_fit_percent),
+            "joint": float(ov.fit_percent),
             "diverged": [n for n, v in ov.outputs.items() if v.diverged],
         }
         for part, ov in zip(_PARTS, (estimation, validation), strict=True)
@@ -92,7 +93,7 @@ class SharedModesFit:
     Attributes
     ----------
     model : SharedDenominatorModel
-    estimation, validation : OutputsValidation or None
+    estimation, validation : Validation or None
         Each output's fit and the joint fit on the two parts; None for a
         fit read back from a study's store (:meth:`from_dict`), which keeps
         their numbers in `fits`.
@@ -110,8 +111,8 @@ class SharedModesFit:
     """
 
     model: SharedDenominatorModel
-    estimation: OutputsValidation | None
-    validation: OutputsValidation | None
+    estimation: Validation | None
+    validation: Validation | None
     fem_hz: np.ndarray
     seed: int
     seconds: float
@@ -307,10 +308,8 @@ def fit_every_sensor(
     rig = FlexibleManipulator() if rig is None else rig
     return SharedModesFit(
         model=model,
-        estimation=validate_outputs(model, est, label="every sensor (estimation)"),
-        validation=validate_outputs(
-            model, val, warmup=est, label="every sensor (validation)"
-        ),
+        estimation=validate(model, est, label="every sensor (estimation)"),
+        validation=validate(model, val, warmup=est, label="every sensor (validation)"),
         fem_hz=np.asarray(rig.modes(_FEM_MODES), dtype=float),
         seed=seed,
         seconds=seconds,

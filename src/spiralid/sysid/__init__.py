@@ -33,6 +33,7 @@ from .models.polynomials import max_pole_radius as max_pole_radius
 from .models.polynomials import random_stable_polynomial as random_stable_polynomial
 from .models.polynomials import step_down as step_down
 from .models.polynomials import step_up as step_up
+from .models.protocol import FittedModelProtocol as FittedModelProtocol
 from .models.shared import SharedDenominatorModel as SharedDenominatorModel
 from .models.shared import SharedModes as SharedModes
 
@@ -47,9 +48,7 @@ from .validation.correlation import whiteness_test as whiteness_test
 from .validation.higher_order import BillingsVoon as BillingsVoon
 from .validation.higher_order import billings_voon as billings_voon
 from .validation.nonlinear import NonlinearChecks as NonlinearChecks
-from .validation.outputs import OutputsValidation as OutputsValidation
 from .validation.outputs import joint_fit as joint_fit
-from .validation.outputs import validate_outputs as validate_outputs
 from .validation.selection import choose as choose
 from .validation.selection import choose_order as choose_order
 from .validation.selection import fits_by_order as fits_by_order
@@ -72,13 +71,13 @@ __all__ = [
     "CorrelationTest",
     "EstimatorResult",
     "FittedModel",
+    "FittedModelProtocol",
     "IOData",
     "IdentifiedModel",
     "ModalParametrization",
     "ModeTable",
     "NARXModel",
     "NonlinearChecks",
-    "OutputsValidation",
     "PaperCost",
     "ParetoIdentification",
     "PolynomialNARX",
@@ -118,7 +117,6 @@ __all__ = [
     "step_up",
     "subspace_denominator",
     "validate",
-    "validate_outputs",
     "validation_fits",
     "whiteness_test",
 ]

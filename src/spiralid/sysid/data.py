@@ -29,9 +29,10 @@ __all__ = ["IOData"]
 
 def single_output_record(data, what: str):
     """`data` checked as an :class:`IOData` of one output, for `what` (a
-    function that models one output): a one-line ValueError otherwise."""
+    function that models one output): a one-line TypeError (not an IOData)
+    or ValueError (several outputs) otherwise."""
     if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     data.require_single_output(what)
     return data
 
@@ -381,7 +382,7 @@ class IOData:
         """
         ref = self if like is None else like
         if not isinstance(ref, IOData):
-            raise ValueError(f"`like` must be an IOData; got {type(like).__name__}")
+            raise TypeError(f"`like` must be an IOData; got {type(like).__name__}")
         if ref.n_outputs != self.n_outputs:
             raise ValueError(
                 f"`like` must have the record's {self.n_outputs} output(s); got "

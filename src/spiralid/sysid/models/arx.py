@@ -36,11 +36,18 @@ from ..data import IOData, single_output_record
 from ..signals import check_signal
 from .polynomials import is_stable_polynomial
 
-__all__ = ["ARX", "INITIAL_CONDITIONS", "arx_least_squares"]
+__all__ = ["ARX", "INITIAL_CONDITIONS", "arx_least_squares", "check_arx"]
 
 # How a free run starts: from rest (zero past samples) or from the record's
 # first measured samples.
 INITIAL_CONDITIONS = ("rest", "measured")
+
+
+def check_arx(value, name: str = "arx") -> None:
+    """`value` is an ARX structure (its ``family`` is ``"arx"``), or a
+    one-line TypeError naming the argument `name`."""
+    if getattr(value, "family", None) != "arx":
+        raise TypeError(f"`{name}` must be an ARX; got {type(value).__name__}")
 
 
 @dataclass(frozen=True)
@@ -87,6 +94,12 @@ class ARX:
 
     #: Linear in the signals: poles, modes and the linear residual tests apply.
     is_linear = True
+
+    #: The family whose estimators fit this structure: the first key of
+    #: the estimator table (:data:`~spiralid.sysid.estimation.core.families.
+    #: ESTIMATORS`), on a record of one output and of several.
+    family = "arx"
+    outputs_family = "shared-denominator"
 
     @property
     def max_lag(self) -> int:

@@ -8,8 +8,13 @@ from that name to the class whose ``from_dict`` reads it.
 
 from __future__ import annotations
 
+import json
+import os
+from pathlib import Path
+
 from .identified import IdentifiedModel
 from .narx import NARXModel
+from .protocol import FittedModelProtocol
 from .shared import SharedDenominatorModel
 
 __all__ = ["MODEL_KINDS", "load_model"]
@@ -31,13 +36,13 @@ def model_kind(d: dict) -> str:
     return kind
 
 
-def load_model(d: dict):
+def load_model(d: dict | str | os.PathLike) -> FittedModelProtocol:
     """The fitted model a ``to_dict()`` (a ``model.json``) describes.
 
     Parameters
     ----------
-    d : dict
-        The model file's content.
+    d : dict, str or path-like
+        The model file's content, or the path of the file (UTF-8 JSON).
 
     Returns
     -------
@@ -47,9 +52,20 @@ def load_model(d: dict):
     Raises
     ------
     ValueError
-        When `d` is not an object, names an unknown kind, or a field is
-        missing or out of range (named in the message).
+        When the content is not an object, names an unknown kind, or a
+        field is missing or out of range (named in the message); when the
+        file is not JSON.
+    OSError
+        When the file cannot be read.
     """
+    if isinstance(d, str | os.PathLike):
+        path = Path(d)
+        try:
+            d = json.loads(path.read_text(encoding="utf-8"))
+        except ValueError as exc:
+            raise ValueError(
+                f"`d` {str(path)!r} is not a JSON model file: {exc}"
+            ) from None
     if not isinstance(d, dict):
         raise ValueError(f"a model must be a JSON object; got {type(d).__name__}")
     return MODEL_KINDS[model_kind(d)].from_dict(d)

@@ -15,11 +15,13 @@ with one output name, unit and offset per output instead of
 
 Every structure declares the same protocol (:class:`~spiralid.sysid.ARX`,
 :class:`~spiralid.sysid.NARX`, :class:`~spiralid.sysid.PolynomialNARX`):
-``n_params``, ``is_linear`` and a ``to_dict`` of its own. Every fitted model
-answers ``structure``, ``params``, ``simulate(u)``, ``predict(data)``,
-``is_stable``, ``linear_part`` (the linear model inside it: itself for an
-ARX fit) and ``to_dict()``; :func:`~spiralid.sysid.models.files.load_model`
-reads any of them back.
+``n_params``, ``is_linear`` and a ``to_dict`` of its own. Every fitted model,
+of one output or several, implements
+:class:`~spiralid.sysid.models.protocol.FittedModelProtocol` (``structure``,
+``params``, ``simulate(u)``, ``predict(data)``, ``linear_part``,
+``output_names``, ``output_model``, ``summary()``, ``to_dict()``; a linear
+model ``modes`` and ``is_stable`` too);
+:func:`~spiralid.sysid.models.files.load_model` reads any of them back.
 """
 
 from __future__ import annotations
@@ -31,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from spiralid._checks import one_of
+from spiralid._checks import named_index, one_of
 
 from . import _fields
 from .arx import INITIAL_CONDITIONS
@@ -215,6 +217,32 @@ class FittedModel(Provenance):
         modes and realisation tests of :func:`~spiralid.sysid.validate`
         apply; otherwise the higher-order correlation tests do."""
         return bool(self.structure.is_linear)
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        """The one output this model predicts (as a model of several
+        outputs names each of its own)."""
+        return (self.output_name,)
+
+    def output_model(self, which: int | str = 0) -> FittedModel:
+        """The model of output `which` (its name or 0): the model itself,
+        which :func:`~spiralid.sysid.validate` validates as it is."""
+        named_index(which, "which", self.output_names)
+        return self
+
+    def summary(self) -> str:
+        """The model in a few lines: structure, method, cost, output and,
+        for a linear model, stability and the transfer function."""
+        lines = [
+            f"{type(self).__name__} of {self.output_name!r} from "
+            f"{self.input_name!r}: {self.structure}",
+            f"method {self.method}, predictor {self.predictor}, "
+            f"cost {self.cost:.6g}, ts {self.ts:g} s",
+        ]
+        if self.is_linear:
+            lines.append(f"stable: {self.is_stable}")
+            lines.append(self.tf_string())
+        return "\n".join(lines)
 
     def _provenance_dict(self) -> dict:
         """The provenance as a model file holds it, the output's fields

@@ -67,7 +67,9 @@ class NARXModel(FittedModel):
     structure).
 
     What :func:`spiralid.sysid.identify` returns for a :class:`NARX` or
-    :class:`PolynomialNARX` structure.
+    :class:`PolynomialNARX` structure. A nonlinear model has no poles, so
+    neither ``is_stable`` nor ``modes``: whether its free run stays bounded
+    is what :func:`~spiralid.sysid.validate` reports (``diverged``).
 
     Attributes
     ----------
@@ -186,12 +188,6 @@ class NARXModel(FittedModel):
             prev = np.r_[0.0, data.y[:-1]]
             return prev + z * s.y_scale
         return s.y_shift + s.y_scale * z
-
-    @property
-    def is_stable(self) -> bool:
-        """True: stability of a nonlinear model is judged by its free run
-        (:func:`~spiralid.sysid.validate` reports it), not by poles."""
-        return True
 
     def to_dict(self, *, timings: bool = True) -> dict:
         """A JSON-safe dictionary; ``NARXModel.from_dict`` reads it back.

@@ -105,6 +105,10 @@ class NARX(_Lags):
     #: even when training kept its output weights at zero.
     is_linear = False
 
+    #: The estimator table's family (a record of one output only).
+    family = "narx"
+    outputs_family = None
+
     @property
     def n_params(self) -> int:
         """Length of the parameter vector."""

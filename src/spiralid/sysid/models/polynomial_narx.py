@@ -93,6 +93,10 @@ class PolynomialNARX(_Lags):
     #: ``degree=1``: its fitted model holds monomials, not polynomials in q.
     is_linear = False
 
+    #: The estimator table's family (a record of one output only).
+    family = "polynomial-narx"
+    outputs_family = None
+
     @property
     def n_params(self) -> int:
         """Number of coefficients (the chosen terms, or the cap)."""

@@ -247,7 +247,34 @@ class SharedDenominatorModel(Provenance):
     def n_outputs(self) -> int:
         return int(self.b.shape[0])
 
-    def theta(self, i: int) -> np.ndarray:
+    @property
+    def structure(self) -> ARX:
+        """The structure every output has (:attr:`arx`), under the name
+        every fitted model answers to."""
+        return self.arx
+
+    @property
+    def params(self) -> np.ndarray:
+        """Every estimated parameter, ``[a, b_1, ..., b_p]`` (the shared
+        denominator, then each output's numerator)."""
+        return np.r_[self.a, self.b.ravel()]
+
+    @property
+    def theta(self) -> np.ndarray:
+        """The parameters (:attr:`params`), as an ARX fit's ``theta``."""
+        return self.params
+
+    @property
+    def is_linear(self) -> bool:
+        """True: the modes and stability come from the shared poles."""
+        return True
+
+    @property
+    def linear_part(self) -> SharedDenominatorModel:
+        """The linear model inside this one: the model itself."""
+        return self
+
+    def output_theta(self, i: int) -> np.ndarray:
         """Output `i`'s ARX theta ``[a, b_i]`` with its known integrators in
         the denominator (the structure of :meth:`output_arx`)."""
         return np.r_[with_integrator(self.a, self.integrators[i]), self.b[i]]
@@ -261,8 +288,18 @@ class SharedDenominatorModel(Provenance):
         u = np.asarray(getattr(u, "u", u), dtype=float)
         return np.column_stack(
             [
-                self.output_arx(i).simulate(self.theta(i), u)
+                self.output_arx(i).simulate(self.output_theta(i), u)
                 for i in range(self.n_outputs)
+            ]
+        )
+
+    def predict(self, data) -> np.ndarray:
+        """One-step-ahead prediction of every output on `data` (a record
+        holding the model's outputs by name), shape (N, p)."""
+        return np.column_stack(
+            [
+                self.output_model(name).predict(data.output(name))
+                for name in self.output_names
             ]
         )
 
@@ -273,7 +310,7 @@ class SharedDenominatorModel(Provenance):
         intervals belong to the shared modes)."""
         i = named_index(which, "which", self.output_names)
         return IdentifiedModel(
-            self.theta(i),
+            self.output_theta(i),
             arx=self.output_arx(i),
             integrator=self.integrators[i],
             ts=self.ts,
@@ -320,12 +357,43 @@ class SharedDenominatorModel(Provenance):
         strongest = int(np.argmax(np.nansum(share, axis=0))) if share.size else 0
         return SharedModes(tables[strongest], share, self.output_names)
 
+    def tf_string(self, digits: int = 4) -> str:
+        """Each output's transfer function in z (:meth:`output_model`'s),
+        one line per output after its name."""
+        return "\n".join(
+            f"{name}: {self.output_model(name).tf_string(digits)}"
+            for name in self.output_names
+        )
+
+    def to_dlti(self) -> signal.dlti:
+        """The model as a SIMO ``scipy.signal.dlti`` state-space system with
+        ``dt = ts`` (the realisation of :meth:`to_control`)."""
+        return signal.dlti(*self._state_space(), dt=self.ts)
+
+    def summary(self) -> str:
+        """The model in a few lines: structure, outputs, method, cost,
+        stability and each output's transfer function."""
+        return "\n".join(
+            [
+                f"SharedDenominatorModel of {', '.join(self.output_names)} from "
+                f"{self.input_name!r}: {self.arx}",
+                f"method {self.method}, joint cost {self.cost:.6g}, ts {self.ts:g} s",
+                f"stable: {self.is_stable}",
+                self.tf_string(),
+            ]
+        )
+
     def to_control(self):
         """The model as a python-control SIMO state-space system in z
         (``dt = ts``): one state for the shared denominator, a row of ``C``
         per output (``scipy.signal.tf2ss`` of the numerators over ``A``).
         Needs python-control (``pip install "spiralid[control]"``)."""
         control = python_control()
+        return control.ss(*self._state_space(), self.ts)
+
+    def _state_space(self):
+        """``(A, B, C, D)`` of one state-space realisation of every output
+        over the shared denominator."""
         # Over the common denominator A (1 - z^-1)^kmax: each numerator times
         # the integrators its output lacks.
         kmax = max(self.integrators)
@@ -340,8 +408,7 @@ class SharedDenominatorModel(Provenance):
         # Leading zero columns (the delay nk) are a strictly proper system's:
         # left in, scipy warns of badly conditioned coefficients.
         lead = np.argmax(np.any(num != 0.0, axis=0)) if np.any(num) else 0
-        a, b, c, d = signal.tf2ss(num[:, lead:], polys[0][1])
-        return control.ss(a, b, c, d, self.ts)
+        return signal.tf2ss(num[:, lead:], polys[0][1])
 
     def to_dict(self, *, timings: bool = True) -> dict:
         """A JSON-safe form (what ``model.json`` holds).

@@ -31,8 +31,9 @@ def linear_checks(model, ts: float, max_damping: float) -> dict:
 
     Parameters
     ----------
-    model : IdentifiedModel
-        A linear model (``theta``, ``arx``, ``poles``, ``zeros``).
+    model : FittedModelProtocol
+        A linear model (``poles``, ``zeros``, ``polynomials``,
+        ``free_denominator``: the protocol's linear members).
     ts : float
         Sample time (s), for the modes.
     max_damping : float
@@ -51,12 +52,10 @@ def linear_checks(model, ts: float, max_damping: float) -> dict:
     # clustered poles near the circle.
     # Without the known integrators' poles (z = 1), which the model has by
     # design (`identify(integrator=...)`).
-    denominator = np.asarray(
-        getattr(model, "free_denominator", model.theta[: model.arx.na]), dtype=float
-    )
-    # An IdentifiedModel's own polynomials: those of its effective order
-    # when the estimation removed a pole-zero pair.
-    num, den = getattr(model, "polynomials", None) or model.arx.polynomials(model.theta)
+    denominator = np.asarray(model.free_denominator, dtype=float)
+    # The model's own polynomials: an ARX fit's are those of its effective
+    # order when the estimation removed a pole-zero pair.
+    num, den = model.polynomials
     return dict(
         modes=modes_from_poles(poles, ts, max_damping=max_damping),
         stable=bool(is_stable_polynomial(denominator)),

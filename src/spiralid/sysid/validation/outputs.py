@@ -1,11 +1,13 @@
 """Validation of a model of several outputs: each output's fit and a joint
-fit.
+fit, in the one :class:`~spiralid.sysid.validation.result.Validation`.
 
-A :class:`~spiralid.sysid.models.shared.SharedDenominatorModel` is validated
-output by output: each output's transfer function ``B_i / A``
-(:meth:`~spiralid.sysid.models.shared.SharedDenominatorModel.output_model`)
-through :func:`~spiralid.sysid.validate` on that output, so every test and
-figure of one output holds for each. The joint fit combines them:
+:func:`~spiralid.sysid.validate` validates a model of several outputs
+(e.g. a :class:`~spiralid.sysid.models.shared.SharedDenominatorModel`)
+output by output: each output's model (``model.output_model(name)``, for a
+shared denominator its transfer function ``B_i / A``) on that output of
+the record, so every test and figure of one output holds for each. The
+result is a :class:`Validation` whose ``outputs`` holds each output's and
+whose ``fit_percent`` is the joint fit:
 
     joint fit = 100 (1 - sqrt(mean_i (1 - fit_i / 100)^2)),
 
@@ -15,15 +17,11 @@ the fit of a single output when there is one).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..data import IOData
-from ..models.shared import SharedDenominatorModel, SharedModes
-from .validate import Validation, validate
 
-__all__ = ["OutputsValidation", "joint_fit", "validate_outputs"]
+__all__ = ["check_output_records", "joint_dict", "joint_fit", "joint_summary"]
 
 
 def joint_fit(fits) -> float:
@@ -44,107 +42,44 @@ def joint_fit(fits) -> float:
     return float(100.0 * (1.0 - np.sqrt(np.mean(miss**2))))
 
 
-@dataclass
-class OutputsValidation:
-    """Each output's :class:`Validation`, the joint fit and the modes.
-
-    Parameters
-    ----------
-    outputs : dict of str to Validation
-        Each output's validation, by name.
-    joint_fit_percent : float
-        :func:`joint_fit` of their fits.
-    modes : SharedModes
-        The model's shared modes with intervals and shares.
-    label : str
-        A name for the tables.
-    """
-
-    outputs: dict[str, Validation]
-    joint_fit_percent: float
-    modes: SharedModes
-    label: str = ""
-
-    def summary(self, modes: bool = True) -> str:
-        """A plain-text table: each output's fit, the joint fit and (unless
-        `modes` is False) the modes."""
-        title = f"Validation of {self.label}" if self.label else "Validation"
-        width = max(len(n) for n in self.outputs)
-        lines = [title, "-" * max(len(title), 40)]
-        for name, v in self.outputs.items():
-            flag = " (diverged)" if v.diverged else ""
-            lines.append(f"fit % of {name:<{width}}  {v.fit_percent:8.2f}{flag}")
-        lines.append(f"joint fit %{' ' * (width - 2)}  {self.joint_fit_percent:8.2f}")
-        if modes:
-            lines += [
-                "",
-                "Shared modes (share of each output's peaks)",
-                str(self.modes),
-            ]
-        return "\n".join(lines)
-
-    def to_dict(self) -> dict:
-        return {
-            "label": self.label,
-            "joint_fit_percent": self.joint_fit_percent,
-            "outputs": {name: v.to_dict() for name, v in self.outputs.items()},
-            "modes": self.modes.to_dict(),
-        }
-
-
-def validate_outputs(
-    model: SharedDenominatorModel,
-    data: IOData,
-    *,
-    warmup: IOData | None = None,
-    label: str | None = None,
-) -> OutputsValidation:
-    """Validate a shared-denominator model on a record of its outputs.
-
-    Parameters
-    ----------
-    model : SharedDenominatorModel
-    data : IOData
-        A record holding every output of `model` (by name; others are left
-        out).
-    warmup : IOData, optional
-        The record before `data` (the estimation part), run through first,
-        as :func:`~spiralid.sysid.validate`'s ``warmup``.
-    label : str, optional
-        A name for the tables; default the model's method.
-
-    Returns
-    -------
-    OutputsValidation
-    """
-    if not isinstance(model, SharedDenominatorModel):
-        raise ValueError(
-            f"`model` must be a SharedDenominatorModel; got {type(model).__name__}"
-        )
+def check_output_records(model, data, warmup) -> None:
+    """`data` and `warmup` (None: none) hold every output of `model`, by
+    name; a one-line ValueError naming the record and the missing outputs
+    otherwise."""
     for name, record in (("data", data), ("warmup", warmup)):
         if record is None:
             continue
         if not isinstance(record, IOData):
-            raise ValueError(f"`{name}` must be an IOData; got {type(record).__name__}")
+            raise TypeError(f"`{name}` must be an IOData; got {type(record).__name__}")
         missing = [o for o in model.output_names if o not in record.output_names]
         if missing:
             raise ValueError(
                 f"`{name}` must hold the model's outputs {model.output_names}; "
                 f"missing {missing}"
             )
-    label = model.method if label is None else str(label)
-    outputs = {
-        name: validate(
-            model.output_model(name),
-            data.output(name),
-            warmup=None if warmup is None else warmup.output(name),
-            label=f"{label}, {name}",
-        )
-        for name in model.output_names
+
+
+def joint_summary(v, modes: bool = True) -> str:
+    """The plain-text table of a validation of several outputs `v`: each
+    output's fit, the joint fit and (unless `modes` is False) the model's
+    modes."""
+    title = f"Validation of {v.label}" if v.label else "Validation"
+    width = max(len(n) for n in v.outputs)
+    lines = [title, "-" * max(len(title), 40)]
+    for name, one in v.outputs.items():
+        flag = " (diverged)" if one.diverged else ""
+        lines.append(f"fit % of {name:<{width}}  {one.fit_percent:8.2f}{flag}")
+    lines.append(f"joint fit %{' ' * (width - 2)}  {v.fit_percent:8.2f}")
+    if modes and v.mode_table is not None:
+        lines += ["", "Shared modes (share of each output's peaks)", str(v.mode_table)]
+    return "\n".join(lines)
+
+
+def joint_dict(v) -> dict:
+    """The JSON form of a validation of several outputs `v`."""
+    return {
+        "label": v.label,
+        "joint_fit_percent": v.fit_percent,
+        "outputs": {name: one.to_dict() for name, one in v.outputs.items()},
+        "modes": None if v.mode_table is None else v.mode_table.to_dict(),
     }
-    return OutputsValidation(
-        outputs,
-        joint_fit([v.fit_percent for v in outputs.values()]),
-        model.modes,
-        label,
-    )

@@ -12,11 +12,13 @@ import numpy as np
 
 from ..models.modes import ModeTable
 from ..models.polynomials import format_pole_radius
+from ..models.shared import SharedModes
 from ..spectra import PSD, Modes, Peaks
 from .correlation import CorrelationTest
 from .fit import _format_fit
 from .higher_order import correlation_dict
 from .nonlinear import NonlinearChecks
+from .outputs import joint_dict, joint_summary
 from .realization import Realization
 
 __all__ = ["Validation"]
@@ -36,7 +38,8 @@ _NO_POLES = (
 class Validation:
     """Everything :func:`validate` found out about a model on a record.
 
-    One type for every structure. Time-domain figures come in pairs: the
+    One type for every structure and for one output or several (see
+    ``outputs``). Time-domain figures come in pairs: the
     free-run simulation (the primary one, the paper's validation) and the
     one-step prediction (``*_one_step``). Errors are ``y - yhat``. The
     fields marked *linear* describe a linear model's poles; for a nonlinear
@@ -116,10 +119,11 @@ class Validation:
         spiral searches): the noise is not modelled, so the whiteness test
         does not apply to it and its one-step prediction is not what it
         promises (the summary leaves both out and says why).
-    mode_table : ModeTable or None
+    mode_table : ModeTable, SharedModes or None
         *Linear.* The model's modes with 95 % intervals and flags
         (:attr:`~spiralid.sysid.IdentifiedModel.modes`), when the model has
-        a covariance.
+        a covariance; for a model of several outputs, its shared modes with
+        each one's share per output.
     reduction : str or None
         *Linear.* What the estimation's pole-zero cancellation removed
         (:attr:`~spiralid.sysid.IdentifiedModel.reduction`), or None.
@@ -135,37 +139,46 @@ class Validation:
         correlation tests and what the network added over its linear start
         (:class:`~spiralid.sysid.validation.nonlinear.NonlinearChecks`);
         None for a linear model.
+    outputs : dict of str to Validation, or None
+        For a model of several outputs, each output's validation by name;
+        then ``fit_percent`` is their joint fit
+        (:func:`~spiralid.sysid.validation.outputs.joint_fit`),
+        ``mode_table`` the model's modes (for a shared denominator a
+        :class:`~spiralid.sysid.models.shared.SharedModes`, with each
+        mode's share per output), and the fields of one output's record
+        (signals, tests, spectra) are None: they are in each output's.
+        None for a model of one output.
     """
 
     label: str
-    n_samples: int
-    ts: float
-    fit_percent: float
-    fit_percent_one_step: float
-    rmse: float
-    rmse_one_step: float
-    cost: float
-    cost_predictor: str
-    error_range: tuple[float, float]
-    error_range_one_step: tuple[float, float]
-    residuals: str
-    whiteness: CorrelationTest
-    independence: CorrelationTest
-    psd_measured: PSD
-    psd_model: PSD
-    peaks_measured: Peaks
-    peaks_model: Peaks
-    modes: Modes
-    stable: bool | None
-    max_pole_radius: float | None
-    realization: Realization | None
-    poles: np.ndarray
-    zeros: np.ndarray
-    t: np.ndarray
-    u: np.ndarray
-    y: np.ndarray
-    y_sim: np.ndarray
-    y_pred: np.ndarray
+    n_samples: int | None = None
+    ts: float | None = None
+    fit_percent: float | None = None
+    fit_percent_one_step: float | None = None
+    rmse: float | None = None
+    rmse_one_step: float | None = None
+    cost: float | None = None
+    cost_predictor: str | None = None
+    error_range: tuple[float, float] | None = None
+    error_range_one_step: tuple[float, float] | None = None
+    residuals: str | None = None
+    whiteness: CorrelationTest | None = None
+    independence: CorrelationTest | None = None
+    psd_measured: PSD | None = None
+    psd_model: PSD | None = None
+    peaks_measured: Peaks | None = None
+    peaks_model: Peaks | None = None
+    modes: Modes | None = None
+    stable: bool | None = None
+    max_pole_radius: float | None = None
+    realization: Realization | None = None
+    poles: np.ndarray | None = None
+    zeros: np.ndarray | None = None
+    t: np.ndarray | None = None
+    u: np.ndarray | None = None
+    y: np.ndarray | None = None
+    y_sim: np.ndarray | None = None
+    y_pred: np.ndarray | None = None
     output_name: str = "output"
     output_unit: str = ""
     integrator: int = 0
@@ -173,10 +186,11 @@ class Validation:
     fit_percent_measured: float = float("nan")
     diverged: bool = False
     output_error: bool = False
-    mode_table: ModeTable | None = None
+    mode_table: ModeTable | SharedModes | None = None
     reduction: str | None = None
     choice: str | None = None
     nonlinear: NonlinearChecks | None = None
+    outputs: dict[str, Validation] | None = None
 
     @property
     def is_linear(self) -> bool:
@@ -230,9 +244,13 @@ class Validation:
             ]
         )
 
-    def summary(self) -> str:
+    def summary(self, modes: bool = True) -> str:
         """A plain-text table of the results (a nonlinear model's
-        Billings-Voon tests after it)."""
+        Billings-Voon tests after it); for several outputs each output's
+        fit, the joint fit and (unless `modes` is False) the model's
+        modes."""
+        if self.outputs is not None:
+            return joint_summary(self, modes)
 
         def hz(x) -> str:
             return ", ".join(f"{v:.2f}" for v in x) or "none"
@@ -371,7 +389,10 @@ class Validation:
         """JSON-safe dictionary, of the same keys for every structure: the
         linear keys null and ``"nonlinear"`` an object for a nonlinear
         model, ``"nonlinear"`` null for a linear one; ``signals=True`` adds
-        the time series."""
+        the time series. For several outputs: the label, the joint fit,
+        each output's dictionary and the model's modes."""
+        if self.outputs is not None:
+            return joint_dict(self)
 
         def cplx(z):
             return [[float(v.real), float(v.imag)] for v in np.asarray(z)]
@@ -440,10 +461,17 @@ class Validation:
             (PSDs with peaks, and a linear model's modes); then
             ``"pole_zero"`` (map with unit circle) for a linear model, or
             ``"billings_voon"`` (the five higher-order correlations) for a
-            nonlinear one.
+            nonlinear one. For several outputs, each output's figures,
+            keyed ``"<output>_<figure>"``.
         """
         from . import plots
 
+        if self.outputs is not None:
+            return {
+                f"{output}_{kind}": fig
+                for output, one in self.outputs.items()
+                for kind, fig in one.plot().items()
+            }
         name = self.label or "model"
         figures = {
             "time": plots.plot_time_response(

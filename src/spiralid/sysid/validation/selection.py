@@ -36,7 +36,7 @@ from spiralid._checks import nonneg, one_of
 from spiralid.optim.front import knee_point
 
 from ..estimation.pareto.identify import ParetoIdentification
-from ..models.fitted import FittedModel
+from ..models.protocol import is_fitted
 from .validate import validate
 
 __all__ = [
@@ -112,7 +112,7 @@ def _candidates(front) -> tuple[list, np.ndarray, list[int]]:
         sizes = [m.arx.na + m.arx.nb for m in front.models]
         return list(front.models), front.objectives[:, 0], sizes
     models = list(front) if isinstance(front, list | tuple) else None
-    if not models or not all(isinstance(m, FittedModel) for m in models):
+    if not models or not all(is_fitted(m) for m in models):
         raise ValueError(
             "`front` must be a ParetoIdentification or a non-empty list of "
             f"fitted models (identify's results); got {type(front).__name__}"
@@ -126,7 +126,7 @@ def validation_fits(front, data, *, warmup=None) -> list[tuple[int, int, float]]
 
     Parameters
     ----------
-    front : ParetoIdentification or list of FittedModel
+    front : ParetoIdentification or list of fitted models
         From :func:`~spiralid.sysid.identify_pareto`, or models of any
         structures (e.g. NARX models of several lags and hidden sizes, each
         from :func:`~spiralid.sysid.identify`).
@@ -166,7 +166,7 @@ def fits_by_order(front, data, *, warmup=None) -> dict[int, tuple[int, float]]:
 
     Parameters
     ----------
-    front : ParetoIdentification or list of FittedModel
+    front : ParetoIdentification or list of fitted models
         As in :func:`validation_fits`; a list whose models all differ in
         size (the number of parameters), as one size keys one fit.
     data : IOData
@@ -210,7 +210,7 @@ def choose_order(front, data, *, warmup=None, tolerance: float = 1.0) -> int:
 
     Parameters
     ----------
-    front : ParetoIdentification or list of FittedModel
+    front : ParetoIdentification or list of fitted models
         From :func:`~spiralid.sysid.identify_pareto` (orders ``na + nb``,
         each order's lowest-cost model validated), or fitted models of any
         structures, e.g. NARX models of several lags and hidden sizes

@@ -148,7 +148,7 @@ def stabilisation(
     StabilisationDiagram
     """
     if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     try:
         orders = tuple(sorted({integer(n, "orders", 1) for n in orders}))
     except TypeError:

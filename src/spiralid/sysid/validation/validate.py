@@ -29,6 +29,7 @@ import numpy as np
 from spiralid._checks import one_of, refuse_options
 
 from ..estimation.core.cost import cost_of_errors
+from ..models.protocol import check_fitted
 from ..signals import check_pair
 from ..spectra import find_resonances, psd
 from .correlation import (
@@ -48,6 +49,7 @@ from .fit import (
 )
 from .linear import absent, linear_checks, runaway_note
 from .nonlinear import nonlinear_checks
+from .outputs import check_output_records, joint_fit
 from .realization import Realization, realization_tests
 from .result import Validation
 
@@ -81,19 +83,27 @@ def validate(
 
     Parameters
     ----------
-    model : IdentifiedModel or NARXModel
+    model : FittedModelProtocol
         From :func:`~spiralid.sysid.identify` or
-        :func:`~spiralid.sysid.load_model`: an ARX model (anything with
-        ``theta``, ``arx``, ``ts``, ``predictor``, ``gain``, ``simulate(u)``,
-        ``predict(data)``, ``poles``, ``zeros``) or a nonlinear one (its
-        ``structure.is_linear`` false: NARX, polynomial NARX). Both get the
-        same :class:`Validation`; a linear model's has its poles, modes and
-        realisation tests, a nonlinear model's its ``nonlinear`` part (the
-        Billings-Voon tests, the network's gain over its linear start).
-        `max_damping` (modes from poles) does not apply to a nonlinear
-        model: a value other than its default is refused in one line.
+        :func:`~spiralid.sysid.load_model`, of any family (it implements
+        :class:`~spiralid.sysid.models.protocol.FittedModelProtocol`): a
+        linear model (ARX) or a nonlinear one (``is_linear`` false: NARX,
+        polynomial NARX). Every model gets the same :class:`Validation`; a
+        linear model's has its poles, modes and realisation tests, a
+        nonlinear model's its ``nonlinear`` part (the Billings-Voon tests,
+        the network's gain over its linear start). `max_damping` (modes
+        from poles) does not apply to a nonlinear model: a value other than
+        its default is refused in one line. A model of several outputs
+        (:class:`~spiralid.sysid.SharedDenominatorModel`) is validated
+        output by output (``model.output_model(name)`` on ``data.output(name)``,
+        with every option here): its :class:`Validation` holds each
+        output's in ``outputs``, the joint fit as ``fit_percent``
+        (:func:`~spiralid.sysid.validation.outputs.joint_fit`) and the
+        model's modes as ``mode_table``.
     data : IOData
-        The validation record, usually the last third (the paper's split).
+        The validation record, usually the last third (the paper's split);
+        for a model of several outputs, a record holding each of them by
+        name.
         The model is run from zero initial conditions over it.
     lags : int, default 25
         Correlation lags: autocorrelation at ``1..lags``, cross-correlation at
@@ -136,7 +146,8 @@ def validate(
     Returns
     -------
     Validation
-        One type for every structure (see :class:`Validation`).
+        One type for every model, of one output or several (see
+        :class:`Validation`).
 
     Raises
     ------
@@ -186,7 +197,20 @@ def validate(
     hardly decays. Pass ``warmup`` to validate such a model from the state
     it has reached.
     """
-    linear = bool(getattr(model, "is_linear", True))
+    options = dict(
+        lags=lags,
+        n_peaks=n_peaks,
+        levels=levels,
+        residuals=residuals,
+        nperseg=nperseg,
+        max_damping=max_damping,
+        gain=gain,
+    )
+    check_fitted(model)
+    names = tuple(model.output_names)
+    if len(names) > 1 or model.output_model(names[0]) is not model:
+        return _validate_outputs(model, data, warmup, label, options)
+    linear = bool(model.is_linear)
     if not linear:
         # Modes are read from poles, which a nonlinear model does not have:
         # the option is refused rather than ignored.
@@ -201,7 +225,7 @@ def validate(
         )  # fmt: skip
     if isinstance(residuals, str) and residuals == "auto":
         residuals = _fitted_error(model)
-    u, y, ts, lags, predictor = _valid_inputs(model, data, lags, residuals, linear)
+    u, y, ts, lags, predictor = _valid_inputs(model, data, lags, residuals)
     extras = linear_checks(model, ts, max_damping) if linear else absent()
 
     # The shared part, the same for every structure.
@@ -268,6 +292,29 @@ def validate(
     )
 
 
+def _validate_outputs(model, data, warmup, label, options: dict) -> Validation:
+    """`validate` of a model of several outputs: each output's model on
+    that output of the records, and their joint fit."""
+    check_output_records(model, data, warmup)
+    label = model.method if label is None else str(label)
+    outputs = {
+        name: validate(
+            model.output_model(name),
+            data.output(name),
+            warmup=None if warmup is None else warmup.output(name),
+            label=f"{label}, {name}",
+            **options,
+        )
+        for name in model.output_names
+    }
+    return Validation(
+        label=label,
+        fit_percent=joint_fit([v.fit_percent for v in outputs.values()]),
+        mode_table=model.modes if model.is_linear else None,
+        outputs=outputs,
+    )
+
+
 def _choice_notes(model) -> str | None:
     """What the estimate's held-back choices said (among minima, and of the
     stability margin), in words; None when it made neither."""
@@ -293,21 +340,14 @@ def _fitted_error(model) -> str:
     return (method.minimises if method is not None else None) or predictor
 
 
-def _valid_inputs(model, data, lags, residuals, linear: bool):
+def _valid_inputs(model, data, lags, residuals):
     """`validate`'s argument checks: the signals, ``lags`` and the predictor,
     before any simulation or spectrum is computed."""
-    needs = ("simulate", "predict", "arx", "theta") if linear else ("simulate",
-             "predict", "structure")  # fmt: skip
-    if not all(hasattr(model, k) for k in needs):
-        raise ValueError(
-            "`model` must be an IdentifiedModel or a NARXModel (from identify() "
-            f"or load_model); got {type(model).__name__}"
-        )
     u, y, ts = _signals_of(data)
     # Checked here too (the correlation tests would) so a bad `lags` fails
     # before the simulation and spectra are computed.
     lags = check_lags(lags, y.size)
-    structure = model.arx if linear else model.structure
+    structure = model.structure
     if structure.max_lag >= y.size:
         # Before any signal of that length is built (a tampered file's nk
         # could ask for terabytes).

@@ -55,7 +55,7 @@ from scipy.signal import lfilter, lfiltic
 from spiralid._checks import nonneg, one_of, positive
 
 from ...data import IOData, single_output_record
-from ...models.arx import ARX, INITIAL_CONDITIONS
+from ...models.arx import ARX, INITIAL_CONDITIONS, check_arx
 from ...models.polynomials import is_stable_polynomial
 
 __all__ = ["INITIAL_CONDITIONS", "PaperCost", "auto_gain", "cost_of_errors"]
@@ -149,8 +149,7 @@ class PaperCost:
         penalty: float = 1e6,
         initial: str = "rest",
     ) -> None:
-        if not isinstance(arx, ARX):
-            raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+        check_arx(arx)
         single_output_record(data, "PaperCost")
         one_of(predictor, "predictor", _PREDICTORS)
         one_of(initial, "initial", INITIAL_CONDITIONS)

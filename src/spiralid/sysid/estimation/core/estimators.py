@@ -1,8 +1,12 @@
-"""Estimators: one function per method, chosen by name from :data:`METHODS`.
+"""The ARX estimators: one function per method, chosen by name from
+:data:`METHODS`.
 
-As ``scipy.optimize`` has one ``_minimize_<method>`` per method,
-:func:`~spiralid.sysid.identify` checks its arguments, gathers them in a
-:class:`Problem` and calls ``METHODS[method].estimate(problem, **options)``.
+As ``scipy.optimize`` has one ``_minimize_<method>`` per method, the ARX
+family's fit (:func:`~spiralid.sysid.estimation.core.arx_fit.fit_arx`, the ARX
+entries of :data:`~spiralid.sysid.estimation.core.families.ESTIMATORS`) gathers
+identify's checked arguments in a :class:`Problem` and calls
+``METHODS[method].estimate(problem, **options)``. Other families' estimators
+are their entries in that table.
 Every estimator returns an :class:`EstimatorResult`, an ``OptimizeResult``
 whose ``x`` is the ARX theta.
 
@@ -95,11 +99,10 @@ from functools import partial
 
 from spiralid.choices import DEFAULT_METHOD, METHOD_NAMES, require_names
 from spiralid.optim import MINIMIZE_OPTIONS, RULES, differential_evolution, minimize
-from spiralid.optim.result import STATUS, OptimiserResult
+from spiralid.optim.result import STATUS
 
 from ..linear.local_estimators import _estimate_ls, _estimate_oe
 from ..linear.parametrizations import DEFAULT_PARAMETRIZATION
-from ..narx import training as _narx
 from ..spiral.population import _estimate_de, _estimate_spiral, search_options
 from ..spiral.recommended import _estimate_recommended
 from .problem import EstimatorResult, Problem
@@ -136,10 +139,6 @@ class Method:
         Default of ``identify(safe_start=None)`` (see the module docstring).
     parametrization : str
         Default of ``identify(parametrization=None)``.
-    narx : callable or None
-        The estimator for a NARX structure,
-        ``narx(problem: NARXProblem, **options) -> OptimizeResult`` (see
-        :mod:`spiralid.sysid.estimation.narx.training`); None: ARX only.
     minimises : str or None
         The error the estimate minimises, for its covariance
         (:mod:`~spiralid.sysid.estimation.core.uncertainty`): a predictor name, or
@@ -152,9 +151,6 @@ class Method:
         Default of ``identify(cancel=None)``: remove near-cancelling
         pole-zero pairs after the estimate; False: the option does not
         apply.
-    narx_options : tuple of str
-        The options of its NARX estimator (beside ``identify_narx``'s own
-        ``holdout`` and ``decay``); empty without one.
     """
 
     estimate: Callable[..., EstimatorResult]
@@ -162,11 +158,9 @@ class Method:
     options: tuple[str, ...] = ()
     safe_start: bool = False
     parametrization: str = DEFAULT_PARAMETRIZATION
-    narx: Callable[..., OptimiserResult] | None = None
     minimises: str | None = None
     margin: bool = False
     cancel: bool = False
-    narx_options: tuple[str, ...] = ()
 
 
 def _keyword_options(function: Callable, own: tuple[str, ...] = ()) -> tuple[str, ...]:
@@ -195,8 +189,6 @@ METHODS: dict[str, Method] = {
             # The rule is the method's own, so a method bound to one rule
             # cannot be re-ruled.
             options=_MINIMIZE_OPTIONS,
-            narx=partial(_narx.estimate_search, rule=name),
-            narx_options=_MINIMIZE_OPTIONS,
         )
         for name in RULES
     },
@@ -209,27 +201,21 @@ METHODS: dict[str, Method] = {
         options=_keyword_options(_estimate_recommended),
         safe_start=True,
         parametrization="modal",
-        narx=_narx.estimate_spiral,
         margin=True,
         cancel=True,
-        narx_options=_keyword_options(_narx.estimate_spiral),
     ),
     "ls": Method(
         _estimate_ls,
         search=False,
         options=(),
-        narx=_narx.estimate_ls,
         minimises="one-step",
-        narx_options=_keyword_options(_narx.estimate_ls),
     ),
     "oe": Method(
         _estimate_oe,
         search=False,
         options=(),
-        narx=_narx.estimate_oe,
         margin=True,
         cancel=True,
-        narx_options=_keyword_options(_narx.estimate_oe),
     ),
 }
 
@@ -239,23 +225,19 @@ METHODS: dict[str, Method] = {
 SEARCH_PROBLEM_OPTIONS = ("parametrization", "bounds", "refine", "safe_start")
 
 
-def method_options(method: str, narx: bool = False) -> tuple[str, ...]:
-    """The options `method` takes through ``identify(**options)``: for an
-    ARX structure a search's :data:`SEARCH_PROBLEM_OPTIONS` and its
-    optimiser's, for a NARX structure its NARX estimator's (beside
-    ``holdout`` and ``decay``). The one table the entry points, the command
-    line and the tests read.
+def method_options(method: str) -> tuple[str, ...]:
+    """The options `method` takes through ``identify(**options)`` for an
+    ARX structure: a search's :data:`SEARCH_PROBLEM_OPTIONS` and its
+    optimiser's; a method that does not search takes none. Another
+    family's options are its entries' in
+    :data:`~spiralid.sysid.estimation.core.families.ESTIMATORS`.
 
     Examples
     --------
     >>> method_options("ls")
     ()
-    >>> method_options("ls", narx=True)
-    ('max_rounds', 'patience', 'patience_share')
     """
     spec = METHODS[method]
-    if narx:
-        return spec.narx_options
     return (*SEARCH_PROBLEM_OPTIONS, *spec.options) if spec.search else ()
 
 

@@ -1,21 +1,27 @@
-"""identify(): data + ARX structure + method -> IdentifiedModel.
+"""identify(): data + structure + method -> the family's fitted model.
 
-The entry point only checks its arguments and dispatches; the pieces live
+The entry point only checks its arguments and finds the estimator of the
+structure's family and the method in the one table,
+:data:`~spiralid.sysid.estimation.core.families.ESTIMATORS`; the pieces live
 in modules named for what they hold, each depending only on those above it:
 
+- :mod:`~spiralid.sysid.estimation.core.families`: the estimator table, keyed
+  by family and method.
+- :mod:`~spiralid.sysid.estimation.core.arx_fit`: the ARX family (the problem,
+  the margin's choice, the model with its covariance).
 - :mod:`~spiralid.sysid.estimation.linear.parametrizations`: what a search moves
   (``"coefficients"``, ``"reflection"``), its box, initial points and map to
   the ARX theta; the table ``PARAMETRIZATIONS``.
-- :mod:`~spiralid.sysid.estimation.linear.outputerror`: the Levenberg-Marquardt
-  polish and Steiglitz-McBride.
-- :mod:`~spiralid.sysid.estimation.core.estimators`: one function per method, the table
-  ``METHODS``, the result type ``EstimatorResult``, the budget rule and the
-  safe start.
+- :mod:`~spiralid.sysid.estimation.linear.outputerror`: the
+  Levenberg-Marquardt polish and Steiglitz-McBride.
+- :mod:`~spiralid.sysid.estimation.core.estimators`: one function per ARX
+  method, the table ``METHODS``, the result type ``EstimatorResult``, the
+  budget rule and the safe start.
 - :mod:`~spiralid.sysid.models.identified`: :class:`IdentifiedModel`.
 - :mod:`~spiralid.sysid.estimation.core.options`: the one option contract
   (which options each method and structure takes).
-- :mod:`~spiralid.sysid.estimation.narx.training`: NARX training, given this
-  module's default ARX as its linear start.
+- :mod:`~spiralid.sysid.estimation.narx.training`: NARX training, given the default
+  ARX as its linear start.
 
 Initial condition of the simulation (``initial``)
 -------------------------------------------------
@@ -46,34 +52,18 @@ eq. (3) as printed: they refuse either option.
 
 from __future__ import annotations
 
-import time
-from dataclasses import replace
-
-import numpy as np
-
-from spiralid._checks import box_bounds, generator, refuse_options
+from spiralid._checks import refuse_options
 
 from ...data import IOData, single_output_record
 from ...models.arx import ARX
 from ...models.identified import IdentifiedModel
 from ...models.narx import NARX, PolynomialNARX
-from ...models.polynomials import integrator_count, with_integrator
-from ..linear.local_estimators import _act_on_modes
-from ..linear.margin import AUTO, is_auto, max_radius
+from ...models.protocol import FittedModelProtocol
+from ..linear.margin import AUTO
 from ..linear.outputerror import steiglitz_mcbride
-from ..linear.parametrizations import (
-    DEFAULT_PARAMETRIZATION,
-    PARAMETRIZATIONS,
-    default_bounds,
-    feasible_initial_points,
-    make_parametrization,
-)
-from ..narx import training as _narx
-from ..spiral import margin_choice
-from ..spiral.cancellation import effective, embed_covariance, embed_factor
-from ..spiral.heldback import HOLDBACK
-from .cost import PaperCost
-from .estimators import DEFAULT_METHOD, METHODS
+from ..linear.parametrizations import default_bounds, feasible_initial_points
+from .estimators import DEFAULT_METHOD
+from .families import estimator, family_of
 from .options import (
     IDENTIFY_DEFAULTS,
     _check_method,
@@ -81,8 +71,6 @@ from .options import (
     identify_options,
     refused_options,
 )
-from .problem import Problem
-from .uncertainty import parameter_covariance
 
 __all__ = [
     "IDENTIFY_DEFAULTS",
@@ -97,13 +85,9 @@ __all__ = [
 ]
 
 
-def _check_bounds(bounds, p: int) -> np.ndarray:
-    return np.column_stack(box_bounds(bounds, p))
-
-
 def identify(
     data: IOData,
-    arx: ARX,
+    structure: ARX | NARX | PolynomialNARX,
     method: str = DEFAULT_METHOD,
     *,
     predictor: str = "simulation",
@@ -115,19 +99,23 @@ def identify(
     max_time_constant: float | str | None = AUTO,
     cancel: bool | None = None,
     **options,
-) -> IdentifiedModel:
-    """Estimate an ARX model from input-output data.
+) -> FittedModelProtocol:
+    """Estimate a model of `structure` from input-output data.
 
     Parameters
     ----------
     data : IOData
         Estimation record.
-    arx : ARX, NARX or PolynomialNARX
-        Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6). A NARX
+    structure : ARX, NARX or PolynomialNARX
+        Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6). Its ``family``
+        and the method name the estimator in
+        :data:`~spiralid.sysid.estimation.core.families.ESTIMATORS`. A NARX
         structure is trained by the method's NARX estimator
         (:mod:`spiralid.sysid.estimation.narx.training`; ``holdout`` passed through
         `options` sets its early-stopping share) and returns a
-        :class:`~spiralid.sysid.models.narx.NARXModel`.
+        :class:`~spiralid.sysid.models.narx.NARXModel`; an ARX structure on
+        a record of several outputs, one denominator for all, returns a
+        :class:`~spiralid.sysid.models.shared.SharedDenominatorModel`.
     method : str, default "spiral"
         A key of :data:`spiralid.sysid.estimation.core.estimators.METHODS`, in
         any case: ``"spiral"``
@@ -251,9 +239,11 @@ def identify(
 
     Returns
     -------
-    IdentifiedModel
-        Its ``result`` is the estimator's
-        :class:`~spiralid.sysid.estimation.core.estimators.EstimatorResult`.
+    FittedModelProtocol
+        The family's fitted model (an ARX's
+        :class:`~spiralid.sysid.models.identified.IdentifiedModel`, whose
+        ``result`` is the estimator's
+        :class:`~spiralid.sysid.estimation.core.estimators.EstimatorResult`).
 
     Notes
     -----
@@ -302,7 +292,6 @@ def identify(
     >>> fit.theta.round(9), fit.is_stable, fit.result["status"]
     (array([-1.5,  0.7,  1. ,  0.5]), True, 0)
     """
-    t_start = time.perf_counter()
     given = dict(
         predictor=predictor,
         initial=initial,
@@ -314,287 +303,20 @@ def identify(
         cancel=cancel,
         **options,
     )
-    if isinstance(data, IOData) and data.n_outputs > 1 and isinstance(arx, ARX):
-        return _identify_shared(data, arx, method, given)
-    single_output_record(data, "identify")
-    if not isinstance(arx, ARX | NARX | PolynomialNARX):
-        raise ValueError(
-            f"`arx` must be an ARX, NARX or PolynomialNARX; got {type(arx).__name__}"
-        )
+    several = isinstance(data, IOData) and data.n_outputs > 1
+    family = family_of(structure, data.n_outputs if several else 1)
+    if family is None or not several:
+        single_output_record(data, "identify")
     method = _check_method(method)
-    check_method_options(method, given, arx)
-    if not isinstance(arx, ARX):
-        takes = identify_options(method, arx)
-        narx = {k: v for k, v in given.items() if k in takes}
-        return _narx.identify_narx(
-            data,
-            arx,
-            method=method,
-            estimate=METHODS[method].narx,
-            linear_estimator=_default_arx,
-            **narx,
+    entry = estimator(family, method, structure)
+    if several:
+        refuse_options(
+            given,
+            entry.options(given.get("refine", False)),
+            f"method {method!r} on a record of {data.n_outputs} outputs (one shared "
+            "denominator)",
+            IDENTIFY_DEFAULTS,
         )
-    count = integrator_count(integrator, arx.na)
-    if count:
-        del given["integrator"]
-        return _identify_integrating(data, arx, count, dict(method=method, **given))
-    problem, options = _problem(method, data, arx, given)
-    res = METHODS[method].estimate(problem, **options)
-    margin = None
-    if is_auto(max_time_constant):
-        # The default margin only: a time constant the user gave is kept.
-        chosen = margin_choice.choose(problem, res, _holdback(method, options))
-        if chosen is not None:
-            problem, res, margin = chosen
-    if method == DEFAULT_METHOD and problem.cancel and arx.na:
-        # The recommended method acts on its own modes table's diagnosis:
-        # a flagged pole is removed where the cost allows.
-        _act_on_modes(problem, res, (res.get("caps") or {}).get("cancel"))
-    return _packaged(method, problem, res, t_start, margin)
-
-
-def _default_arx(data: IOData, arx: ARX, integrator: int, rng) -> np.ndarray:
-    """The default method's ARX theta, a NARX's linear start: handed to
-    the NARX estimator so that it does not import this module back. With
-    the default stop, as a user's call: on the whole record, from a fresh
-    generator, it is the model ``identify(data, arx, integrator=...,
-    rng=seed)`` returns."""
-    return identify(data, arx, integrator=integrator, rng=rng).theta
-
-
-def _problem(method: str, data: IOData, arx: ARX, given: dict):
-    """identify's checked arguments as a :class:`Problem`, and the options
-    left for the estimator."""
-    spec = METHODS[method]
-    settings = {**IDENTIFY_DEFAULTS, **given}
-    options = {k: v for k, v in given.items() if k not in IDENTIFY_DEFAULTS}
-    refine, safe_start = settings["refine"], settings["safe_start"]
-    if not isinstance(refine, bool | np.bool_):
-        raise TypeError(f"`refine` must be True or False; got {refine!r}")
-    if safe_start is not None and not isinstance(safe_start, bool | np.bool_):
-        raise TypeError(f"`safe_start` must be True, False or None; got {safe_start!r}")
-    parametrization = settings["parametrization"]
-    if parametrization is None:
-        parametrization = spec.parametrization
-        if arx.na == 0 and parametrization == "modal":
-            # An FIR model has no modes; the recommended method solves it
-            # exactly over the coefficients (see `_estimate_fir`).
-            parametrization = DEFAULT_PARAMETRIZATION
-    radius, cancel = margin_options(
-        method, data, refine, settings["max_time_constant"], settings["cancel"]
-    )
-    # The margin inside the search: for the methods that apply it, in a
-    # parametrisation that can hold it (a paper search's refine polishes alone).
-    kind = (
-        PARAMETRIZATIONS.get(parametrization)
-        if isinstance(parametrization, str)
-        else None
-    )
-    inside = spec.margin and getattr(kind, "takes_margin", False)
-    par = make_parametrization(parametrization, data, arx, radius if inside else None)
-    predictor, initial = settings["predictor"], settings["initial"]
-    gain, penalty, bounds = settings["gain"], settings["penalty"], settings["bounds"]
-    cost = PaperCost(
-        arx, data, predictor=predictor, gain=gain, penalty=penalty, initial=initial
-    )
-    problem = Problem(
-        data=data,
-        arx=arx,
-        cost=cost,
-        predictor=predictor,
-        initial=initial,
-        gain=gain,
-        penalty=penalty,
-        parametrization=par,
-        rng=generator(settings["rng"]),
-        bounds=None if bounds is None else _check_bounds(bounds, par.n_search),
-        refine=bool(refine),
-        safe_start=spec.safe_start if safe_start is None else bool(safe_start),
-        max_radius=radius,
-        cancel=cancel,
-    )
-    return problem, options
-
-
-def _holdback(method: str, options: dict) -> float:
-    """The share of the record the margin's choice holds back: the
-    recommended method's `holdback` (None or 0: choose by the cost alone,
-    which keeps the margin), :data:`~spiralid.sysid.estimation.spiral.heldback.
-    HOLDBACK` for the others."""
-    if method == DEFAULT_METHOD:
-        return options.get("holdback", HOLDBACK) or 0.0
-    return HOLDBACK
-
-
-def _packaged(
-    method: str,
-    problem: Problem,
-    res,
-    t_start: float,
-    margin: margin_choice.MarginChoice | None = None,
-) -> IdentifiedModel:
-    """The method's result on the problem as a model with its covariance."""
-    spec = METHODS[method]
-    data, arx, cost = problem.data, problem.arx, problem.cost
-    predictor, initial = problem.predictor, problem.initial
-    refined = res.get("refine")
-    t_refine = 0.0 if refined is None else refined.elapsed
-    cancelled = res.get("cancelled") or []
-    if cancelled:
-        # The removed coefficients are fixed at zero, not estimated: the
-        # covariance is the reduced model's, with zero variance for them.
-        order = res.effective_order
-        theta_r, arx_r = effective(res.x, arx, order)
-        cov_r, s2, root_r = parameter_covariance(
-            theta_r, arx_r, data, spec.minimises or predictor, initial, factor=True
-        )
-        covariance = embed_covariance(cov_r, arx, order)
-        root = None if root_r is None else embed_factor(root_r, arx, order)
     else:
-        covariance, s2, root = parameter_covariance(
-            res.x, arx, data, spec.minimises or predictor, initial, factor=True
-        )
-    return IdentifiedModel(
-        res.x,
-        arx=arx,
-        ts=data.ts,
-        method=method,
-        predictor=predictor,
-        parametrization=problem.parametrization.name,
-        initial=initial,
-        gain=cost.w,
-        penalty=cost.penalty,
-        cost=res.fun,
-        result=res,
-        refine_result=refined,
-        history=res.history,
-        timings={
-            "search": res.elapsed,
-            "refine": t_refine,
-            "total": time.perf_counter() - t_start,
-        },
-        bounds=res.get("bounds"),
-        covariance=covariance,
-        covariance_factor=root,
-        noise_variance=s2,
-        cancellations=tuple(cancelled),
-        selection=None if res.get("selection") is None else res.selection.to_dict(),
-        margin=None if margin is None else margin.to_dict(),
-        diagnosis=_diagnosis(res),
-        **data.provenance(),
-    )
-
-
-def _diagnosis(res) -> dict | None:
-    """What acting on the modes table did, when it found a flagged pole."""
-    found = res.get("diagnosis")
-    if found is None or not (found.removed or found.kept or found.untried):
-        return None
-    return found.to_dict()
-
-
-def margin_options(method: str, data: IOData, refine, max_time_constant, cancel):
-    """identify's ``max_time_constant`` and ``cancel`` for `method`: the
-    margin's radius (None: none) and whether to cancel. Whether they apply
-    at all is :func:`check_method_options`' rule; here their values."""
-    spec = METHODS[method]
-    applies = spec.margin or (spec.search and bool(refine))
-    if is_auto(max_time_constant):
-        seconds = data.n * data.ts if applies else None
-    else:
-        seconds = _time_constant(max_time_constant, data.ts)
-    if cancel is None:
-        cancel = spec.cancel
-    elif not isinstance(cancel, bool | np.bool_):
-        raise TypeError(f"`cancel` must be True, False or None; got {cancel!r}")
-    return max_radius(data.ts, seconds), bool(cancel)
-
-
-def _time_constant(value, ts: float) -> float | None:
-    """An explicit ``max_time_constant`` in seconds (None: no margin)."""
-    if value is None:
-        return None
-    bad = isinstance(value, bool | np.bool_ | str)
-    try:
-        seconds = float(value)
-    except (TypeError, ValueError):
-        bad = True
-    if bad or not (np.isfinite(seconds) and seconds > 0):
-        raise ValueError(
-            "`max_time_constant` must be a number of seconds > 0, "
-            f"{AUTO!r} or None; got {value!r}"
-        )
-    if seconds < ts:
-        # Every pole inside exp(-1) = 0.37 and below: no sampled plant's
-        # margin, and r_max^na would underflow.
-        raise ValueError(
-            "`max_time_constant` must be at least the sample time "
-            f"ts = {ts:g} s; got {value!r}"
-        )
-    return seconds
-
-
-def _identify_shared(data: IOData, arx: ARX, method, given: dict):
-    """`identify` on a record of several outputs: one denominator for all
-    (:func:`~spiralid.sysid.estimation.shared.denominator.identify_shared`) by the
-    methods of :data:`~spiralid.sysid.estimation.shared.denominator.SHARED_METHODS`."""
-    from ..shared.denominator import SHARED_METHODS, identify_shared, shared_options
-
-    method = _check_method(method)
-    if method not in SHARED_METHODS:
-        raise ValueError(
-            f"`method` {method!r} takes one output; a record of several outputs "
-            f"{data.output_names} is identified by one of {tuple(SHARED_METHODS)} "
-            "(one shared denominator), or pass data.output(name)"
-        )
-    if given["predictor"] != "simulation" or given["initial"] != "rest":
-        raise ValueError(
-            "a record of several outputs is fitted to its simulation error from "
-            f"rest; got predictor={given['predictor']!r}, initial={given['initial']!r}"
-        )
-    takes = shared_options(method)
-    refuse_options(
-        given,
-        takes,
-        f"method {method!r} on a record of {data.n_outputs} outputs (one shared "
-        "denominator)",
-        IDENTIFY_DEFAULTS,
-    )
-    own = {k: given[k] for k in SHARED_METHODS[method] if k in given}
-    return identify_shared(
-        data,
-        arx,
-        method=method,
-        rng=given["rng"],
-        integrator=given["integrator"],
-        **own,
-    )
-
-
-def _identify_integrating(
-    data: IOData, arx: ARX, count: int, options: dict
-) -> IdentifiedModel:
-    """`identify` with `count` known integrators: ``B / A'`` from the
-    `count`-fold running sum of the input, composed back into
-    ``B / (A' (1 - z^-1)^count)``."""
-    if options["predictor"] != "simulation" or options["initial"] != "rest":
-        raise ValueError(
-            "`integrator` needs predictor='simulation' and initial='rest' (the "
-            "running sum of the input stands for the integrator's state from "
-            f"rest); got predictor={options['predictor']!r}, "
-            f"initial={options['initial']!r}"
-        )
-    u = data.u
-    for _ in range(count):
-        u = np.cumsum(u)
-    inner = identify(replace(data, u=u), ARX(arx.na - count, arx.nb, arx.nk), **options)
-    free = inner.theta[: arx.na - count]
-    theta = np.r_[with_integrator(free, count), inner.theta[arx.na - count :]]
-    return replace(
-        inner,
-        theta=theta,
-        arx=arx,
-        input_unit=data.input_unit,
-        u_offset=data.u_offset,
-        integrator=count,
-    )
+        check_method_options(method, given, structure)
+    return entry.fit(data, structure, method, given)

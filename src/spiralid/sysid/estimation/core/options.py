@@ -6,14 +6,13 @@ the command line and study files share."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from spiralid._checks import is_default, one_of, refuse_options
 
 from ...models.arx import ARX
-from ...models.narx import NARX, PolynomialNARX
-from ..linear.margin import AUTO
-from .estimators import METHODS, method_options
+from ...models.narx import NARX  # noqa: F401 (the doctests' structure)
+from .estimators import METHODS
+from .families import estimator, family_of
+from .problem import IDENTIFY_DEFAULTS
 
 __all__ = [
     "IDENTIFY_DEFAULTS",
@@ -23,31 +22,14 @@ __all__ = [
 ]
 
 
-# identify's arguments by name with their defaults; an argument equal to
-# its default is never refused, whatever the method or structure.
-IDENTIFY_DEFAULTS = dict(
-    predictor="simulation",
-    initial="rest",
-    rng=None,
-    gain="auto",
-    penalty=1e6,
-    integrator=False,
-    max_time_constant=AUTO,
-    cancel=None,
-    parametrization=None,
-    bounds=None,
-    refine=False,
-    safe_start=None,
-    # A NARX's early stopping and weight decay (identify_narx's).
-    holdout=0.2,
-    decay=1e-3,
-)
-
-
-def identify_options(method: str, structure, refine: bool = False) -> tuple[str, ...]:
-    """Every option :func:`identify` takes for `method` and `structure`,
-    its own arguments and ``**options`` alike; the one table `identify`,
-    the command line and the tests check against.
+def identify_options(
+    method: str, structure, refine: bool = False, n_outputs: int = 1
+) -> tuple[str, ...]:
+    """Every option :func:`identify` takes for `method` and `structure` (on
+    a record of `n_outputs` outputs), its own arguments and ``**options``
+    alike: the options of the estimator table's entry
+    (:data:`~.families.ESTIMATORS`); the one table `identify`, the command
+    line and the tests check against.
 
     ``rng`` for every method and structure: one call can then loop over
     methods, and a deterministic method (``"ls"``, ``"oe"``, forward
@@ -71,22 +53,8 @@ def identify_options(method: str, structure, refine: bool = False) -> tuple[str,
     ('rng', 'predictor', 'initial', 'holdout', 'decay', 'max_rounds', 'patience',
      'patience_share')
     """
-    if isinstance(structure, PolynomialNARX):
-        return ("rng", "predictor", "initial")
-    if isinstance(structure, NARX):
-        own = ("rng", "predictor", "initial", "holdout", "decay")
-        return (*own, *method_options(method, narx=True))
-    spec = METHODS[method]
-    out = ["rng", "predictor", "initial", "gain", "penalty", "integrator"]
-    if spec.margin or (spec.search and _is_true(refine)):
-        out.append("max_time_constant")
-    if spec.cancel:
-        out.append("cancel")
-    return (*out, *method_options(method))
-
-
-def _is_true(value) -> bool:
-    return isinstance(value, bool | np.bool_) and bool(value)
+    family = family_of(structure, n_outputs)
+    return estimator(family, method, structure).options(refine)
 
 
 def _check_method(method) -> str:
@@ -120,14 +88,8 @@ def check_method_options(method: str, options: dict, structure=None) -> None:
     never refused."""
     method = _check_method(method)
     structure = ARX(1, 1, 0) if structure is None else structure
-    kind = ""
-    if isinstance(structure, NARX | PolynomialNARX):
-        if METHODS[method].narx is None:
-            able = tuple(name for name, m in METHODS.items() if m.narx is not None)
-            raise ValueError(
-                f"`method` {method!r} does not train NARX models; use one of {able}"
-            )
-        kind = f" for a {type(structure).__name__}"
+    family = family_of(structure)
+    kind = "" if family == "arx" else f" for a {type(structure).__name__}"
     applicable = identify_options(method, structure, options.get("refine", False))
     refuse_options(
         options, applicable, f"method {method!r}{kind}", defaults=IDENTIFY_DEFAULTS

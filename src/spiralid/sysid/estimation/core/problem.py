@@ -13,10 +13,31 @@ from spiralid.optim.result import OptimiserResult
 
 from ...data import IOData
 from ...models.arx import ARX
+from ..linear.margin import AUTO
 from ..linear.parametrizations import Parametrization, make_parametrization
 from .cost import PaperCost
 
-__all__ = ["EstimatorResult", "Problem"]
+__all__ = ["IDENTIFY_DEFAULTS", "EstimatorResult", "Problem"]
+
+# identify's arguments by name with their defaults; an argument equal to
+# its default is never refused, whatever the method or structure.
+IDENTIFY_DEFAULTS = dict(
+    predictor="simulation",
+    initial="rest",
+    rng=None,
+    gain="auto",
+    penalty=1e6,
+    integrator=False,
+    max_time_constant=AUTO,
+    cancel=None,
+    parametrization=None,
+    bounds=None,
+    refine=False,
+    safe_start=None,
+    # A NARX's early stopping and weight decay (identify_narx's).
+    holdout=0.2,
+    decay=1e-3,
+)
 
 
 class EstimatorResult(OptimiserResult):

@@ -35,7 +35,7 @@ import numpy as np
 from spiralid._checks import positive
 
 from ...data import IOData, single_output_record
-from ...models.arx import ARX
+from ...models.arx import ARX, check_arx
 from ...spectra import cross_spectra, segment_length
 
 __all__ = ["FrequencyError", "FrequencyEstimate", "h1_estimate"]
@@ -218,10 +218,9 @@ class FrequencyError:
     """
 
     def __init__(self, arx: ARX, estimate: FrequencyEstimate) -> None:
-        if not isinstance(arx, ARX):
-            raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+        check_arx(arx)
         if not isinstance(estimate, FrequencyEstimate):
-            raise ValueError(
+            raise TypeError(
                 f"`estimate` must be a FrequencyEstimate; got {type(estimate).__name__}"
             )
         self.arx = arx

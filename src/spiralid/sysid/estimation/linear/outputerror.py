@@ -30,7 +30,7 @@ from spiralid._checks import integer
 from spiralid.optim.result import OptimiserResult
 
 from ...data import IOData, single_output_record
-from ...models.arx import ARX, arx_least_squares
+from ...models.arx import ARX, arx_least_squares, check_arx
 from ...models.polynomials import step_down, step_up
 from .levenberg import levenberg_marquardt
 from .margin import powers, project_denominator, scaled, unscaled, within
@@ -324,8 +324,7 @@ def steiglitz_mcbride(
     True
     """
     single_output_record(data, "steiglitz_mcbride")
-    if not isinstance(arx, ARX):
-        raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+    check_arx(arx)
     n_iter = integer(n_iter, "n_iter", 0)
     na, t0 = arx.na, arx.max_lag
     if theta0 is None:

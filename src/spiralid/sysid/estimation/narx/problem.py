@@ -13,7 +13,7 @@ import numpy as np
 from spiralid._checks import integer, nonneg
 from spiralid.optim.result import OptimiserResult
 
-from ...models.narx import NARX, Scaling
+from ...models.narx import Scaling
 from ..linear.levenberg import levenberg_marquardt
 
 __all__ = [
@@ -128,7 +128,7 @@ class NARXProblem:
         fun, jac = self._residual_and_jacobian(predictor)
         decay = getattr(self, "decay", 0.0)
         st = self.structure
-        if decay <= 0.0 or not isinstance(st, NARX) or st.h == 0:
+        if decay <= 0.0 or st.family != "narx" or st.h == 0:
             return fun, jac
         net = np.arange(st.h * (st.n_regressors + 2))
         m = self.train.stop - self.train.start

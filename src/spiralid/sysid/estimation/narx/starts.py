@@ -13,7 +13,6 @@ from spiralid.choices import DEFAULT_METHOD
 
 from ...data import IOData
 from ...models.arx import ARX, arx_least_squares
-from ...models.narx import NARX
 from .problem import NARXProblem
 
 
@@ -31,7 +30,7 @@ def _linear_start(problem: NARXProblem, method: str = "default", n: int | None =
     ``"ls"``: least squares of the one-step error.
     """
     st = problem.structure
-    if not isinstance(st, NARX) or not st.linear:
+    if st.family != "narx" or not st.linear:
         return None, ""
     data = problem.data if n is None else problem.data[:n]
     k = st.integrator

@@ -65,10 +65,9 @@ from spiralid.optim.result import OptimiserResult
 from spiralid.optim.spiral import _parse_method
 
 from ...data import IOData
-from ...models.narx import NARXModel, PolynomialNARX
+from ...models.narx import NARXModel
 from ..linear.levenberg import levenberg_marquardt
 from ..spiral.population import search_options
-from .frols import frols
 from .problem import (
     _TOL,
     MAX_ROUNDS,
@@ -183,8 +182,6 @@ def estimate_ls(
     -------
     OptimiserResult
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        return frols(problem)
     t0 = time.perf_counter()
     start, refit, linear, what = _starts(problem, "ls")
     options = stopping_options(max_rounds, patience, patience_share)
@@ -228,11 +225,6 @@ def estimate_oe(
         ``linear_cost`` the linear start and its cost, ``kept_linear``
         whether training ended at it.
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        raise ValueError(
-            "method 'oe' trains an MLP NARX; a PolynomialNARX is estimated by "
-            "method 'ls' (forward-regression orthogonal least squares)"
-        )
     t0 = time.perf_counter()
     start, refit, linear, what = _starts(problem)
     options = stopping_options(max_rounds, patience, patience_share)
@@ -285,11 +277,6 @@ def estimate_search(problem: NARXProblem, *, rule: str, **options) -> OptimiserR
     -------
     OptimiserResult
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        raise ValueError(
-            "a PolynomialNARX is estimated by method 'ls' (FROLS); searches "
-            "train an MLP NARX"
-        )
     t0 = time.perf_counter()
     opts = dict(options)
     opts.setdefault("max_nfev", 10_000)
@@ -366,10 +353,6 @@ def estimate_spiral(
     OptimiserResult
         ``start`` names the point whose final polish won.
     """
-    if isinstance(problem.structure, PolynomialNARX):
-        # The default method takes every structure: a polynomial's terms
-        # are chosen by forward regression, which a search would not improve.
-        return frols(problem)
     t0 = time.perf_counter()
     n_points = integer(n_points, "n_points", 2)
     max_nfev = integer(max_nfev, "max_nfev", n_points)

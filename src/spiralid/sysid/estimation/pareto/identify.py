@@ -145,7 +145,7 @@ class ParetoIdentification:
 
 
 def _structures(orders, nk: int | None) -> list[ARX]:
-    if isinstance(orders, ARX):
+    if getattr(orders, "family", None) == "arx":
         if nk is not None and nk != orders.nk:
             raise ValueError(
                 f"`nk` builds structures from orders given as numbers; {orders} "

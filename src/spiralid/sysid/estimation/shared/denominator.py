@@ -323,8 +323,8 @@ def identify_shared(
     """
     t0 = time.perf_counter()
     if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
-    if not isinstance(arx, ARX) or arx.na < 1:
+        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
+    if getattr(arx, "family", None) != "arx" or arx.na < 1:
         raise ValueError(f"`arx` must be an ARX with na >= 1; got {arx!r}")
     if method not in SHARED_METHODS:
         raise ValueError(

@@ -79,7 +79,7 @@ def subspace_denominator(
     True
     """
     if not isinstance(data, IOData):
-        raise ValueError(f"`data` must be an IOData; got {type(data).__name__}")
+        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     n = integer(n, "n", 1)
     i = max(2 * n, n + 1) if horizon is None else integer(horizon, "horizon", n + 1)
     u = data.u[:, None]
