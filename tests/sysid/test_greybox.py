@@ -5,9 +5,11 @@ linear kind on a linear ``f``, bad input refused in one line, and the JSON
 form read back."""
 
 import json
+import os
 
 import numpy as np
 import pytest
+from clitools import cli_env, run
 from scipy import signal
 
 import spiralid as sid
@@ -196,3 +198,25 @@ def test_the_nonlinear_kind_fits_by_oe():
     assert type(model) is sid.sysid.GreyBoxModel and not model.is_linear
     assert model.linear_part is None
     np.testing.assert_allclose(model.params, TRUE, rtol=0.05)
+
+
+def test_the_command_line_validates_a_saved_grey_box(tmp_path, monkeypatch):
+    # The functions must be importable where the command runs: a module of
+    # the user's, on its path.
+    (tmp_path / "user_msd.py").write_text(
+        "def msd(p):\n"
+        "    k, c, m = p\n"
+        "    return [[0, 1], [-k / m, -c / m]], [[0], [1 / m]], [[1, 0]], [[0]]\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    from user_msd import msd as user_ss
+
+    rec = record(n=300)
+    model = sid.identify(rec, GreyBox(parameters(), ss=user_ss), method="oe")
+    (tmp_path / "m").mkdir()
+    (tmp_path / "m" / "model.json").write_text(json.dumps(model.to_dict()))
+    np.savez(tmp_path / "rec.npz", u=rec.u, y=rec.y, ts=rec.ts)
+    path = os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])
+    out = run("validate", "m/model.json", "rec.npz", "--quiet", cwd=tmp_path,
+              env=cli_env(PYTHONPATH=path))  # fmt: skip
+    assert out.returncode == 0, out.stderr

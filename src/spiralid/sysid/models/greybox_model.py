@@ -22,6 +22,10 @@ from .polynomials import is_stable_polynomial
 __all__ = ["GreyBoxModel", "LinearGreyBoxModel"]
 
 
+# What the model keeps of its record (IOData's fields of the same names).
+_RECORD = ("input_name", "input_unit", "output_unit", "u_offset", "y_offset")
+
+
 def _inputs(u) -> np.ndarray:
     return np.asarray(u.u if isinstance(u, IOData) else u, dtype=float)
 
@@ -52,6 +56,12 @@ class GreyBoxModel:
         The output's name.
     nfev : int
         Simulations the fit ran.
+    input_name, input_unit, output_unit : str
+        The record's names and units, which the command line checks a
+        validation record against.
+    u_offset, y_offset : float
+        The offsets removed from the record's signals before the fit (its
+        ``IOData``'s); the parameters describe the signals without them.
     """
 
     structure: GreyBox
@@ -63,6 +73,11 @@ class GreyBoxModel:
     undetermined: list = field(default_factory=list)
     output_name: str = "y"
     nfev: int = 0
+    input_name: str = "u"
+    input_unit: str = ""
+    output_unit: str = ""
+    u_offset: float = 0.0
+    y_offset: float = 0.0
 
     def __post_init__(self) -> None:
         self.values = np.asarray(self.values, dtype=float)
@@ -159,6 +174,7 @@ class GreyBoxModel:
             cost=float(self.cost),
             output_name=self.output_name,
             nfev=int(self.nfev),
+            **{name: getattr(self, name) for name in _RECORD},
         )
 
     @classmethod
@@ -179,6 +195,7 @@ class GreyBoxModel:
                 undetermined=list(d.get("undetermined", [])),
                 output_name=str(d.get("output_name", "y")),
                 nfev=int(d.get("nfev", 0)),
+                **{name: d[name] for name in _RECORD if name in d},
             )
         except KeyError as missing:
             raise ValueError(
@@ -201,6 +218,8 @@ class LinearGreyBoxModel(GreyBoxModel):
     Parameters
     ----------
     structure, values, ts, method, cost, intervals, undetermined, output_name, nfev
+        As :class:`GreyBoxModel`'s attributes.
+    input_name, input_unit, output_unit, u_offset, y_offset
         As :class:`GreyBoxModel`'s attributes.
     """
 

@@ -104,6 +104,11 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
         cost=problem.cost_of(residual),
         intervals=intervals,
         undetermined=notes,
-        output_name=str(getattr(data, "output_name", "y")),
+        output_name=str(data.output_name),
         nfev=problem.nfev,
+        input_name=str(data.input_name),
+        input_unit=data.input_unit,
+        output_unit=data.output_unit,
+        u_offset=data.u_offset,
+        y_offset=data.y_offset,
     )
