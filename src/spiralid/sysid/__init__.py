@@ -21,6 +21,10 @@ from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.files import load_model as load_model
 from .models.fitted import FittedModel as FittedModel
+from .models.greybox import GreyBox as GreyBox
+from .models.greybox import Parameter as Parameter
+from .models.greybox_model import GreyBoxModel as GreyBoxModel
+from .models.greybox_model import LinearGreyBoxModel as LinearGreyBoxModel
 from .models.identified import IdentifiedModel as IdentifiedModel
 from .models.modes import ModeTable as ModeTable
 from .models.narx import NARX as NARX
@@ -72,13 +76,17 @@ __all__ = [
     "EstimatorResult",
     "FittedModel",
     "FittedModelProtocol",
+    "GreyBox",
+    "GreyBoxModel",
     "IOData",
     "IdentifiedModel",
+    "LinearGreyBoxModel",
     "ModalParametrization",
     "ModeTable",
     "NARXModel",
     "NonlinearChecks",
     "PaperCost",
+    "Parameter",
     "ParetoIdentification",
     "PolynomialNARX",
     "ProjectedCost",

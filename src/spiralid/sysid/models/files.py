@@ -2,8 +2,8 @@
 
 A model file (``model.json``) names its kind in the field ``"model"``:
 ``"arx"`` (or absent, in files written before the field existed),
-``"narx"`` or ``"shared-denominator"``; :data:`MODEL_KINDS` is the one table
-from that name to the class whose ``from_dict`` reads it.
+``"narx"``, ``"shared-denominator"`` or ``"greybox"``; :data:`MODEL_KINDS`
+is the one table from that name to the class whose ``from_dict`` reads it.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import json
 import os
 from pathlib import Path
 
+from .greybox_model import GreyBoxModel
 from .identified import IdentifiedModel
 from .narx import NARXModel
 from .protocol import FittedModelProtocol
@@ -23,6 +24,7 @@ MODEL_KINDS = {
     "arx": IdentifiedModel,
     "narx": NARXModel,
     "shared-denominator": SharedDenominatorModel,
+    "greybox": GreyBoxModel,
 }
 
 
@@ -46,7 +48,7 @@ def load_model(d: dict | str | os.PathLike) -> FittedModelProtocol:
 
     Returns
     -------
-    IdentifiedModel, NARXModel or SharedDenominatorModel
+    IdentifiedModel, NARXModel, SharedDenominatorModel or GreyBoxModel
         As its field ``"model"`` says.
 
     Raises

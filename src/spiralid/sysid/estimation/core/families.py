@@ -14,6 +14,7 @@ family                    methods
 ``"narx"``                ``"spiral"``, ``"ls"``, ``"oe"``, every rule
 ``"polynomial-narx"``     ``"ls"`` and ``"spiral"`` (forward regression)
 ``"shared-denominator"``  :data:`~.shared.SHARED_METHODS`
+``"greybox"``             :data:`~.greybox.fit.GREYBOX_METHODS`
 ========================  ======================================================
 
 Adding a family
@@ -43,6 +44,7 @@ from spiralid.optim import RULES
 
 from ...data import IOData
 from ...models.protocol import FittedModelProtocol
+from ..greybox.fit import GREYBOX_METHODS, fit_greybox
 from ..narx import training as _narx
 from ..narx.frols import frols
 from ..shared.denominator import SHARED_METHODS, identify_shared, shared_options
@@ -210,6 +212,10 @@ ESTIMATORS: dict[tuple[str, str], Estimator] = {
             _fit_shared, _fixed(shared_options(name))
         )
         for name in SHARED_METHODS
+    },
+    **{
+        ("greybox", name): Estimator(fit_greybox, _fixed(options))
+        for name, options in GREYBOX_METHODS.items()
     },
 }
 

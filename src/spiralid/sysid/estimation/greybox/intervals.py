@@ -1,0 +1,86 @@
+"""The parameters' 95 % intervals and what the record cannot determine,
+from the simulation error's Jacobian at the fit.
+
+In the search's unit-box coordinates ``z`` the covariance is ``s^2 (J'J)^-1``
+(``s^2`` the residual variance, ``J = d e / d z``), taken through the
+singular value decomposition ``J = U S V'``. A direction ``v_i`` whose 95 %
+half-width ``1.96 s / S_i`` is wider than the whole box (or whose ``S_i`` is
+below rounding) is one the record cannot determine: it is dropped from the
+covariance, and every parameter it moves is named as not determined, with
+no interval (a tiny interval from a pseudo-inverse would claim the
+opposite). Each other parameter's interval ``z_j +- 1.96 sd_j`` is mapped
+back to its unit through its coordinate: symmetric for a linear one,
+symmetric in ``log`` (so positive, and wider above the value) for a
+log-scaled one.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .problem import GreyBoxProblem
+
+__all__ = ["parameter_intervals"]
+
+_Z95 = 1.959963984540054
+# Singular values below this share of the largest are rounding.
+_RANK_TOL = 1e-8
+# A parameter moved by more than this share of an undetermined direction is
+# named as not determined.
+_SHARE = 0.1
+
+
+def parameter_intervals(
+    problem: GreyBoxProblem, z: np.ndarray, residual: np.ndarray, jac: np.ndarray
+) -> tuple[np.ndarray, list[str]]:
+    """Every parameter's 95 % interval (NaN for a fixed or undetermined
+    one) and one sentence per undetermined direction.
+
+    Parameters
+    ----------
+    problem : GreyBoxProblem
+        The fit's problem (coordinates and names).
+    z : ndarray
+        The fit in unit-box coordinates.
+    residual : ndarray
+        The simulation error there.
+    jac : ndarray
+        ``d residual / d z`` there.
+
+    Returns
+    -------
+    intervals : ndarray, shape (n_parameters, 2)
+    undetermined : list of str
+    """
+    n_all = problem.structure.free.size
+    intervals = np.full((n_all, 2), np.nan)
+    names = [p.name for p in problem.structure.parameters if p.free]
+    dof = residual.size - z.size
+    if not (np.all(np.isfinite(jac)) and np.all(np.isfinite(residual))) or dof < 1:
+        return intervals, ["no interval: the fit's Jacobian is not finite"]
+    s2 = float(residual @ residual) / dof
+    _, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    smax = sv[0] if sv.size else 0.0
+    with np.errstate(divide="ignore"):
+        half = _Z95 * np.sqrt(s2) / sv
+    lost = (sv <= _RANK_TOL * smax) | (half > 1.0)
+    undetermined = np.zeros(z.size, dtype=bool)
+    notes = []
+    for i in np.flatnonzero(lost):
+        moved = np.abs(vt[i]) > _SHARE
+        undetermined |= moved
+        terms = " ".join(f"{vt[i, j]:+.2f} {names[j]}" for j in np.flatnonzero(moved))
+        notes.append(
+            "not determined by the record: the direction "
+            f"{terms} (unit-box coordinates; log scale where the parameter has one)"
+        )
+    keep = ~lost
+    cov = (vt[keep].T / sv[keep] ** 2) @ vt[keep] * s2
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    low = problem.free_values(z - _Z95 * sd)
+    high = problem.free_values(z + _Z95 * sd)
+    free_rows = np.flatnonzero(problem.free)
+    for j, row in enumerate(free_rows):
+        if not undetermined[j]:
+            intervals[row] = low[j], high[j]
+    return intervals, notes

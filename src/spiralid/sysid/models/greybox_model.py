@@ -1,0 +1,271 @@
+"""The fitted grey box: :class:`GreyBoxModel` (nonlinear kind) and
+:class:`LinearGreyBoxModel` (linear kind, with the linear members of
+:class:`~spiralid.sysid.models.protocol.FittedModelProtocol`).
+
+Its parameters carry 95 % intervals in their own units, from the polish's
+Jacobian (see :mod:`spiralid.sysid.estimation.greybox`); a parameter the
+record cannot determine has no interval and is named in ``undetermined``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal
+
+from ..data import IOData
+from .greybox import GreyBox
+from .modes import ModeTable, mode_table
+from .polynomials import is_stable_polynomial
+
+__all__ = ["GreyBoxModel", "LinearGreyBoxModel"]
+
+
+# What the model keeps of its record (IOData's fields of the same names).
+_RECORD = ("input_name", "input_unit", "output_unit", "u_offset", "y_offset")
+
+
+def _inputs(u) -> np.ndarray:
+    return np.asarray(u.u if isinstance(u, IOData) else u, dtype=float)
+
+
+@dataclass
+class GreyBoxModel:
+    """A grey box fitted to a record.
+
+    Attributes
+    ----------
+    structure : GreyBox
+        The structure fitted (its parameters' initial values and bounds).
+    values : ndarray
+        Every parameter's value, fixed ones included, in declared order.
+    ts : float
+        The record's sample time.
+    method : str
+        The method that fitted it.
+    cost : float
+        The paper's eq. (2) on the simulation error.
+    intervals : ndarray, shape (n, 2)
+        Each parameter's 95 % interval in its unit; NaN for a fixed one and
+        for one the record cannot determine.
+    undetermined : list of str
+        The parameters and combinations the record cannot determine, one
+        sentence each.
+    output_name : str
+        The output's name.
+    nfev : int
+        Simulations the fit ran.
+    input_name, input_unit, output_unit : str
+        The record's names and units, which the command line checks a
+        validation record against.
+    u_offset, y_offset : float
+        The offsets removed from the record's signals before the fit (its
+        ``IOData``'s); the parameters describe the signals without them.
+    """
+
+    structure: GreyBox
+    values: np.ndarray
+    ts: float
+    method: str
+    cost: float = float("nan")
+    intervals: np.ndarray | None = None
+    undetermined: list = field(default_factory=list)
+    output_name: str = "y"
+    nfev: int = 0
+    input_name: str = "u"
+    input_unit: str = ""
+    output_unit: str = ""
+    u_offset: float = 0.0
+    y_offset: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.values = np.asarray(self.values, dtype=float)
+        n = self.values.size
+        if self.intervals is None:
+            self.intervals = np.full((n, 2), np.nan)
+        self.intervals = np.asarray(self.intervals, dtype=float).reshape(n, 2)
+
+    # -- the protocol -----------------------------------------------------------
+
+    @property
+    def params(self) -> np.ndarray:
+        """The estimated (free) parameters' values."""
+        return self.values[self.structure.free]
+
+    @property
+    def is_linear(self) -> bool:
+        """False: a nonlinear grey box (see :class:`LinearGreyBoxModel`)."""
+        return False
+
+    @property
+    def linear_part(self) -> LinearGreyBoxModel | None:
+        """None: the nonlinear kind has no linear part declared (its
+        linearisation is not built)."""
+        return None
+
+    @property
+    def output_names(self) -> tuple[str, ...]:
+        return (self.output_name,)
+
+    def output_model(self, which: int | str) -> GreyBoxModel:
+        """The model itself (one output)."""
+        if which not in (0, self.output_name):
+            raise ValueError(
+                f"`which` must be 0 or {self.output_name!r}; got {which!r}"
+            )
+        return self
+
+    def simulate(self, u, y0=None) -> np.ndarray:
+        """The free run from the structure's initial state over `u` (an
+        ``IOData`` gives its ``u``), shape (N,). `y0` is accepted as every
+        model's ``simulate`` takes it, and unused: a grey box reads no past
+        outputs (``max_lag`` 0)."""
+        return self.structure.simulate(self.values, _inputs(u), self.ts)
+
+    def predict(self, data: IOData) -> np.ndarray:
+        """The one-step prediction of an output-error model: its free run
+        (a grey box has no noise model to correct it with the measured
+        outputs)."""
+        return self.simulate(data)
+
+    # -- text and JSON --------------------------------------------------------------
+
+    def parameter_rows(self) -> list[str]:
+        """One line per parameter: value, unit, 95 % interval or why none."""
+        rows = []
+        for i, p in enumerate(self.structure.parameters):
+            low, high = self.intervals[i]
+            if not p.free:
+                note = "fixed"
+            elif np.isfinite(low):
+                note = f"95 % [{low:.6g}, {high:.6g}]"
+            else:
+                note = "not determined by the record"
+            rows.append(
+                f"  {p.name} = {self.values[i]:.6g} {p.unit}".rstrip() + f"  {note}"
+            )
+        return rows
+
+    def summary(self) -> str:
+        """Structure, method, cost, each parameter with its unit and 95 %
+        interval, and what the record cannot determine."""
+        lines = [
+            f"{self.structure}",
+            f"method {self.method}, cost {self.cost:.6g} (eq. 2, simulation error), "
+            f"ts = {self.ts:g} s",
+            *self.parameter_rows(),
+            *(f"  {note}" for note in self.undetermined),
+        ]
+        return "\n".join(lines)
+
+    def to_dict(self, *, timings: bool = True) -> dict:
+        """The ``model.json`` form: the structure (functions by import
+        path; a lambda or closure is refused in one line), every
+        parameter's value and interval."""
+        return dict(
+            model="greybox",
+            structure=self.structure.to_dict(),
+            values=self.values.tolist(),
+            intervals=[[float(a), float(b)] for a, b in self.intervals],
+            undetermined=list(self.undetermined),
+            ts=float(self.ts),
+            method=str(self.method),
+            cost=float(self.cost),
+            output_name=self.output_name,
+            nfev=int(self.nfev),
+            **{name: getattr(self, name) for name in _RECORD},
+        )
+
+    @classmethod
+    def from_dict(cls, d: dict) -> GreyBoxModel:
+        """The model :meth:`to_dict` wrote (the kind its structure names)."""
+        if not isinstance(d, dict) or d.get("model") != "greybox":
+            raise ValueError("a grey-box model file must have 'model': 'greybox'")
+        try:
+            structure = GreyBox.from_dict(d["structure"])
+            kind = LinearGreyBoxModel if structure.kind == "linear" else GreyBoxModel
+            return kind(
+                structure=structure,
+                values=np.asarray(d["values"], dtype=float),
+                ts=float(d["ts"]),
+                method=str(d["method"]),
+                cost=float(d["cost"]),
+                intervals=np.asarray(d["intervals"], dtype=float),
+                undetermined=list(d.get("undetermined", [])),
+                output_name=str(d.get("output_name", "y")),
+                nfev=int(d.get("nfev", 0)),
+                **{name: d[name] for name in _RECORD if name in d},
+            )
+        except KeyError as missing:
+            raise ValueError(
+                f"grey-box model file: field {missing} is missing"
+            ) from None
+
+    def __repr__(self) -> str:
+        values = ", ".join(
+            f"{n}={v:.4g}"
+            for n, v in zip(self.structure.names, self.values, strict=True)
+        )
+        return f"{type(self).__name__}({values}; {self.method})"
+
+
+class LinearGreyBoxModel(GreyBoxModel):
+    """A fitted linear grey box: a :class:`GreyBoxModel` with the linear
+    members, read from its exact zero-order-hold discretisation at the
+    model's sample time.
+
+    Parameters
+    ----------
+    structure, values, ts, method, cost, intervals, undetermined, output_name, nfev
+        As :class:`GreyBoxModel`'s attributes.
+    input_name, input_unit, output_unit, u_offset, y_offset
+        As :class:`GreyBoxModel`'s attributes.
+    """
+
+    @property
+    def is_linear(self) -> bool:
+        return True
+
+    @property
+    def linear_part(self) -> LinearGreyBoxModel:
+        """The model itself."""
+        return self
+
+    def _discrete(self):
+        return self.structure.discretise(self.values, self.ts)
+
+    @property
+    def polynomials(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(num, den)`` in ``z^-1`` of equal lengths, ``den[0] = 1``."""
+        ad, bd, c, d = self._discrete()
+        num, den = signal.ss2tf(ad, bd, c, d)
+        return np.asarray(num[0], dtype=float), np.asarray(den, dtype=float)
+
+    @property
+    def free_denominator(self) -> np.ndarray:
+        """The denominator's ``a_1..a_n`` (every pole is the parameters')."""
+        return self.polynomials[1][1:]
+
+    @property
+    def poles(self) -> np.ndarray:
+        """Poles in z: the eigenvalues of the discretised ``A``."""
+        return np.linalg.eigvals(self._discrete()[0])
+
+    @property
+    def zeros(self) -> np.ndarray:
+        """Finite zeros in z of the discretised model."""
+        num = np.trim_zeros(self.polynomials[0], "f")
+        return np.roots(num) if num.size > 1 else np.zeros(0, dtype=complex)
+
+    @property
+    def is_stable(self) -> bool:
+        """Every pole strictly inside the unit circle."""
+        return bool(is_stable_polynomial(self.free_denominator))
+
+    @property
+    def modes(self) -> ModeTable:
+        """The complex pole pairs as modes (no intervals on them: the
+        intervals are the parameters')."""
+        num, den = self.polynomials
+        return mode_table(den[1:], num, self.ts)
