@@ -280,7 +280,7 @@ def test_validate_bad_input():
 
 @pytest.mark.parametrize("bad", [None, "model.json", np.zeros(4)])
 def test_validate_names_a_model_that_is_not_one(bad):
-    with pytest.raises(ValueError, match="`model` must be a fitted model"):
+    with pytest.raises(TypeError, match="`model` must be a fitted model"):
         validate(bad, record(200))
 
 

@@ -48,6 +48,12 @@ Names and meanings
     The outputs the model predicts, and the model of one of them: the
     model itself for a model of one output, which
     :func:`~spiralid.sysid.validate` uses to validate each output.
+``method``, ``ts``, ``input_name``, ``input_unit``, ``u_offset``
+    How it was estimated and on what record: the method's name, the sample
+    time, and the input's name, unit and the offset removed from it before
+    estimation (``spiralid validate`` removes the same from new data); each
+    output model's ``output_name``, ``output_unit`` and ``y_offset`` say
+    the same of its output.
 ``to_dict()`` / ``from_dict(d)``
     The JSON form of ``model.json``, whose ``"model"`` field names the
     family; :func:`~spiralid.sysid.models.files.load_model` reads any.
@@ -82,6 +88,9 @@ class FittedModelProtocol(Protocol):
 
     method: str
     ts: float
+    input_name: str
+    input_unit: str
+    u_offset: float
 
     @property
     def structure(self) -> Any: ...
@@ -120,9 +129,9 @@ def is_fitted(value) -> bool:
 
 def check_fitted(value, name: str = "model") -> None:
     """`value` implements :class:`FittedModelProtocol`, or a one-line
-    ValueError naming the argument `name` and what `value` is."""
+    TypeError naming the argument `name` and what `value` is."""
     if not is_fitted(value):
-        raise ValueError(
+        raise TypeError(
             f"`{name}` must be a fitted model (from identify() or load_model); "
             f"got {type(value).__name__}"
         )
