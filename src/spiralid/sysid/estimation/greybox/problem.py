@@ -48,7 +48,7 @@ class GreyBoxProblem:
     """
 
     def __init__(self, data: IOData, structure: GreyBox, gain="auto", penalty=1e6):
-        if not isinstance(structure, GreyBox):
+        if getattr(structure, "family", None) != GreyBox.family:
             raise TypeError(
                 f"`structure` must be a GreyBox; got {type(structure).__name__}"
             )
