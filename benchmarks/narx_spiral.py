@@ -115,7 +115,7 @@ def seeded_search(problem, *, rule: str = "learned-metric", max_nfev: int = 3000
 
 
 def fit_weights(method: str, est: IOData, st: NARX, seed: int, budget: int):
-    from spiralid.sysid.estimation.core.identify import _default_arx
+    from spiralid.sysid.estimation.core.families import _default_arx
     from spiralid.sysid.estimation.narx.training import identify_narx
 
     if method.startswith("learned-metric, seeded"):

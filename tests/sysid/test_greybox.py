@@ -220,3 +220,11 @@ def test_the_command_line_validates_a_saved_grey_box(tmp_path, monkeypatch):
     out = run("validate", "m/model.json", "rec.npz", "--quiet", cwd=tmp_path,
               env=cli_env(PYTHONPATH=path))  # fmt: skip
     assert out.returncode == 0, out.stderr
+    # export writes ARX coefficients: a grey box is refused in one line.
+    out = run("export", "m/model.json", cwd=tmp_path, env=cli_env(PYTHONPATH=path))
+    assert out.returncode == 2
+    assert out.stderr.strip().endswith(
+        "'m/model.json' is a greybox model, not an ARX one (export takes the "
+        "single-output ARX models of spiralid identify and spiralid pareto)"
+    )
+    assert "\n" not in out.stderr.strip()

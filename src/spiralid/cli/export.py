@@ -47,9 +47,14 @@ class _Formatter(argparse.RawDescriptionHelpFormatter, _HelpFormatter):
     defaults shown."""
 
 
+# How a family's model is named in export's refusals.
+_FAMILY_NAMES = {"narx": "NARX", "polynomial-narx": "polynomial NARX"}
+
+
 def _model(name: str):
-    """The ARX model in `name`: a NARX model has no transfer function, and
-    one of several outputs has one per output."""
+    """The ARX model in `name`: a nonlinear model has no transfer function,
+    another family's has no ARX coefficients, and one of several outputs
+    has one per output."""
     from .validate import _read_model
 
     model, _, _ = _read_model(name)
@@ -57,10 +62,15 @@ def _model(name: str):
         "export takes the single-output ARX models of `spiralid identify` and "
         "`spiralid pareto`"
     )
+    family = model.structure.family
+    kind = _FAMILY_NAMES.get(family, family)
     if not model.is_linear:
         raise UsageError(
-            f"{name!r} is a NARX model: it has no transfer function to export ({takes})"
+            f"{name!r} is a {kind} model: it has no transfer function to export "
+            f"({takes})"
         )
+    if family != "arx":
+        raise UsageError(f"{name!r} is a {kind} model, not an ARX one ({takes})")
     outputs = model.output_names
     if len(outputs) > 1:
         raise UsageError(

@@ -219,7 +219,7 @@ def _chosen_by_fit(args, est, val, options, progress):
 
 
 # The budget of the searches that have one of their own (identify's
-# "spiral", spiral_method._estimate_recommended, and every NARX search,
+# "spiral", spiral/recommended.py's _estimate_recommended, and every NARX search,
 # narx.estimate_search and estimate_spiral), and the iteration cap of the
 # others (spiralid.optim.minimize, differential_evolution): what --help says
 # and what the progress counts toward.
@@ -565,7 +565,7 @@ def run(args, argv: list[str]) -> int:
         return _run_narx(args)
     with _progress(args) as progress:
         arx, est, val = _load_parts(args, progress, _structure)
-        # The budget rule is identify()'s (searches.search_options).
+        # The budget rule is identify()'s (spiral/population.py: search_options).
         options = _identify_options(args, arx)
         if est.n_outputs > 1:
             _check_shared_options(args, est)

@@ -401,7 +401,11 @@ class GreyBox:
 
     @classmethod
     def from_dict(cls, d: dict) -> GreyBox:
-        """The structure :meth:`to_dict` wrote, its functions imported."""
+        """The structure :meth:`to_dict` wrote, its functions imported.
+
+        The file names each function's module, which this imports and
+        runs (as unpickling would): read only model files you trust.
+        """
         functions = {role: _import(path) for role, path in d["functions"].items()}
         params = [Parameter(**p) for p in d["parameters"]]
         extra = {}

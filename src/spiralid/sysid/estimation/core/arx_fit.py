@@ -146,8 +146,7 @@ def _problem(method: str, data: IOData, arx: ARX, given: dict):
 def _holdback(method: str, options: dict) -> float:
     """The share of the record the margin's choice holds back: the
     recommended method's `holdback` (None or 0: choose by the cost alone,
-    which keeps the margin), :data:`~spiralid.sysid.estimation.heldback.
-    HOLDBACK` for the others."""
+    which keeps the margin), :data:`~.heldback.HOLDBACK` for the others."""
     if method == DEFAULT_METHOD:
         return options.get("holdback", HOLDBACK) or 0.0
     return HOLDBACK

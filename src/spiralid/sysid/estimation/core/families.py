@@ -13,7 +13,7 @@ family                    methods
 ``"arx"``                 every key of :data:`~.estimators.METHODS`
 ``"narx"``                ``"spiral"``, ``"ls"``, ``"oe"``, every rule
 ``"polynomial-narx"``     ``"ls"`` and ``"spiral"`` (forward regression)
-``"shared-denominator"``  :data:`~.shared.SHARED_METHODS`
+``"shared-denominator"``  :data:`~.denominator.SHARED_METHODS`
 ``"greybox"``             :data:`~.greybox.fit.GREYBOX_METHODS`
 ========================  ======================================================
 
@@ -136,7 +136,7 @@ _IDENTIFY_ARGUMENTS = (
 
 def _fit_narx(data, structure, method, given, *, estimate, takes):
     """A NARX or polynomial NARX by the estimator `estimate`
-    (:func:`~.narx.identify_narx`), with the options it `takes`."""
+    (:func:`~.training.identify_narx`), with the options it `takes`."""
     return _narx.identify_narx(
         data,
         structure,
@@ -166,7 +166,7 @@ _POLYNOMIAL = ("rng", "predictor", "initial")
 
 def _fit_shared(data, structure, method, given):
     """One denominator for every output
-    (:func:`~.shared.identify_shared`), fitted to the simulation error
+    (:func:`~.denominator.identify_shared`), fitted to the simulation error
     from rest."""
     if given["predictor"] != "simulation" or given["initial"] != "rest":
         raise ValueError(

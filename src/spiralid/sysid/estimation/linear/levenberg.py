@@ -54,8 +54,8 @@ STOPS = {
     4: "No damped step lowers the cost: a local minimum to working precision.",
     5: "The cost fell by less than its stall tolerance over the stall window: "
     "the end of a flat valley.",
-    6: "At the pace of its last stall window the evaluations left could not "
-    "bring the cost down to the rival's: given up.",
+    6: "At its pace over the last fifth of the stall window the evaluations "
+    "left could not bring the cost down to the rival's: given up.",
 }
 
 
@@ -241,6 +241,9 @@ def levenberg_marquardt(
         (a key of :data:`STOPS`), ``status`` (1 when the cap ended it,
         otherwise 0), ``success`` and ``message``.
     """
+
+    if rival is not None and stall is None:
+        raise ValueError("`rival` is judged over the stall window: give `stall` too")
 
     def evaluate(x):
         r = residual(x)

@@ -55,7 +55,7 @@ def _polish(
 
     Each polish after the first races the lowest squared error reached so
     far (``rival`` of
-    :func:`~spiralid.sysid.estimation.levenberg.levenberg_marquardt`): one
+    :func:`~spiralid.sysid.estimation.linear.levenberg.levenberg_marquardt`): one
     that cannot reach it at its own pace is given up, since only the lowest
     is kept."""
     t0 = time.perf_counter()

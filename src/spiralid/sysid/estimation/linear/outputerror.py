@@ -234,7 +234,7 @@ def local_polish(
     ``rival`` (optional) is the squared error ``|r|^2`` another start's
     polish reached when only the lower is kept: the polish gives up where
     its pace cannot reach it (stop 6 of
-    :func:`~spiralid.sysid.estimation.levenberg.levenberg_marquardt`)."""
+    :func:`~spiralid.sysid.estimation.linear.levenberg.levenberg_marquardt`)."""
     na = arx.na
     residual, jacobian = error_functions(arx, data, predictor, initial)
     if max_nfev is None:

@@ -1,10 +1,11 @@
-"""Training NARX models: the estimators :data:`~.core.estimators.METHODS` holds
-for a :class:`~spiralid.sysid.models.narx.NARX` or
+"""Training NARX models: the estimators the table
+:data:`~spiralid.sysid.estimation.core.families.ESTIMATORS` holds for a
+:class:`~spiralid.sysid.models.narx.NARX` or
 :class:`~spiralid.sysid.models.narx.PolynomialNARX` structure.
 
 :func:`~spiralid.sysid.identify` with a NARX structure goes through the same
-table as ARX: each method's entry names its NARX estimator
-(``Method.narx``). What each method does to a NARX:
+table as ARX: each ``("narx", method)`` entry names its NARX estimator.
+What each method does to a NARX:
 
 ``"ls"``
     Least squares of the one-step error. For the MLP, Levenberg-Marquardt
@@ -206,7 +207,7 @@ def estimate_oe(
     patience_share: float = 0.0,
 ) -> OptimiserResult:
     """``"oe"``: the gradient baseline on the predictor's error, from the
-    linear start (:func:`.narx_starts._linear_start`).
+    linear start (:func:`~spiralid.sysid.estimation.narx.starts._linear_start`).
 
     Parameters
     ----------
@@ -434,7 +435,7 @@ def identify_narx(
     **options,
 ) -> NARXModel:
     """Estimate a NARX model with the estimator `estimate` (the method's
-    ``Method.narx``); :func:`~spiralid.sysid.identify` calls it.
+    entry in the estimator table); :func:`~spiralid.sysid.identify` calls it.
 
     Parameters
     ----------
@@ -445,7 +446,7 @@ def identify_narx(
     method : str
         The method's name (recorded in the model).
     estimate : callable
-        ``estimate(problem, **options)``, the method's ``Method.narx``.
+        ``estimate(problem, **options)``, from the method's table entry.
     predictor : {"simulation", "one-step"}
         The error the cost measures.
     initial : {"rest", "measured"}
