@@ -58,7 +58,32 @@ from ...data import IOData, single_output_record
 from ...models.arx import ARX, INITIAL_CONDITIONS, check_arx
 from ...models.polynomials import is_stable_polynomial
 
-__all__ = ["INITIAL_CONDITIONS", "PaperCost", "auto_gain", "cost_of_errors"]
+__all__ = [
+    "INITIAL_CONDITIONS",
+    "PaperCost",
+    "auto_gain",
+    "cost_of_errors",
+    "gain_value",
+]
+
+
+def gain_value(gain, y: np.ndarray) -> float:
+    """Eq. (2)'s gain ``w``: :func:`auto_gain` of `y` for ``"auto"``, else
+    `gain` checked as a finite number > 0 (a one-line error naming
+    ``gain`` otherwise: ValueError for another string or a bad number,
+    TypeError for another type)."""
+    if isinstance(gain, str):
+        if gain != "auto":
+            raise ValueError(
+                f"`gain` must be 'auto' or a finite number > 0; got {gain!r}"
+            )
+        return auto_gain(y)
+    try:
+        return positive(gain, "gain")
+    except (TypeError, ValueError) as err:
+        raise type(err)(
+            f"`gain` must be 'auto' or a finite number > 0; got {gain!r}"
+        ) from None
 
 
 def auto_gain(y: np.ndarray) -> float:
@@ -165,19 +190,7 @@ class PaperCost:
         self.t0 = 0 if from_rest else lag
         self.K = data.n - self.t0
         y = data.y[self.t0 :]
-        if isinstance(gain, str):
-            if gain != "auto":
-                raise ValueError(
-                    f"`gain` must be 'auto' or a finite number > 0; got {gain!r}"
-                )
-            self.w = auto_gain(y)
-        else:
-            try:
-                self.w = positive(gain, "gain")
-            except (TypeError, ValueError) as err:
-                raise type(err)(
-                    f"`gain` must be 'auto' or a finite number > 0; got {gain!r}"
-                ) from None
+        self.w = gain_value(gain, y)
         # The one-step error always sums over t >= max_lag (all regressors
         # measured); a simulation from rest only uses it for unstable
         # candidates.

@@ -23,7 +23,7 @@ from spiralid._checks import positive
 
 from ...data import IOData
 from ...models.greybox import GreyBox
-from ..core.cost import auto_gain, cost_of_errors
+from ..core.cost import cost_of_errors, gain_value
 
 __all__ = ["GreyBoxProblem"]
 
@@ -74,10 +74,7 @@ class GreyBoxProblem:
         high = np.array([p.bounds[1] for p in params])
         self.low = np.where(self.log, np.log(np.where(self.log, low, 1.0)), low)
         self.high = np.where(self.log, np.log(np.where(self.log, high, 1.0)), high)
-        self.w = (
-            auto_gain(self.y) if isinstance(gain, str) and gain == "auto"
-            else positive(gain, "gain")
-        )  # fmt: skip
+        self.w = gain_value(gain, self.y)
         self.penalty = positive(penalty, "penalty")
         self.nfev = 0
 
