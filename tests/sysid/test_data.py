@@ -190,3 +190,21 @@ def test_non_utf8_csv_is_refused_clearly(tmp_path):
     p.write_bytes("u,y\n1,2\n".encode("utf-16"))
     with pytest.raises(ValueError, match="is UTF-16 text, not UTF-8"):
         IOData.from_csv(p, ts=1.0)
+
+
+def test_cascaded_tanks_records_are_the_benchmarks():
+    """Both records as the benchmark describes them: 1,024 samples at 4 s, a
+    pump voltage in 0-10 V, and a level that saturates at 10 V (the
+    overflow) in each record."""
+    from spiralid.datasets import cascaded_tanks, load
+
+    est, test = cascaded_tanks(), cascaded_tanks("test")
+    for record in (est, test):
+        assert (record.n, record.ts) == (1024, 4.0)
+        assert (record.input_unit, record.output_unit) == ("V", "V")
+        assert 0.0 <= record.u.min() and record.u.max() <= 10.0
+        assert np.sum(record.y >= 10.0 - 1e-9) >= 1
+    assert not np.array_equal(est.u, test.u)
+    np.testing.assert_array_equal(load("cascaded_tanks_test").y, test.y)
+    with pytest.raises(ValueError, match="record"):
+        cascaded_tanks("validation")
