@@ -56,6 +56,7 @@ from spiralid._checks import refuse_options
 
 from ...data import IOData, single_output_record
 from ...models.arx import ARX
+from ...models.greybox import GreyBox
 from ...models.identified import IdentifiedModel
 from ...models.narx import NARX, PolynomialNARX
 from ...models.protocol import FittedModelProtocol
@@ -87,7 +88,7 @@ __all__ = [
 
 def identify(
     data: IOData,
-    structure: ARX | NARX | PolynomialNARX,
+    structure: ARX | NARX | PolynomialNARX | GreyBox,
     method: str = DEFAULT_METHOD,
     *,
     predictor: str = "simulation",
@@ -106,7 +107,7 @@ def identify(
     ----------
     data : IOData
         Estimation record.
-    structure : ARX, NARX or PolynomialNARX
+    structure : ARX, NARX, PolynomialNARX or GreyBox
         Model structure, e.g. ``ARX(8, 8, 0)`` for eq. (6). Its ``family``
         and the method name the estimator in
         :data:`~spiralid.sysid.estimation.core.families.ESTIMATORS`. A NARX
@@ -115,7 +116,10 @@ def identify(
         `options` sets its early-stopping share) and returns a
         :class:`~spiralid.sysid.models.narx.NARXModel`; an ARX structure on
         a record of several outputs, one denominator for all, returns a
-        :class:`~spiralid.sysid.models.shared.SharedDenominatorModel`.
+        :class:`~spiralid.sysid.models.shared.SharedDenominatorModel`; a
+        :class:`~spiralid.sysid.models.greybox.GreyBox` returns a
+        :class:`~spiralid.sysid.models.greybox_model.GreyBoxModel`
+        (:mod:`spiralid.sysid.estimation.greybox.fit`).
     method : str, default "spiral"
         A key of :data:`spiralid.sysid.estimation.core.estimators.METHODS`, in
         any case: ``"spiral"``
@@ -278,7 +282,13 @@ def identify(
     ``n_points``, ``max_iter``, ``max_nfev``, ``max_time``, ``target``,
     ``x0``, ``callback``, ``bounds_policy``, ``restarts``. A
     PolynomialNARX (``"ls"`` only) takes ``rng``, ``predictor`` and
-    ``initial``.
+    ``initial``. A :class:`~spiralid.sysid.models.greybox.GreyBox`
+    (:data:`~spiralid.sysid.estimation.greybox.fit.GREYBOX_METHODS`) takes
+    ``rng``, ``gain``, ``penalty`` and ``workers`` (its simulations on
+    several processes, :mod:`~spiralid.sysid.estimation.greybox.parallel`),
+    and: ``"spiral"`` ``n_points``, ``max_nfev``, ``polish_nfev``;
+    ``"oe"`` ``polish_nfev``; ``"sda"`` and ``"ebsda"`` ``n_points``,
+    ``max_nfev``.
     ``tests/test_option_contract.py`` checks this table against
     :func:`identify_options` and the command line.
 

@@ -26,11 +26,12 @@ from ...models.greybox import GreyBox
 from ...models.greybox_model import GreyBoxModel, LinearGreyBoxModel
 from ..linear.levenberg import levenberg_marquardt
 from .intervals import parameter_intervals
+from .parallel import ParallelEvaluator
 from .problem import GreyBoxProblem
 
 __all__ = ["GREYBOX_METHODS", "fit_greybox"]
 
-_COMMON = ("rng", "gain", "penalty")
+_COMMON = ("rng", "gain", "penalty", "workers")
 #: method -> the options it takes beside identify's common ones.
 GREYBOX_METHODS: dict[str, tuple[str, ...]] = {
     "spiral": (*_COMMON, "n_points", "max_nfev", "polish_nfev"),
@@ -45,17 +46,42 @@ _POLISH_NFEV = 200
 _RULES = {"spiral": "learned-metric", "sda": "sda", "ebsda": "ebsda"}
 
 
-def _polish(problem: GreyBoxProblem, z0: np.ndarray, max_nfev: int) -> np.ndarray:
+def _polish(
+    problem: GreyBoxProblem, z0: np.ndarray, max_nfev: int, pool: ParallelEvaluator
+) -> np.ndarray:
     """Levenberg-Marquardt on the simulation error from `z0`, trial points
-    clipped into the unit box."""
+    clipped into the unit box, the Jacobian's simulations on `pool`."""
     result = levenberg_marquardt(
         problem.residual,
-        problem.jacobian,
+        lambda z: problem.jacobian(z, pool.residuals),
         z0,
         project=lambda z: np.clip(z, 0.0, 1.0),
         max_nfev=max_nfev,
     )
     return np.asarray(result.x, dtype=float)
+
+
+def _search(
+    problem: GreyBoxProblem, method: str, given: dict, pool: ParallelEvaluator
+) -> np.ndarray:
+    """The search's best unit-box point (the initial values' for a
+    local-only method); a batch of points at a time on `pool`'s workers."""
+    if method not in _RULES:
+        return problem.z0
+    n_points = integer(given.get("n_points", _N_POINTS), "n_points", 2)
+    budget = integer(given.get("max_nfev", _MAX_NFEV), "max_nfev", n_points)
+    parallel = pool.executor is not None
+    found = minimize(
+        pool.costs if parallel else problem,
+        np.tile([0.0, 1.0], (problem.n_free, 1)),
+        method=_RULES[method],
+        n_points=n_points,
+        max_nfev=budget,
+        rng=given.get("rng"),
+        vectorized=parallel,
+        x0=problem.z0,
+    )
+    return np.asarray(found.x, dtype=float)
 
 
 def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
@@ -74,26 +100,14 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
         penalty=given.get("penalty", 1e6),
     )
     polish_nfev = integer(given.get("polish_nfev", _POLISH_NFEV), "polish_nfev", 1)
-    z = problem.z0
-    if method in _RULES:
-        n_points = integer(given.get("n_points", _N_POINTS), "n_points", 2)
-        budget = integer(given.get("max_nfev", _MAX_NFEV), "max_nfev", n_points)
-        found = minimize(
-            problem,
-            np.tile([0.0, 1.0], (problem.n_free, 1)),
-            method=_RULES[method],
-            n_points=n_points,
-            max_nfev=budget,
-            rng=given.get("rng"),
-            x0=problem.z0,
-        )
-        z = np.asarray(found.x, dtype=float)
-    if method in ("spiral", "oe"):
-        polished = _polish(problem, z, polish_nfev)
-        if problem(polished) <= problem(z):
-            z = polished
-    residual = problem.residual(z)
-    jac = problem.jacobian(z)
+    with ParallelEvaluator(problem, given.get("workers")) as pool:
+        z = _search(problem, method, given, pool)
+        if method in ("spiral", "oe"):
+            polished = _polish(problem, z, polish_nfev, pool)
+            if problem(polished) <= problem(z):
+                z = polished
+        residual = problem.residual(z)
+        jac = problem.jacobian(z, pool.residuals)
     intervals, notes = parameter_intervals(problem, z, residual, jac)
     kind = LinearGreyBoxModel if structure.kind == "linear" else GreyBoxModel
     return kind(

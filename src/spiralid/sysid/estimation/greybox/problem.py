@@ -129,15 +129,17 @@ class GreyBoxProblem:
         """The cost at the unit-box point `z`."""
         return self.cost_of(self.residual(z))
 
-    def jacobian(self, z) -> np.ndarray:
+    def jacobian(self, z, residuals=None) -> np.ndarray:
         """``d residual / d z`` by forward differences, stepping inward at
-        the box's upper face."""
+        the box's upper face; `residuals` (a batch of points -> their
+        residuals, e.g. on several processes) runs the ``n + 1``
+        simulations, one by one by default."""
         z = np.asarray(z, dtype=float)
-        r0 = self.residual(z)
-        jac = np.empty((r0.size, z.size))
-        for j in range(z.size):
-            h = _STEP if z[j] + _STEP <= 1.0 else -_STEP
-            step = z.copy()
-            step[j] += h
-            jac[:, j] = (self.residual(step) - r0) / h
-        return jac
+        steps = np.where(z + _STEP <= 1.0, _STEP, -_STEP)
+        points = np.vstack([z, z + np.diag(steps)])
+        if residuals is None:
+            r0, *moved = (self.residual(p) for p in points)
+        else:
+            r0, *moved = residuals(points)
+        pairs = zip(moved, steps, strict=True)
+        return np.column_stack([(r - r0) / h for r, h in pairs])
