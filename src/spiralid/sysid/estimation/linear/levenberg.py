@@ -239,7 +239,8 @@ def levenberg_marquardt(
         ``jac`` (at ``x``), ``optimality`` (the gradient ``J' r``'s largest
         component), ``nfev``, ``njev``, ``nit`` (accepted steps), ``stop``
         (a key of :data:`STOPS`), ``status`` (1 when the cap ended it,
-        otherwise 0), ``success`` and ``message``.
+        otherwise 0), ``success`` (False at the cap and when given up to
+        the rival: neither met a tolerance) and ``message``.
     """
 
     if rival is not None and stall is None:
@@ -317,7 +318,7 @@ def levenberg_marquardt(
         history=None,
         stop=status,
         status=1 if status == 0 else 0,
-        success=status != 0,
+        success=status not in (0, 6),
         message=STOPS[status],
     )
 
