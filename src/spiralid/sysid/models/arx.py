@@ -354,8 +354,7 @@ def arx_least_squares(data: IOData, arx: ARX) -> np.ndarray:
     array([-1.5,  0.7,  1. ,  0.5])
     """
     single_output_record(data, "arx_least_squares")
-    if not isinstance(arx, ARX):
-        raise ValueError(f"`arx` must be an ARX; got {type(arx).__name__}")
+    check_arx(arx)
     arx.check_length(data)
     if np.ptp(data.u) == 0.0:
         raise ValueError(

@@ -228,12 +228,12 @@ def methods_of(family: str) -> tuple[str, ...]:
 def family_of(structure, n_outputs: int = 1) -> str | None:
     """The family of `structure` on a record of `n_outputs` outputs: its
     ``family``, or for several its ``outputs_family`` (None: the structure
-    takes one output); a one-line ValueError for what is not a
+    takes one output); a one-line TypeError for what is not a
     structure."""
     family = getattr(structure, "family", None)
     families = tuple(dict.fromkeys(f for f, _ in ESTIMATORS))
     if family not in families:
-        raise ValueError(
+        raise TypeError(
             "`structure` must be a model structure of a family of the estimator "
             f"table {families} (ARX, NARX, PolynomialNARX...); got "
             f"{type(structure).__name__}"
