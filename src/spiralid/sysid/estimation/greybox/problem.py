@@ -68,7 +68,7 @@ class GreyBoxProblem:
                 f"`data` has N = {self.y.size} samples; a grey box of {d} free "
                 f"parameters needs more than {2 * d}"
             )
-        params = [p for p in structure.parameters if p.free]
+        params = [p for p in structure.all_parameters if p.free]
         self.log = np.array([p.log for p in params])
         low = np.array([p.bounds[0] for p in params])
         high = np.array([p.bounds[1] for p in params])
