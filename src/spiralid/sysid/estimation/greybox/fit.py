@@ -86,8 +86,13 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
             max_nfev=budget,
             rng=given.get("rng"),
             x0=problem.z0,
+            # The spiral's trial points outside the box are clipped onto it
+            # (the paper's searches stay as printed: the problem clips what
+            # they evaluate): a parameter's bounds are physical, and a
+            # point beyond them would be reported as the fit.
+            options={"bounds_policy": "clip"} if method == "spiral" else None,
         )
-        z = np.asarray(found.x, dtype=float)
+        z = np.clip(np.asarray(found.x, dtype=float), 0.0, 1.0)
     if method in ("spiral", "oe"):
         polished = _polish(problem, z, polish_nfev)
         if problem(polished) <= problem(z):

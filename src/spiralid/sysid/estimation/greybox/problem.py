@@ -97,9 +97,11 @@ class GreyBoxProblem:
         return np.where(self.log, np.exp(c), c)
 
     def values(self, z) -> np.ndarray:
-        """Every parameter's value at `z` (fixed ones at their value)."""
+        """Every parameter's value at `z` clipped into the box (fixed ones at
+        their value): a search that steps outside the bounds (the paper's
+        SDA does) runs the model on the box's face, never beyond."""
         out = self.structure.initial_values
-        out[self.free] = self.free_values(z)
+        out[self.free] = self.free_values(np.clip(z, 0.0, 1.0))
         return out
 
     @property
