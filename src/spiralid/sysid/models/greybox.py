@@ -301,8 +301,7 @@ class GreyBox:
             x = np.full(0, np.nan)
         if x.size != self.n_states or not np.all(np.isfinite(x)):
             raise ValueError(
-                f"`x0` must be {self.n_states} finite numbers or Parameters; got "
-                f"{x0!r}"
+                f"`x0` must be {self.n_states} finite numbers or Parameters; got {x0!r}"
             )
         return x
 
@@ -343,7 +342,7 @@ class GreyBox:
 
     def _derivative(self, t, x, u, values) -> np.ndarray:
         name = _function_name(self.functions["f"])
-        dx = np.asarray(self.functions["f"](t, x, u, values), dtype=float)
+        dx = _called("f", name, self.functions["f"], t, x, u, values)
         if dx.shape != (self.n_states,):
             raise ValueError(
                 f"`f` ({name}) must return dx/dt of shape ({self.n_states},); got "
@@ -355,7 +354,7 @@ class GreyBox:
 
     def _output(self, x, u, values, size) -> np.ndarray:
         name = _function_name(self.functions["g"])
-        y = np.atleast_1d(np.asarray(self.functions["g"](x, u, values), dtype=float))
+        y = np.atleast_1d(_called("g", name, self.functions["g"], x, u, values))
         if y.ndim != 1 or (size is not None and y.size != size):
             raise ValueError(f"`g` ({name}) must return y of shape (p,); got {y.shape}")
         if not np.all(np.isfinite(y)):
@@ -489,6 +488,18 @@ class GreyBox:
         return f"GreyBox({self.kind}: {funs}; {', '.join(self.names)})"
 
     __str__ = __repr__
+
+
+def _called(role: str, name: str, fun: Callable, *args) -> np.ndarray:
+    """``fun(*args)`` as a float array, or the same error type in one line
+    naming the function (a wrong signature, a string returned)."""
+    try:
+        return np.asarray(fun(*args), dtype=float)
+    except (TypeError, ValueError) as error:
+        first = (str(error).strip().splitlines() or [""])[0][:160]
+        raise type(error)(
+            f"`{role}` ({name}) failed on the initial values and state: {first}"
+        ) from None
 
 
 def _import(path: str) -> Callable:
