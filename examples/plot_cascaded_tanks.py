@@ -16,7 +16,7 @@ record by the simulation error, the initial levels (unknown: the record
 starts mid-way) estimated with them. The benchmark's score is the RMS of the
 free run's error on the test record, the first 5 samples left out.
 
-The model's functions are shipped in :mod:`spiralid.datasets.tanks_model`
+The model's functions are shipped in ``spiralid.datasets.tanks_model``
 (so that a fitted model's ``model.json`` names them by import path); write
 your own the same way, in a module of your own: Numba functions
 (``numba.njit``) run in compiled code, plain Python ones work too, slower.

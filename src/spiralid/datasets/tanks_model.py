@@ -59,7 +59,7 @@ TANKS_PARAMETERS: dict[str, tuple] = {
 }
 
 
-@numba.njit
+@numba.njit(cache=True)
 def tanks_f(t, x, u, p):  # pragma: no cover - compiled
     """``dx/dt`` of the two tanks (see the module docstring)."""
     up = max(x[0], 0.0)
@@ -75,7 +75,7 @@ def tanks_f(t, x, u, p):  # pragma: no cover - compiled
     return np.array([dx0, dx1])
 
 
-@numba.njit
+@numba.njit(cache=True)
 def tanks_g(x, u, p):  # pragma: no cover - compiled
     """The lower tank's sensor: its level plus an offset, saturating."""
     return min(x[1] + p[5], SENSOR_MAX)

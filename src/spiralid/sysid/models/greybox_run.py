@@ -63,13 +63,13 @@ def rk4_python(
     return y
 
 
-@numba.njit
+@numba.njit(cache=True)
 def _first(value):  # pragma: no cover - compiled
     # g may return a number or a one-element array.
     return np.asarray(value).ravel()[0]
 
 
-@numba.njit
+@numba.njit(cache=True)
 def rk4_compiled(f, g, p, x0, u, ts, n_sub):  # pragma: no cover - compiled
     """:func:`rk4_python` compiled, `f` and `g` Numba functions (each pair
     compiles once per process)."""
