@@ -13,10 +13,15 @@ Two kinds, as MATLAB's ``idgrey`` and ``idnlgrey``:
 
 ``p`` is every parameter's value in the declared order, free and fixed
 alike (``k, c, m = p`` unpacks it), ``x`` and ``u`` one-dimensional arrays
-(``u`` of length ``n_inputs``). A plain Python function works; a Numba one
-is called the same way. Each function is called once at construction on
-the initial values, and a wrong shape or a NaN is refused there in one line
-naming the function.
+(``u`` of length ``n_inputs``). A plain Python function works; with Numba
+functions (``numba.njit``) for both ``f`` and ``g`` the Runge-Kutta loop
+runs compiled (:mod:`.greybox_run`). Each function is called once at
+construction on the initial values, and a wrong shape or a NaN is refused
+there in one line naming the function.
+
+The initial state is zero, given, or estimated: an entry of ``x0`` given
+as a :class:`Parameter` joins the parameters (after the functions' ones,
+never in ``p``), searched and given an interval as they are.
 
 A run that blows up returns non-finite outputs from the sample it left the
 floating-point range on: the estimation's cost turns them into its penalty
