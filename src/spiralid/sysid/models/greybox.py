@@ -13,10 +13,15 @@ Two kinds, as MATLAB's ``idgrey`` and ``idnlgrey``:
 
 ``p`` is every parameter's value in the declared order, free and fixed
 alike (``k, c, m = p`` unpacks it), ``x`` and ``u`` one-dimensional arrays
-(``u`` of length ``n_inputs``). A plain Python function works; a Numba one
-is called the same way. Each function is called once at construction on
-the initial values, and a wrong shape or a NaN is refused there in one line
-naming the function.
+(``u`` of length ``n_inputs``). A plain Python function works; with Numba
+functions (``numba.njit``) for both ``f`` and ``g`` the Runge-Kutta loop
+runs compiled (:mod:`.greybox_run`). Each function is called once at
+construction on the initial values, and a wrong shape or a NaN is refused
+there in one line naming the function.
+
+The initial state is zero, given, or estimated: an entry of ``x0`` given
+as a :class:`Parameter` joins the parameters (after the functions' ones,
+never in ``p``), searched and given an interval as they are.
 
 A run that blows up returns non-finite outputs from the sample it left the
 floating-point range on: the estimation's cost turns them into its penalty
@@ -32,6 +37,10 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 from scipy import linalg
+
+from spiralid._checks import integer
+
+from .greybox_run import is_compiled, lti_run, rk4_compiled, rk4_python
 
 __all__ = ["GreyBox", "Parameter"]
 
@@ -117,6 +126,10 @@ class Parameter:
         )
 
 
+def _is_sequence(obj) -> bool:
+    return isinstance(obj, Sequence | np.ndarray) and not isinstance(obj, str)
+
+
 def _function_name(fun: Callable) -> str:
     return getattr(fun, "__qualname__", None) or type(fun).__name__
 
@@ -139,8 +152,11 @@ class GreyBox:
     n_inputs : int, default 1
         The nonlinear kind's input dimension (the linear kind's is ``B``'s
         columns).
-    x0 : array_like, optional
-        Initial state (zero by default).
+    x0 : sequence of float or Parameter, optional
+        Initial state, zero by default: one entry per state, a number
+        (given) or a :class:`Parameter` (estimated with the model's
+        parameters if free, within its bounds, as ``idnlgrey``'s initial
+        states; held at its value if fixed).
     substeps : int, default 10
         Runge-Kutta steps per sample (nonlinear kind).
 
@@ -152,6 +168,14 @@ class GreyBox:
         ``"linear"`` or ``"nonlinear"``.
     n_outputs : int
         The output dimension (one: the family fits records of one output).
+    parameters : tuple of Parameter
+        The functions' parameters (``p``).
+    state_parameters : tuple of Parameter
+        The initial state's parameters, in state order (the entries of `x0`
+        given as :class:`Parameter`).
+    all_parameters : tuple of Parameter
+        Both, the functions' first: the vector ``values`` that
+        :meth:`simulate` and a fitted model's ``values`` hold.
     """
 
     family = "greybox"
@@ -171,22 +195,17 @@ class GreyBox:
         x0=None,
         substeps: int = 10,
     ) -> None:
-        params = tuple(parameters)
+        params = tuple(parameters) if _is_sequence(parameters) else ()
         if not params or not all(isinstance(p, Parameter) for p in params):
             raise TypeError(
                 "`parameters` must be a non-empty sequence of Parameter; got "
                 f"{type(parameters).__name__}"
             )
-        names = [p.name for p in params]
-        twice = sorted({n for n in names if names.count(n) > 1})
-        if twice:
-            raise ValueError(f"`parameters` names {twice} more than once")
         if (ss is None) == (f is None):
             raise ValueError("a GreyBox takes either `ss` (linear) or `f` and `g`")
         self.parameters = params
-        self.substeps = int(substeps)
-        if self.substeps < 1:
-            raise ValueError(f"`substeps` must be >= 1; got {substeps!r}")
+        self.state_parameters: tuple[Parameter, ...] = ()
+        self.substeps = integer(substeps, "substeps", 1)
         values = self.initial_values
         if ss is not None:
             if not callable(ss):
@@ -205,15 +224,21 @@ class GreyBox:
                     raise TypeError(
                         f"`{name}` must be callable; got {type(fun).__name__}"
                     )
-            if n_states is None or int(n_states) < 1:
-                raise ValueError(
-                    f"the nonlinear kind needs `n_states` >= 1; got {n_states!r}"
-                )
+            if n_states is None:
+                raise ValueError("the nonlinear kind needs `n_states` >= 1; got None")
             self.kind = "nonlinear"
             self.functions = {"f": f, "g": g}
-            self.n_states, self.n_inputs = int(n_states), int(n_inputs)
+            self.n_states = integer(n_states, "n_states", 1)
+            self.n_inputs = integer(n_inputs, "n_inputs", 1)
             self.n_outputs = None
-        self.x0 = self._initial_state(x0)
+        self._x0_given = self._initial_state(x0)
+        names = list(self.names)
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise ValueError(
+                f"`parameters` and `x0` name {twice} more than once: each "
+                "parameter needs its own name"
+            )
         if self.kind == "nonlinear":
             u0 = np.zeros(self.n_inputs)
             self._derivative(0.0, self.x0, u0, values)
@@ -227,31 +252,61 @@ class GreyBox:
     # -- the parameters -------------------------------------------------------
 
     @property
+    def all_parameters(self) -> tuple[Parameter, ...]:
+        return self.parameters + self.state_parameters
+
+    @property
     def names(self) -> tuple[str, ...]:
-        """Every parameter's name, in order."""
-        return tuple(p.name for p in self.parameters)
+        """Every parameter's name (:attr:`all_parameters`), in order."""
+        return tuple(p.name for p in self.all_parameters)
 
     @property
     def initial_values(self) -> np.ndarray:
-        """Every parameter's initial value, in order."""
-        return np.array([p.value for p in self.parameters])
+        """Every parameter's initial value (:attr:`all_parameters`), in
+        order."""
+        return np.array([p.value for p in self.all_parameters])
 
     @property
     def free(self) -> np.ndarray:
-        """Which parameters are estimated (boolean mask)."""
-        return np.array([p.free for p in self.parameters])
+        """Which of :attr:`all_parameters` are estimated (boolean mask)."""
+        return np.array([p.free for p in self.all_parameters])
+
+    @property
+    def x0(self) -> np.ndarray:
+        """The initial state at the initial values."""
+        return self.initial_state(self.initial_values)
+
+    def initial_state(self, values) -> np.ndarray:
+        """The initial state at `values` (every parameter, as
+        :meth:`simulate` takes them)."""
+        x = self._x0_given.copy()
+        n_p = len(self.parameters)
+        if len(values) > n_p:
+            x[self._x0_free_rows] = np.asarray(values, dtype=float)[n_p:]
+        return x
 
     @property
     def _output_function(self) -> str:
         return "ss" if self.kind == "linear" else "g"
 
     def _initial_state(self, x0) -> np.ndarray:
+        """The given initial state (a Parameter's entry at its value), the
+        Parameters kept in :attr:`state_parameters`."""
+        self._x0_free_rows = np.zeros(0, dtype=int)
         if x0 is None:
             return np.zeros(self.n_states)
-        x = np.asarray(x0, dtype=float).ravel()
+        entries = list(x0) if _is_sequence(x0) else [x0]
+        rows = [i for i, e in enumerate(entries) if isinstance(e, Parameter)]
+        self.state_parameters = tuple(entries[i] for i in rows)
+        self._x0_free_rows = np.array(rows, dtype=int)
+        numbers = [e.value if isinstance(e, Parameter) else e for e in entries]
+        try:
+            x = np.asarray(numbers, dtype=float).ravel()
+        except (TypeError, ValueError):
+            x = np.full(0, np.nan)
         if x.size != self.n_states or not np.all(np.isfinite(x)):
             raise ValueError(
-                f"`x0` must be {self.n_states} finite numbers; got {np.asarray(x0)!r}"
+                f"`x0` must be {self.n_states} finite numbers or Parameters; got {x0!r}"
             )
         return x
 
@@ -292,7 +347,7 @@ class GreyBox:
 
     def _derivative(self, t, x, u, values) -> np.ndarray:
         name = _function_name(self.functions["f"])
-        dx = np.asarray(self.functions["f"](t, x, u, values), dtype=float)
+        dx = _called("f", name, self.functions["f"], t, x, u, values)
         if dx.shape != (self.n_states,):
             raise ValueError(
                 f"`f` ({name}) must return dx/dt of shape ({self.n_states},); got "
@@ -304,7 +359,7 @@ class GreyBox:
 
     def _output(self, x, u, values, size) -> np.ndarray:
         name = _function_name(self.functions["g"])
-        y = np.atleast_1d(np.asarray(self.functions["g"](x, u, values), dtype=float))
+        y = np.atleast_1d(_called("g", name, self.functions["g"], x, u, values))
         if y.ndim != 1 or (size is not None and y.size != size):
             raise ValueError(f"`g` ({name}) must return y of shape (p,); got {y.shape}")
         if not np.all(np.isfinite(y)):
@@ -331,42 +386,48 @@ class GreyBox:
     def simulate(self, values, u, ts: float) -> np.ndarray:
         """The output, shape (N,), over the input `u` (shape (N,) or (N,
         m)) from the initial state at the parameter values `values` (every
-        parameter, in order); non-finite from where the run blew up."""
-        values = np.asarray(values, dtype=float)
-        uu = np.asarray(u, dtype=float).reshape(len(u), -1)
+        parameter of :attr:`all_parameters`, in order, or only the
+        functions', the initial state then at its initial values);
+        non-finite from where the run blew up.
+
+        With Numba functions ``f`` and ``g`` the Runge-Kutta loop runs
+        compiled (:mod:`.greybox_run`), otherwise in Python; the two agree
+        to rounding.
+        """
+        values = np.asarray(values, dtype=float).ravel()
+        n_p = len(self.parameters)
+        if values.size not in (n_p, n_p + len(self.state_parameters)):
+            raise ValueError(
+                f"`values` must hold {n_p} or {len(self.names)} numbers (the "
+                f"parameters {self.names}); got {values.size}"
+            )
+        uu = np.ascontiguousarray(np.asarray(u, dtype=float).reshape(len(u), -1))
         if uu.shape[1] != self.n_inputs:
             raise ValueError(
                 f"`u` must have {self.n_inputs} input column(s); got {uu.shape[1]}"
             )
+        p, x0 = np.ascontiguousarray(values[:n_p]), self.initial_state(values)
         with np.errstate(all="ignore"):
             if self.kind == "linear":
                 try:
-                    ad, bd, c, d = self.discretise(values, ts)
+                    ad, bd, c, d = self.discretise(p, ts)
                 except ValueError:
                     # Parameters where ss itself fails: no run, the penalty.
                     return np.full(uu.shape[0], np.nan)
-                return _lti_run(ad, bd, c, d, self.x0, uu)[:, 0]
-            return self._rk4(values, uu, ts)
-
-    def _rk4(self, values, uu: np.ndarray, ts: float) -> np.ndarray:
-        f, g = self.functions["f"], self.functions["g"]
-        h = ts / self.substeps
-        x = self.x0.copy()
-        y = np.full(uu.shape[0], np.nan)
-        for k in range(uu.shape[0]):
-            uk = uu[k]
-            y[k] = np.asarray(g(x, uk, values), dtype=float).ravel()[0]
-            t = k * ts
-            for _ in range(self.substeps):
-                k1 = np.asarray(f(t, x, uk, values), dtype=float)
-                k2 = np.asarray(f(t + h / 2, x + h / 2 * k1, uk, values), dtype=float)
-                k3 = np.asarray(f(t + h / 2, x + h / 2 * k2, uk, values), dtype=float)
-                k4 = np.asarray(f(t + h, x + h * k3, uk, values), dtype=float)
-                x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-                t += h
-            if not np.all(np.isfinite(x)):
-                break  # the rest stays NaN: the cost's penalty
-        return y
+                return lti_run(ad, bd, c, d, x0, uu)[:, 0]
+            f, g = self.functions["f"], self.functions["g"]
+            if not is_compiled(f, g):
+                return rk4_python(f, g, p, x0, uu, float(ts), self.substeps)
+            try:
+                return rk4_compiled(f, g, p, x0, uu, float(ts), self.substeps)
+            except numba.core.errors.TypingError as error:
+                first = str(error).strip().splitlines()[-1][:200]
+                raise ValueError(
+                    f"the Numba functions `f` ({_function_name(f)}) and `g` "
+                    f"({_function_name(g)}) do not compile in the Runge-Kutta "
+                    f"loop (f must return a float array of the states, g a "
+                    f"number or a one-element array): {first}"
+                ) from None
 
     # -- text and JSON ------------------------------------------------------------
 
@@ -395,9 +456,17 @@ class GreyBox:
             parameters=[p.to_dict() for p in self.parameters],
             n_states=self.n_states,
             n_inputs=self.n_inputs,
-            x0=self.x0.tolist(),
+            x0=self._x0_entries(),
             substeps=self.substeps,
         )
+
+    def _x0_entries(self) -> list:
+        """The initial state as `x0` takes it: numbers, and the estimated
+        entries as Parameters' JSON forms."""
+        out: list = self._x0_given.tolist()
+        for row, p in zip(self._x0_free_rows, self.state_parameters, strict=True):
+            out[row] = p.to_dict()
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> GreyBox:
@@ -408,11 +477,14 @@ class GreyBox:
         """
         functions = {role: _import(path) for role, path in d["functions"].items()}
         params = [Parameter(**p) for p in d["parameters"]]
+        x0 = d.get("x0")
+        if x0 is not None:
+            x0 = [Parameter(**e) if isinstance(e, dict) else e for e in x0]
         extra = {}
         if d["kind"] == "nonlinear":
             extra = dict(n_states=int(d["n_states"]), n_inputs=int(d["n_inputs"]))
         return cls(
-            params, x0=d.get("x0"), substeps=int(d.get("substeps", 10)), **functions,
+            params, x0=x0, substeps=int(d.get("substeps", 10)), **functions,
             **extra,
         )  # fmt: skip
 
@@ -421,6 +493,18 @@ class GreyBox:
         return f"GreyBox({self.kind}: {funs}; {', '.join(self.names)})"
 
     __str__ = __repr__
+
+
+def _called(role: str, name: str, fun: Callable, *args) -> np.ndarray:
+    """``fun(*args)`` as a float array, or the same error type in one line
+    naming the function (a wrong signature, a string returned)."""
+    try:
+        return np.asarray(fun(*args), dtype=float)
+    except (TypeError, ValueError) as error:
+        first = (str(error).strip().splitlines() or [""])[0][:160]
+        raise type(error)(
+            f"`{role}` ({name}) failed on the initial values and state: {first}"
+        ) from None
 
 
 def _import(path: str) -> Callable:
@@ -438,18 +522,3 @@ def _import(path: str) -> Callable:
             f"the grey box's function {path!r} cannot be imported: {error}"
         ) from None
     return obj
-
-
-@numba.njit(cache=True)
-def _lti_run(ad, bd, c, d, x0, u):  # pragma: no cover - compiled
-    """``x[k+1] = Ad x[k] + Bd u[k]``, ``y[k] = C x[k] + D u[k]`` from
-    `x0`; NaN after the state leaves the floating-point range."""
-    n_samples = u.shape[0]
-    y = np.full((n_samples, c.shape[0]), np.nan)
-    x = x0.copy()
-    for k in range(n_samples):
-        y[k] = c @ x + d @ u[k]
-        x = ad @ x + bd @ u[k]
-        if not np.all(np.isfinite(x)):
-            break
-    return y

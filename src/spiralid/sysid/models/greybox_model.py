@@ -39,7 +39,9 @@ class GreyBoxModel:
     structure : GreyBox
         The structure fitted (its parameters' initial values and bounds).
     values : ndarray
-        Every parameter's value, fixed ones included, in declared order.
+        Every parameter's value, fixed ones included, in the order of the
+        structure's ``all_parameters`` (the functions', then the initial
+        state's).
     ts : float
         The record's sample time.
     method : str
@@ -134,7 +136,7 @@ class GreyBoxModel:
     def parameter_rows(self) -> list[str]:
         """One line per parameter: value, unit, 95 % interval or why none."""
         rows = []
-        for i, p in enumerate(self.structure.parameters):
+        for i, p in enumerate(self.structure.all_parameters):
             low, high = self.intervals[i]
             if not p.free:
                 note = "fixed"

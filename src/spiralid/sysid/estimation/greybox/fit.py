@@ -80,8 +80,13 @@ def _search(
         rng=given.get("rng"),
         vectorized=parallel,
         x0=problem.z0,
+        # The spiral's trial points outside the box are clipped onto it
+        # (the paper's searches stay as printed: the problem clips what
+        # they evaluate): a parameter's bounds are physical, and a point
+        # beyond them would be reported as the fit.
+        options={"bounds_policy": "clip"} if method == "spiral" else None,
     )
-    return np.asarray(found.x, dtype=float)
+    return np.clip(np.asarray(found.x, dtype=float), 0.0, 1.0)
 
 
 def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):

@@ -54,7 +54,7 @@ def parameter_intervals(
     """
     n_all = problem.structure.free.size
     intervals = np.full((n_all, 2), np.nan)
-    names = [p.name for p in problem.structure.parameters if p.free]
+    names = [p.name for p in problem.structure.all_parameters if p.free]
     dof = residual.size - z.size
     if not (np.all(np.isfinite(jac)) and np.all(np.isfinite(residual))) or dof < 1:
         return intervals, ["no interval: the fit's Jacobian is not finite"]

@@ -68,10 +68,11 @@ class GreyBoxProblem:
                 f"`data` has N = {self.y.size} samples; a grey box of {d} free "
                 f"parameters needs more than {2 * d}"
             )
-        params = [p for p in structure.parameters if p.free]
+        params = [p for p in structure.all_parameters if p.free]
         self.log = np.array([p.log for p in params])
         low = np.array([p.bounds[0] for p in params])
         high = np.array([p.bounds[1] for p in params])
+        self.bounds = (low, high)
         self.low = np.where(self.log, np.log(np.where(self.log, low, 1.0)), low)
         self.high = np.where(self.log, np.log(np.where(self.log, high, 1.0)), high)
         self.w = gain_value(gain, self.y)
@@ -94,12 +95,17 @@ class GreyBoxProblem:
         """The free parameters' values at the unit-box point `z` (any
         real `z`, inside the box or not)."""
         c = self.low + np.asarray(z, dtype=float) * (self.high - self.low)
-        return np.where(self.log, np.exp(c), c)
+        v = np.where(self.log, np.exp(c), c)
+        # exp(log(high)) may round a hair above high: the bound is the bound.
+        inside = (np.asarray(z) >= 0.0) & (np.asarray(z) <= 1.0)
+        return np.where(inside, np.clip(v, self.bounds[0], self.bounds[1]), v)
 
     def values(self, z) -> np.ndarray:
-        """Every parameter's value at `z` (fixed ones at their value)."""
+        """Every parameter's value at `z` clipped into the box (fixed ones at
+        their value): a search that steps outside the bounds (the paper's
+        SDA does) runs the model on the box's face, never beyond."""
         out = self.structure.initial_values
-        out[self.free] = self.free_values(z)
+        out[self.free] = self.free_values(np.clip(z, 0.0, 1.0))
         return out
 
     @property

@@ -1,0 +1,122 @@
+"""A physical model of the Cascaded Tanks benchmark (:func:`cascaded_tanks`)
+as a :class:`~spiralid.sysid.GreyBox`: two tanks with outflow through an
+opening (Torricelli's law), the upper tank's overflow, a pump that moves
+no water below a threshold voltage, and the level sensor that saturates at
+10 V.
+
+States (both in volts of the level sensor's scale): ``x[0]`` the upper
+tank's level, ``x[1]`` the lower tank's. With ``p`` as
+:data:`TANKS_PARAMETERS` names it::
+
+    q_up   = upper_outflow * x0**upper_exponent            (Torricelli: 0.5)
+    dx0/dt = pump_gain * max(u - pump_threshold, 0) - q_up
+    dx1/dt = area_ratio * q_up - lower_outflow * x1**lower_exponent
+             + overflow_share * (what the upper tank spills)
+    y      = min(x1 + sensor_offset, 10)
+
+The upper tank spills once ``x0`` reaches :data:`UPPER_TOP` (it then stays
+there, its surplus inflow going partly into the lower tank and partly
+away), and the lower tank stops filling at ``lower_top`` (its own
+overflow). The upper level is never measured: its scale is the model's
+choice, fixed by :data:`UPPER_TOP`, or the record could not tell the pump's
+gain from the upper tank's size.
+
+Why here and not in an example: ``model.json`` names the model's functions
+by import path, and an example's functions live in ``__main__`` when it
+runs; shipped with the package, a fitted tanks model saves and loads
+anywhere spiralid is installed. ``f`` and ``g`` are Numba functions, so the
+grey box integrates them in compiled code (a Python ``f`` would work too,
+tens of times slower: ``benchmarks/greybox_speed.py``).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from spiralid.sysid.models.greybox import GreyBox, Parameter
+
+__all__ = ["TANKS_PARAMETERS", "UPPER_TOP", "tanks_f", "tanks_g", "tanks_greybox"]
+
+#: The upper tank's overflow level, in the model's volts.
+UPPER_TOP = 10.0
+#: The level sensor's saturation (both records reach it).
+SENSOR_MAX = 10.0
+
+#: name -> (initial value, bounds, unit, Torricelli's fixed value or None):
+#: the order ``p`` is read in.
+TANKS_PARAMETERS: dict[str, tuple] = {
+    "upper_outflow": (0.05, (1e-3, 1.0), "V^(1-e)/s", None),
+    "area_ratio": (1.0, (1e-2, 10.0), "", None),
+    "lower_outflow": (0.05, (1e-3, 1.0), "V^(1-e)/s", None),
+    "pump_gain": (0.05, (1e-3, 1.0), "1/s", None),
+    "overflow_share": (0.5, (1e-3, 10.0), "", None),
+    "sensor_offset": (0.0, (-3.0, 3.0), "V", None),
+    "pump_threshold": (0.5, (0.0, 2.0), "V", None),
+    "lower_top": (10.0, (5.0, 15.0), "V", None),
+    "upper_exponent": (0.5, (0.2, 1.0), "", 0.5),
+    "lower_exponent": (0.5, (0.2, 1.0), "", 0.5),
+}
+
+
+@numba.njit(cache=True)
+def tanks_f(t, x, u, p):  # pragma: no cover - compiled
+    """``dx/dt`` of the two tanks (see the module docstring)."""
+    up = max(x[0], 0.0)
+    low = max(x[1], 0.0)
+    q_up = p[0] * up ** p[8]
+    dx0 = p[3] * max(u[0] - p[6], 0.0) - q_up
+    spill = 0.0
+    if x[0] >= UPPER_TOP and dx0 > 0.0:
+        spill, dx0 = dx0, 0.0
+    dx1 = p[1] * q_up - p[2] * low ** p[9] + p[4] * spill
+    if x[1] >= p[7] and dx1 > 0.0:
+        dx1 = 0.0
+    return np.array([dx0, dx1])
+
+
+@numba.njit(cache=True)
+def tanks_g(x, u, p):  # pragma: no cover - compiled
+    """The lower tank's sensor: its level plus an offset, saturating."""
+    return min(x[1] + p[5], SENSOR_MAX)
+
+
+def tanks_greybox(
+    *, exponents: bool = False, x0="estimated", substeps: int = 4
+) -> GreyBox:
+    """The tanks model as a grey box ready for
+    :func:`~spiralid.sysid.identify`.
+
+    Parameters
+    ----------
+    exponents : bool, default False
+        Estimate the outflow exponents too (else fixed at Torricelli's 0.5).
+    x0 : "estimated" or sequence of float, default "estimated"
+        The initial levels: estimated within ``[0, 10]`` V (the records
+        start from an unknown state), or given.
+    substeps : int, default 4
+        Runge-Kutta steps per 4 s sample.
+
+    Returns
+    -------
+    GreyBox
+    """
+    params = [
+        Parameter(
+            name,
+            value,
+            bounds,
+            unit,
+            free=exponents or fixed is None,
+            log=bounds[0] > 0 and fixed is None,
+        )
+        for name, (value, bounds, unit, fixed) in TANKS_PARAMETERS.items()
+    ]
+    if isinstance(x0, str):
+        if x0 != "estimated":
+            raise ValueError(f"`x0` must be 'estimated' or two levels; got {x0!r}")
+        x0 = [
+            Parameter("upper_level_0", 5.0, (0.0, UPPER_TOP), "V"),
+            Parameter("lower_level_0", 5.0, (0.0, SENSOR_MAX), "V"),
+        ]
+    return GreyBox(params, f=tanks_f, g=tanks_g, n_states=2, x0=x0, substeps=substeps)

@@ -1,0 +1,84 @@
+"""The Cascaded Tanks grey box (spiralid.datasets.tanks_model): its
+equations against hand-worked values, its compiled run against its Python
+original, and a fitted model's file read back through the functions'
+import path."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import spiralid as sid
+from spiralid.datasets import cascaded_tanks
+from spiralid.datasets.tanks_model import (
+    TANKS_PARAMETERS,
+    tanks_f,
+    tanks_g,
+    tanks_greybox,
+)
+from spiralid.sysid import GreyBox
+
+#: upper_outflow, area_ratio, lower_outflow, pump_gain, overflow_share,
+#: sensor_offset, pump_threshold, lower_top, upper_exponent, lower_exponent
+P = np.array([0.04, 1.0, 0.05, 0.05, 0.5, 0.3, 0.6, 9.5, 0.5, 0.5])
+
+
+def test_the_equations_by_hand():
+    u = np.array([3.0])
+    # Both tanks below their tops: Torricelli outflows, the pump above its
+    # threshold.
+    dx = tanks_f(0.0, np.array([4.0, 2.25]), u, P)
+    q_up = 0.04 * 2.0
+    np.testing.assert_allclose(
+        dx, [0.05 * (3.0 - 0.6) - q_up, 1.0 * q_up - 0.05 * 1.5], rtol=1e-14
+    )
+    # Below the threshold the pump moves nothing.
+    assert tanks_f(0.0, np.array([4.0, 2.25]), np.array([0.5]), P)[0] == -q_up
+    # The upper tank at its top spills its surplus, half of it (the share)
+    # into the lower tank.
+    strong = np.array([5.0])
+    full = tanks_f(0.0, np.array([10.0, 2.25]), strong, P)
+    surplus = 0.05 * 4.4 - 0.04 * math.sqrt(10.0)
+    assert surplus > 0
+    np.testing.assert_allclose(
+        full, [0.0, 0.04 * math.sqrt(10.0) - 0.05 * 1.5 + 0.5 * surplus]
+    )
+    # The lower tank at its top fills no further; it still drains.
+    assert tanks_f(0.0, np.array([10.0, 9.5]), strong, P)[1] == 0.0
+    assert tanks_f(0.0, np.array([0.0, 9.5]), strong, P)[1] < 0.0
+    # The sensor: level plus offset, saturating at 10 V.
+    assert tanks_g(np.array([0.0, 4.0]), u, P) == pytest.approx(4.3)
+    assert tanks_g(np.array([0.0, 9.9]), u, P) == 10.0
+
+
+def test_the_compiled_model_runs_as_its_python_original():
+    est = cascaded_tanks()
+    box = tanks_greybox(x0=[6.0, 5.0])
+    python = GreyBox(
+        box.parameters, f=tanks_f.py_func, g=tanks_g.py_func, n_states=2,
+        x0=[6.0, 5.0], substeps=box.substeps,
+    )  # fmt: skip
+    values = box.initial_values
+    y = box.simulate(values, est.u[:300], est.ts)
+    np.testing.assert_allclose(
+        y, python.simulate(values, est.u[:300], est.ts), rtol=1e-12, atol=1e-12
+    )
+    assert np.all(np.isfinite(y)) and np.max(y) <= 10.0
+
+
+def test_the_builder_and_a_saved_fit(tmp_path):
+    box = tanks_greybox()
+    assert box.names[: len(TANKS_PARAMETERS)] == tuple(TANKS_PARAMETERS)
+    assert box.names[-2:] == ("upper_level_0", "lower_level_0")
+    assert box.free.sum() == 10 and tanks_greybox(exponents=True).free.all()
+    with pytest.raises(ValueError, match="`x0`"):
+        tanks_greybox(x0="rest")
+    est = cascaded_tanks()
+    model = sid.identify(est, box, method="oe", polish_nfev=3)
+    path = tmp_path / "model.json"
+    path.write_text(json.dumps(model.to_dict()))
+    text = path.read_text()
+    assert "spiralid.datasets.tanks_model:tanks_f" in text
+    back = sid.sysid.load_model(path)
+    np.testing.assert_array_equal(back.simulate(est), model.simulate(est))
