@@ -707,50 +707,43 @@ class FlexibleManipulator:
         torque `u` from the state `x0v`, the modal states when asked for
         (else None), and the velocity scale of the modal states; with
         `n_modes`, of the model truncated to that many flexible modes."""
+        # With friction the run is sub-stepped (see spiralid.fms._friction):
+        # only the sub-step's model is needed. The filters' cutoff is
+        # relative to the Nyquist frequency: the same filter in Hz at the
+        # sub-step's rate.
+        m = self.friction_substeps if self.has_friction else 1
         Ad, Bd, C, D, scale = _discrete(
             self,
-            ts,
+            ts / m if m > 1 else ts,
             sensors.antialias_order,
-            sensors.antialias_cutoff,
+            sensors.antialias_cutoff / m if m > 1 else sensors.antialias_cutoff,
             sensors.deflection_at,
             sensors.acceleration_at,
             n_modes,
         )
-        n = scale.size
+        n, nq = scale.size, self.ndof
         phi = self._modal[1][:, :n]
         M = self.mass_matrix
         s0 = np.zeros(Ad.shape[0])
-        s0[:n] = phi.T @ (M @ x0v[:n])
-        s0[n : 2 * n] = (phi.T @ (M @ x0v[n:])) / scale
+        s0[:n] = phi.T @ (M @ x0v[:nq])
+        s0[n : 2 * n] = (phi.T @ (M @ x0v[nq:])) / scale
         if self.torque_limit is not None:
             u_applied = np.clip(u, -self.torque_limit, self.torque_limit)
         else:
             u_applied = u
         if self.has_friction:
-            y, s = self._simulate_friction(u_applied, s0, ts, sensors, n_modes)
+            y, s = self._simulate_friction(u_applied, s0, (Ad, Bd, C, D), n_modes)
             return y, (s if return_state else None), scale
         y, s = simulate_discrete(Ad, Bd, C, D, u_applied, s0, return_state)
         return y, s, scale
 
-    def _simulate_friction(
-        self, u, s0, ts: float, sensors: Sensors, n_modes: int | None = None
-    ):
+    def _simulate_friction(self, u, s0, sub_model, n_modes: int | None = None):
         """Outputs and states with hub friction, sub-stepped (see
-        :mod:`spiralid.fms._friction`)."""
+        :mod:`spiralid.fms._friction`); `sub_model` the exact ZOH ``(Ad,
+        Bd, C, D)`` of one sub-step."""
         from spiralid.fms._friction import simulate_friction
 
-        m = self.friction_substeps
-        # The filters' cutoff is relative to the Nyquist frequency: the same
-        # filter in Hz at the sub-step's rate.
-        Ad, Bd, C, D, _ = _discrete(
-            self,
-            ts / m,
-            sensors.antialias_order,
-            sensors.antialias_cutoff / m,
-            sensors.deflection_at,
-            sensors.acceleration_at,
-            n_modes,
-        )
+        Ad, Bd, C, D = sub_model
         cv = np.zeros(Ad.shape[0])
         plant_c = self._plant(n_modes=n_modes)[2]
         cv[: plant_c.shape[1]] = plant_c[1]
@@ -762,7 +755,7 @@ class FlexibleManipulator:
             cv,
             u,
             s0,
-            m,
+            self.friction_substeps,
             self.coulomb_friction,
             self.static_friction,
             self.stribeck_velocity,
