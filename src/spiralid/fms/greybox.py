@@ -29,35 +29,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from spiralid._checks import integer, one_of
+from spiralid.choices import RIG_PARAMETERS
 from spiralid.fms.rig import _OUTPUTS, FlexibleManipulator, _continuous, _discrete
 from spiralid.fms.sensors import Sensors
 from spiralid.sysid.models.greybox import GreyBox, Parameter
 
-__all__ = ["RIG_PARAMETERS", "RigGreyBox"]
+__all__ = ["RIG_PARAMETERS", "RigGreyBox", "default_parameter"]
 
-#: The fields a :class:`RigGreyBox` can free, with their units: the
-#: dataclass's physical fields and two of its properties,
-#: ``flexural_rigidity`` (E I, set through the Young's modulus) and
-#: ``mass_per_length`` (rho A, set through the density), the two numbers
-#: the finite elements read from the beam's material and cross-section.
-RIG_PARAMETERS: dict[str, str] = {
-    "length": "m",
-    "width": "m",
-    "thickness": "m",
-    "youngs_modulus": "Pa",
-    "density": "kg/m^3",
-    "flexural_rigidity": "N m^2",
-    "mass_per_length": "kg/m",
-    "hub_inertia": "kg m^2",
-    "payload_mass": "kg",
-    "payload_inertia": "kg m^2",
-    "damping_ratio": "",
-    "hub_friction": "N m s/rad",
-    "coulomb_friction": "N m",
-    "static_friction": "N m",
-    "stribeck_velocity": "rad/s",
-    "torque_limit": "N m",
-}
 # The derived parameters and the fields they are computed from: freeing one
 # with any of its fields would leave a direction the model cannot see.
 _DERIVED = {
@@ -65,7 +43,12 @@ _DERIVED = {
     "mass_per_length": ("density", "width", "thickness"),
 }
 # The fields that make the rig nonlinear (the friction step, the clip).
-_NONLINEAR = ("coulomb_friction", "static_friction", "stribeck_velocity", "torque_limit")
+_NONLINEAR = (
+    "coulomb_friction",
+    "static_friction",
+    "stribeck_velocity",
+    "torque_limit",
+)
 # Default bounds: a factor either side of the preset, on a log scale.
 _FACTOR = 4.0
 # The outputs read through no anti-aliasing filter: the encoder's count and
@@ -182,7 +165,9 @@ class RigGreyBox(GreyBox):
             )
         sensors = Sensors() if sensors is None else sensors
         if not isinstance(sensors, Sensors):
-            raise TypeError(f"`sensors` must be a Sensors; got {type(sensors).__name__}")
+            raise TypeError(
+                f"`sensors` must be a Sensors; got {type(sensors).__name__}"
+            )
         if isinstance(free, str) or not isinstance(free, Sequence) or not free:
             raise TypeError(
                 "`free` must be a non-empty list of field names or Parameters; "
