@@ -125,9 +125,11 @@ def test_default_bounds_are_a_factor_around_the_preset():
     assert zeta.bounds[1] < 1.0
     # flexural_rigidity and mass_per_length set E and rho: the rig's own
     # properties read them back.
-    values = [2.0, 0.01, 0.05]
-    moved = box.rig_at(values)
+    box = RigGreyBox([*box.names, "mass_per_length"], rig)
+    assert box.initial_values[-1] == pytest.approx(rig.density * rig.area)
+    moved = box.rig_at([2.0, 0.01, 0.05, 0.1])
     assert moved.flexural_rigidity == pytest.approx(2.0)
+    assert moved.density * moved.area == pytest.approx(0.1)
     assert moved.payload_mass == 0.01 and moved.damping_ratio == 0.05
 
 

@@ -57,9 +57,9 @@ _UNFILTERED = ("hub_angle", "tip_deflection")
 
 
 def _value(rig: FlexibleManipulator, name: str) -> float | None:
-    value = getattr(rig, name)
     if name == "mass_per_length":
-        value = rig.density * rig.area
+        return float(rig.density * rig.area)
+    value = getattr(rig, name)
     return None if value is None else float(value)
 
 
