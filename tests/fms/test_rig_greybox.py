@@ -167,3 +167,19 @@ def test_the_command_line_fits_the_rig(tmp_path):
     )  # fmt: skip
     assert out.returncode == 2 and "unknown field stiffness" in out.stderr
     assert not (tmp_path / "bad").exists()
+
+
+def test_a_point_outside_the_box_runs_at_its_projection():
+    # The paper's searches, as printed, may step outside the unit box: the
+    # rig is then run at the nearest point inside, never at a length of
+    # kilometres.
+    from spiralid.sysid.estimation.greybox.problem import GreyBoxProblem
+
+    rig = FlexibleManipulator(n_elements=4)
+    rec = record(rig, "hub_angle")
+    box = RigGreyBox(["length", "hub_inertia"], rig)
+    problem = GreyBoxProblem(rec, box)
+    values = problem.values([7.0, -3.0])
+    assert values[0] == pytest.approx(box.parameters[0].bounds[1])
+    assert values[1] == pytest.approx(box.parameters[1].bounds[0])
+    assert problem([7.0, -3.0]) == problem([1.0, 0.0])

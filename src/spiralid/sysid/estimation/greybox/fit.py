@@ -87,7 +87,8 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
             rng=given.get("rng"),
             x0=problem.z0,
         )
-        z = np.asarray(found.x, dtype=float)
+        # The point the cost evaluated (see GreyBoxProblem.values).
+        z = np.clip(np.asarray(found.x, dtype=float), 0.0, 1.0)
     if method in ("spiral", "oe"):
         polished = _polish(problem, z, polish_nfev)
         if problem(polished) <= problem(z):

@@ -97,9 +97,12 @@ class GreyBoxProblem:
         return np.where(self.log, np.exp(c), c)
 
     def values(self, z) -> np.ndarray:
-        """Every parameter's value at `z` (fixed ones at their value)."""
+        """Every parameter's value at `z` projected into the box (fixed ones
+        at their value): a search that steps outside the bounds (the
+        paper's rules, as printed, do not keep to them) evaluates the
+        nearest point inside, so no parameter ever leaves its bounds."""
         out = self.structure.initial_values
-        out[self.free] = self.free_values(z)
+        out[self.free] = self.free_values(np.clip(z, 0.0, 1.0))
         return out
 
     @property
