@@ -183,3 +183,21 @@ def test_a_point_outside_the_box_runs_at_its_projection():
     assert values[0] == pytest.approx(box.parameters[0].bounds[1])
     assert values[1] == pytest.approx(box.parameters[1].bounds[0])
     assert problem([7.0, -3.0]) == problem([1.0, 0.0])
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--method", "ls"], "--method ls does not fit --model rig: spiral, oe"),
+        (["--method", "oe", "--points", "7"], "--points does not apply to --method oe"),
+        (["--na", "4"], "--na applies to --model arx, narx and polynomial"),
+    ],
+)
+def test_the_command_refuses_what_the_rig_cannot_take(extra, message):
+    from spiralid.cli import build_parser
+    from spiralid.cli.errors import UsageError
+    from spiralid.cli.identify import _check_options
+
+    argv = ["identify", "r.csv", "--model", "rig", "--free", "hub_inertia", *extra]
+    with pytest.raises(UsageError, match=message):
+        _check_options(build_parser().parse_args(argv))
