@@ -201,3 +201,17 @@ def test_the_command_refuses_what_the_rig_cannot_take(extra, message):
     argv = ["identify", "r.csv", "--model", "rig", "--free", "hub_inertia", *extra]
     with pytest.raises(UsageError, match=message):
         _check_options(build_parser().parse_args(argv))
+
+
+def test_the_command_says_where_the_sensor_came_from():
+    from argparse import Namespace
+
+    from spiralid.cli.errors import UsageError
+    from spiralid.cli.rig import _structure
+
+    args = Namespace(free=["hub_inertia"], rig="default", sensor=None, modes=None)
+    data = sid.IOData(np.zeros(10), np.zeros(10), ts=0.01)  # its output is "y"
+    with pytest.raises(UsageError, match=r"got 'y' \(the record's output name; set"):
+        _structure(args, data)
+    args.sensor = "end_acceleration"
+    assert _structure(args, data).output == "end_acceleration"

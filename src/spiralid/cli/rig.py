@@ -81,7 +81,12 @@ def _structure(args, data):
     try:
         return RigGreyBox(args.free, rig, output=sensor, n_modes=args.modes)
     except (TypeError, ValueError) as error:
-        raise UsageError(f"--model rig: {error}") from None
+        # The sensor defaults to the record's output name, which the
+        # message would otherwise leave unexplained.
+        hint = ""
+        if args.sensor is None and "`output`" in str(error):
+            hint = " (the record's output name; set --sensor)"
+        raise UsageError(f"--model rig: {error}{hint}") from None
 
 
 def run_rig(args, options: dict, write_model, validated, write_timings) -> int:

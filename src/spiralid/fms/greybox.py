@@ -317,13 +317,13 @@ class RigGreyBox(GreyBox):
         values : array_like
             Every parameter's value, in order.
         n : int, default 4
-            Modes listed (at most ``2 n_elements``).
+            Modes listed (fewer where the rig has fewer, ``2 n_elements``).
 
         Returns
         -------
         str
         """
-        n = integer(n, "n", 1)
+        n = min(integer(n, "n", 1), 2 * self.rig.n_elements)
         fitted = self.rig_at(values)
         rows = ["mode  FEM preset Hz  fitted Hz  fitted damping"]
         for k, (f0, f1) in enumerate(
