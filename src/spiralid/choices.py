@@ -19,6 +19,7 @@ __all__ = [
     "OBJECTIVES",
     "PARAMETRIZATION_NAMES",
     "PARETO_METHOD_NAMES",
+    "RIG_PARAMETERS",
     "RULE_NAMES",
     "require_names",
 ]
@@ -52,6 +53,31 @@ OBJECTIVES: dict[str, str] = {
     "frequency": "frequency-response error (dB, coherence-weighted RMS)",
     "one-step": "one-step cost, eq. (2) (% of rms(y))",
     "order": "parameters na + nb",
+}
+
+# The fields of the flexible manipulator a rig grey box can free
+# (spiralid.fms.greybox.RigGreyBox, `spiralid identify --model rig --free`),
+# with their units: the dataclass's physical fields and two of its
+# properties, flexural_rigidity (E I, set through the Young's modulus) and
+# mass_per_length (rho A, set through the density), the two numbers the
+# finite elements read from the beam's material and cross-section.
+RIG_PARAMETERS: dict[str, str] = {
+    "length": "m",
+    "width": "m",
+    "thickness": "m",
+    "youngs_modulus": "Pa",
+    "density": "kg/m^3",
+    "flexural_rigidity": "N m^2",
+    "mass_per_length": "kg/m",
+    "hub_inertia": "kg m^2",
+    "payload_mass": "kg",
+    "payload_inertia": "kg m^2",
+    "damping_ratio": "",
+    "hub_friction": "N m s/rad",
+    "coulomb_friction": "N m",
+    "static_friction": "N m",
+    "stribeck_velocity": "rad/s",
+    "torque_limit": "N m",
 }
 
 

@@ -33,6 +33,7 @@ from .options import (
     _refuse_unused,
     _save_figures,
 )
+from .rig import RIG_FLAGS, add_rig_options, run_rig
 
 
 def _structure(args):
@@ -440,6 +441,7 @@ _MODEL_FLAGS = {
     "--activation": ("narx",),
     "--degree": ("polynomial",),
     "--terms": ("polynomial",),
+    **dict.fromkeys(RIG_FLAGS, ("rig",)),
 }
 
 
@@ -447,6 +449,10 @@ def _example_structure(model: str):
     """A structure of the kind --model asks for (its options' table)."""
     from spiralid.sysid import ARX, NARX, PolynomialNARX
 
+    if model == "rig":
+        from spiralid.fms.greybox import RigGreyBox
+
+        return RigGreyBox(["hub_inertia"])
     kinds = {"arx": ARX, "narx": NARX, "polynomial": PolynomialNARX}
     return kinds[model](1, 1, 0)
 
@@ -530,7 +536,15 @@ def _check_options(args) -> None:
 
     model, method = args.model, args.method
     _check_candidates(args)
-    if model != "arx" and ("narx", method) not in ESTIMATORS:
+    if model == "rig":
+        if ("greybox", method) not in ESTIMATORS:
+            able = ", ".join(methods_of("greybox"))
+            raise UsageError(f"--method {method} does not fit --model rig: {able}")
+        _refuse_unused(
+            _given(args, "--na", "--nb", "--nk"),
+            "to --model arx, narx and polynomial, not to --model rig",
+        )
+    elif model != "arx" and ("narx", method) not in ESTIMATORS:
         able = ", ".join(methods_of("narx"))
         raise UsageError(f"--method {method} does not train NARX models: {able}")
     if model == "polynomial" and method != "ls":
@@ -561,6 +575,9 @@ def run(args, argv: list[str]) -> int:
     from spiralid.sysid.validation.plots import plot_convergence
 
     _check_options(args)
+    if args.model == "rig":
+        options = _identify_options(args, _example_structure("rig"))
+        return run_rig(args, options, _write_model, _validated, _write_timings)
     if args.model != "arx":
         return _run_narx(args)
     with _progress(args) as progress:
@@ -622,11 +639,13 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
     """--model, and the options of the NARX families."""
     p.add_argument(
         "--model",
-        choices=["arx", "narx", "polynomial"],
+        choices=["arx", "narx", "polynomial", "rig"],
         default="arx",
         help="ARX, NARX with a one-hidden-layer perceptron (--na past outputs, "
-        "--nb past inputs) or polynomial NARX by forward-regression OLS",
+        "--nb past inputs), polynomial NARX by forward-regression OLS, or the "
+        "flexible manipulator's physical parameters (--free)",
     )
+    add_rig_options(p)
     p.add_argument(
         "--hidden",
         type=_orders,

@@ -3,6 +3,8 @@
 The physical rig of the paper is not available, so :class:`FlexibleManipulator`
 simulates it from physics (hub + Euler-Bernoulli beam + payload, exact
 zero-order-hold sampling, encoder/tachometer/accelerometer models).
+:class:`RigGreyBox` (:mod:`spiralid.fms.greybox`) is the rig as a grey box
+whose physical parameters :func:`spiralid.sysid.identify` fits to a record.
 """
 
 from spiralid.fms.experiment import Experiment, paper_experiment
@@ -14,6 +16,7 @@ __all__ = [
     "Experiment",
     "FlexibleManipulator",
     "Recording",
+    "RigGreyBox",
     "Sensors",
     "bang_bang",
     "chirp",
@@ -22,3 +25,13 @@ __all__ = [
     "paper_experiment",
     "prbs",
 ]
+
+
+def __getattr__(name: str):
+    # The grey box builds on spiralid.sysid: loaded on first use, so that
+    # the simulator alone stays as light to import as before.
+    if name == "RigGreyBox":
+        from spiralid.fms.greybox import RigGreyBox
+
+        return RigGreyBox
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -564,6 +564,7 @@ class FlexibleManipulator:
         self,
         deflection_at: tuple[float, ...] = (),
         acceleration_at: tuple[float, ...] = (),
+        n_modes: int | None = None,
     ) -> tuple[np.ndarray, ...]:
         """Continuous model in modal coordinates, scaled for the exponential.
 
@@ -573,10 +574,14 @@ class FlexibleManipulator:
         Returns ``A, B`` and output rows ``(C, D)`` for hub angle, hub
         velocity, end-point acceleration and tip deflection, then the
         deflection at each of `deflection_at` and the acceleration at each
-        of `acceleration_at`, plus the velocity scaling.
+        of `acceleration_at`, plus the velocity scaling. With `n_modes`, only
+        the rigid mode and the first `n_modes` flexible ones are kept (a
+        modal truncation: the grey box's reduced model).
         """
         omega, phi = self._modal
-        n = self.ndof
+        if n_modes is not None:
+            omega, phi = omega[: n_modes + 1], phi[:, : n_modes + 1]
+        n = omega.size
         scale = omega.copy()
         scale[0] = 1.0
         g = phi[0]  # hub torque's modal participation
@@ -588,7 +593,7 @@ class FlexibleManipulator:
         A[n:, :n] = -np.diag(omega**2 / scale)
         A[n:, n:] = -(cm * scale[None, :]) / scale[:, None]
         B = np.concatenate([np.zeros(n), g / scale])
-        tip = phi[n - 2]
+        tip = phi[self.ndof - 2]
         h = self.length * phi[0] + tip  # end point's share of each mode
         nd = len(deflection_at)
         C = np.zeros((4 + nd + len(acceleration_at), 2 * n))
@@ -689,52 +694,58 @@ class FlexibleManipulator:
             state = np.hstack([s[:, :n] @ phi.T, (s[:, n : 2 * n] * scale) @ phi.T])
         return _recording(u, y, ts, sensors, gen, state)
 
-    def _outputs(self, u, x0v, ts: float, sensors: Sensors, return_state: bool):
+    def _outputs(
+        self,
+        u,
+        x0v,
+        ts: float,
+        sensors: Sensors,
+        return_state: bool,
+        n_modes: int | None = None,
+    ):
         """The exact sensor outputs (before noise and quantisation) for the
         torque `u` from the state `x0v`, the modal states when asked for
-        (else None), and the velocity scale of the modal states."""
-        n = self.ndof
+        (else None), and the velocity scale of the modal states; with
+        `n_modes`, of the model truncated to that many flexible modes."""
+        # With friction the run is sub-stepped (see spiralid.fms._friction):
+        # only the sub-step's model is needed. The filters' cutoff is
+        # relative to the Nyquist frequency: the same filter in Hz at the
+        # sub-step's rate.
+        m = self.friction_substeps if self.has_friction else 1
         Ad, Bd, C, D, scale = _discrete(
             self,
-            ts,
+            ts / m if m > 1 else ts,
             sensors.antialias_order,
-            sensors.antialias_cutoff,
+            sensors.antialias_cutoff / m if m > 1 else sensors.antialias_cutoff,
             sensors.deflection_at,
             sensors.acceleration_at,
+            n_modes,
         )
-        _, phi = self._modal
+        n, nq = scale.size, self.ndof
+        phi = self._modal[1][:, :n]
         M = self.mass_matrix
         s0 = np.zeros(Ad.shape[0])
-        s0[:n] = phi.T @ (M @ x0v[:n])
-        s0[n : 2 * n] = (phi.T @ (M @ x0v[n:])) / scale
+        s0[:n] = phi.T @ (M @ x0v[:nq])
+        s0[n : 2 * n] = (phi.T @ (M @ x0v[nq:])) / scale
         if self.torque_limit is not None:
             u_applied = np.clip(u, -self.torque_limit, self.torque_limit)
         else:
             u_applied = u
         if self.has_friction:
-            y, s = self._simulate_friction(u_applied, s0, ts, sensors)
+            y, s = self._simulate_friction(u_applied, s0, (Ad, Bd, C, D), n_modes)
             return y, (s if return_state else None), scale
         y, s = simulate_discrete(Ad, Bd, C, D, u_applied, s0, return_state)
         return y, s, scale
 
-    def _simulate_friction(self, u, s0, ts: float, sensors: Sensors):
+    def _simulate_friction(self, u, s0, sub_model, n_modes: int | None = None):
         """Outputs and states with hub friction, sub-stepped (see
-        :mod:`spiralid.fms._friction`)."""
+        :mod:`spiralid.fms._friction`); `sub_model` the exact ZOH ``(Ad,
+        Bd, C, D)`` of one sub-step."""
         from spiralid.fms._friction import simulate_friction
 
-        m = self.friction_substeps
-        # The filters' cutoff is relative to the Nyquist frequency: the same
-        # filter in Hz at the sub-step's rate.
-        Ad, Bd, C, D, _ = _discrete(
-            self,
-            ts / m,
-            sensors.antialias_order,
-            sensors.antialias_cutoff / m,
-            sensors.deflection_at,
-            sensors.acceleration_at,
-        )
+        Ad, Bd, C, D = sub_model
         cv = np.zeros(Ad.shape[0])
-        plant_c = self._plant()[2]
+        plant_c = self._plant(n_modes=n_modes)[2]
         cv[: plant_c.shape[1]] = plant_c[1]
         return simulate_friction(
             Ad,
@@ -744,7 +755,7 @@ class FlexibleManipulator:
             cv,
             u,
             s0,
-            m,
+            self.friction_substeps,
             self.coulomb_friction,
             self.static_friction,
             self.stribeck_velocity,
@@ -861,10 +872,33 @@ def _discrete(
     cutoff: float,
     deflection_at: tuple[float, ...] = (),
     acceleration_at: tuple[float, ...] = (),
+    n_modes: int | None = None,
 ) -> tuple[np.ndarray, ...]:
     """Exact ZOH model of the rig plus anti-aliasing filters (cached); the
     sensors along the beam are outputs after the four channels."""
-    A, B, C, D, scale = rig._plant(deflection_at, acceleration_at)
+    A, B, C, D, scale = _continuous(
+        rig, ts, order, cutoff, deflection_at, acceleration_at, n_modes
+    )
+    Ad, Bd = discretise_zoh(A, B, ts)
+    for arr in (Ad, Bd, C, D, scale):
+        arr.flags.writeable = False
+    return Ad, Bd, C, D, scale
+
+
+def _continuous(
+    rig: FlexibleManipulator,
+    ts: float,
+    order: int,
+    cutoff: float,
+    deflection_at: tuple[float, ...] = (),
+    acceleration_at: tuple[float, ...] = (),
+    n_modes: int | None = None,
+) -> tuple[np.ndarray, ...]:
+    """The continuous model :func:`_discrete` samples: the rig's plant
+    (`n_modes` flexible modes, all by default) with an anti-aliasing filter
+    of `order` in front of each analogue channel (`cutoff` a fraction of
+    the Nyquist frequency of `ts`)."""
+    A, B, C, D, scale = rig._plant(deflection_at, acceleration_at, n_modes)
     if order > 0:
         af, bf, cf = butterworth_ss(order, cutoff * 0.5 / ts)
         npl = A.shape[0]
@@ -890,7 +924,4 @@ def _discrete(
             cc[row, sl] = cf
             dd[row] = 0.0
         A, B, C, D = big, bb, cc, dd
-    Ad, Bd = discretise_zoh(A, B, ts)
-    for arr in (Ad, Bd, C, D, scale):
-        arr.flags.writeable = False
-    return Ad, Bd, C, D, scale
+    return A, B, C, D, scale

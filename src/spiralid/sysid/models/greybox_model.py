@@ -15,7 +15,7 @@ import numpy as np
 from scipy import signal
 
 from ..data import IOData
-from .greybox import GreyBox
+from .greybox import GreyBox, _import
 from .modes import ModeTable, mode_table
 from .polynomials import is_stable_polynomial
 
@@ -28,6 +28,16 @@ _RECORD = ("input_name", "input_unit", "output_unit", "u_offset", "y_offset")
 
 def _inputs(u) -> np.ndarray:
     return np.asarray(u.u if isinstance(u, IOData) else u, dtype=float)
+
+
+def _structure_from_dict(d: dict) -> GreyBox:
+    """The structure a model file holds: a :class:`GreyBox`, or a class of
+    its own named by import path (the rig's, which lives in ``fms``: the
+    path keeps ``sysid`` from importing it)."""
+    kind = _import(d["class"]) if "class" in d else GreyBox
+    if not (isinstance(kind, type) and issubclass(kind, GreyBox)):
+        raise ValueError(f"grey-box model file: {d['class']!r} is not a GreyBox")
+    return kind.from_dict(d)
 
 
 @dataclass
@@ -185,7 +195,7 @@ class GreyBoxModel:
         if not isinstance(d, dict) or d.get("model") != "greybox":
             raise ValueError("a grey-box model file must have 'model': 'greybox'")
         try:
-            structure = GreyBox.from_dict(d["structure"])
+            structure = _structure_from_dict(d["structure"])
             kind = LinearGreyBoxModel if structure.kind == "linear" else GreyBoxModel
             return kind(
                 structure=structure,

@@ -1,0 +1,377 @@
+"""The rig as a ready grey box: :class:`RigGreyBox`, any subset of
+:class:`~spiralid.fms.rig.FlexibleManipulator`'s physical fields free,
+fitted by :func:`spiralid.sysid.identify` to a record of one of its
+sensors.
+
+Every evaluation builds the rig at the parameter values and runs the rig's
+own sampled simulation (``FlexibleManipulator._outputs``): the exact
+zero-order hold of the finite-element model for the linear rig, the
+implicit stick-slip step of :mod:`spiralid.fms._friction` with hub
+friction on, the amplifier's clip with a torque limit. Nothing of the
+physics is restated here, so the grey box and the simulator that made a
+record cannot drift apart.
+
+``n_modes`` keeps the rigid mode and the first ``n_modes`` flexible ones
+(modal truncation): fewer states, so faster runs (the stick-slip step's
+cost grows with the square of the state count), at the price of the
+higher modes' share of the output.
+
+This module is the one place where ``fms`` builds on ``sysid`` (the grey-box
+family); ``sysid`` never imports ``fms``: a saved model names this class by
+its import path, which :func:`spiralid.sysid.load_model` follows.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+
+import numpy as np
+
+from spiralid._checks import integer, one_of
+from spiralid.choices import RIG_PARAMETERS
+from spiralid.fms.rig import _OUTPUTS, FlexibleManipulator, _continuous, _discrete
+from spiralid.fms.sensors import Sensors
+from spiralid.sysid.models.greybox import GreyBox, Parameter
+
+__all__ = ["RIG_PARAMETERS", "RigGreyBox", "default_parameter"]
+
+# The derived parameters and the fields they are computed from: freeing one
+# with any of its fields would leave a direction the model cannot see.
+_DERIVED = {
+    "flexural_rigidity": ("youngs_modulus", "width", "thickness"),
+    "mass_per_length": ("density", "width", "thickness"),
+}
+# The fields that make the rig nonlinear (the friction step, the clip).
+_NONLINEAR = (
+    "coulomb_friction",
+    "static_friction",
+    "stribeck_velocity",
+    "torque_limit",
+)
+# Default bounds: a factor either side of the preset, on a log scale.
+_FACTOR = 4.0
+# The outputs read through no anti-aliasing filter: the encoder's count and
+# the exact deflections.
+_UNFILTERED = ("hub_angle", "tip_deflection")
+
+
+def _value(rig: FlexibleManipulator, name: str) -> float | None:
+    if name == "mass_per_length":
+        return float(rig.density * rig.area)
+    value = getattr(rig, name)
+    return None if value is None else float(value)
+
+
+def _zero_preset_high(rig: FlexibleManipulator, name: str) -> float:
+    """The upper bound of a field whose preset is zero (our choice, a
+    scale of the rig): a payload up to the beam's mass or its inertia about
+    the hub, friction torques up to 0.1 N m (a third of the paper's
+    pulses) and a viscous friction that would stop the rigid rig in 0.1 s."""
+    beam_mass = rig.density * rig.area * rig.length
+    return {
+        "payload_mass": beam_mass,
+        "payload_inertia": beam_mass * rig.length**2 / 3.0,
+        "coulomb_friction": 0.1,
+        "static_friction": 0.1,
+        "hub_friction": 10.0 * rig.total_inertia,
+    }[name]
+
+
+def default_parameter(rig: FlexibleManipulator, name: str) -> Parameter:
+    """The free parameter `name` (a key of :data:`RIG_PARAMETERS`) at its
+    value on `rig`: bounds a factor 4 either side on a log scale, or from
+    zero up to a scale of the rig where the preset is zero.
+
+    Parameters
+    ----------
+    rig : FlexibleManipulator
+        The rig whose value starts the parameter.
+    name : str
+        The field.
+
+    Returns
+    -------
+    Parameter
+    """
+    one_of(name, "free", RIG_PARAMETERS)
+    unit = RIG_PARAMETERS[name]
+    value = _value(rig, name)
+    if value is None:
+        raise ValueError(
+            f"`free`: {name} is None on the rig (no limit): give it as a "
+            "Parameter with a value and bounds"
+        )
+    if value > 0.0:
+        high = value * _FACTOR
+        if name == "damping_ratio":
+            high = min(high, 0.95)  # the field must stay below 1
+        return Parameter(name, value, (value / _FACTOR, high), unit)
+    return Parameter(name, 0.0, (0.0, _zero_preset_high(rig, name)), unit)
+
+
+class RigGreyBox(GreyBox):
+    """The flexible manipulator as a grey box: the fields named in `free`
+    estimated, the others held at `rig`'s values.
+
+    Parameters
+    ----------
+    free : sequence of str or Parameter
+        The fields to estimate, each a key of :data:`RIG_PARAMETERS`; a name
+        takes :func:`default_parameter`'s value and bounds, a
+        :class:`~spiralid.sysid.Parameter` of such a name its own (and with
+        ``free=False`` just sets the field).
+    rig : FlexibleManipulator, optional
+        The rig whose other fields are held and whose values start the
+        free ones; default ``FlexibleManipulator()``.
+    output : str, default "hub_angle"
+        The sensor the record holds: ``"hub_angle"``, ``"hub_velocity"``,
+        ``"end_acceleration"``, ``"tip_deflection"``, or one of `sensors`'
+        positional outputs (``deflection_<x>``, ``acceleration_<x>``).
+    n_modes : int, optional
+        Keep the rigid mode and this many flexible modes (default all
+        ``2 n_elements``).
+    sensors : Sensors, optional
+        The instruments (their anti-aliasing filter is part of the model of
+        a filtered channel; noise and quantisation are not); default
+        ``Sensors()``, the rig's.
+
+    Attributes
+    ----------
+    kind : str
+        ``"nonlinear"`` when friction or a torque limit is on or free, else
+        ``"linear"`` (the fit then has poles and modes).
+
+    Examples
+    --------
+    >>> box = RigGreyBox(["flexural_rigidity", "hub_inertia"], n_modes=3)
+    >>> box.kind, box.names, box.n_states
+    ('linear', ('flexural_rigidity', 'hub_inertia'), 8)
+    """
+
+    def __init__(
+        self,
+        free: Sequence[str | Parameter],
+        rig: FlexibleManipulator | None = None,
+        *,
+        output: str = "hub_angle",
+        n_modes: int | None = None,
+        sensors: Sensors | None = None,
+    ) -> None:
+        rig = FlexibleManipulator() if rig is None else rig
+        if not isinstance(rig, FlexibleManipulator):
+            raise TypeError(
+                f"`rig` must be a FlexibleManipulator; got {type(rig).__name__}"
+            )
+        sensors = Sensors() if sensors is None else sensors
+        if not isinstance(sensors, Sensors):
+            raise TypeError(
+                f"`sensors` must be a Sensors; got {type(sensors).__name__}"
+            )
+        if isinstance(free, str) or not isinstance(free, Sequence) or not free:
+            raise TypeError(
+                "`free` must be a non-empty list of field names or Parameters; "
+                f"got {free!r}"
+            )
+        self.parameters = tuple(self._parameter(rig, p) for p in free)
+        names = [p.name for p in self.parameters]
+        if len(set(names)) != len(names):
+            raise ValueError(f"`free` names a field more than once: {names}")
+        for derived, parts in _DERIVED.items():
+            clash = [n for n in parts if n in names]
+            if derived in names and clash:
+                raise ValueError(
+                    f"`free`: {derived} is computed from {', '.join(clash)}; free "
+                    "one or the other"
+                )
+        self.rig, self.sensors = rig, sensors
+        self.output = one_of(output, "output", _OUTPUTS + sensors.positional_names)
+        self._row = (_OUTPUTS + sensors.positional_names).index(self.output)
+        if n_modes is not None:
+            n_modes = integer(n_modes, "n_modes", 1)
+            if n_modes > 2 * rig.n_elements:
+                raise ValueError(
+                    f"`n_modes` must be at most 2 n_elements = {2 * rig.n_elements}; "
+                    f"got {n_modes}"
+                )
+        self.n_modes = n_modes
+        # The encoder and the deflections pass no filter: the model runs
+        # without the other channels' filter states.
+        unfiltered = self.output in _UNFILTERED or self.output.startswith("defl")
+        self._sim_sensors = (
+            dataclasses.replace(sensors, antialias_order=0) if unfiltered else sensors
+        )
+        nonlinear = rig.has_friction or rig.torque_limit is not None
+        self.kind = (
+            "nonlinear" if nonlinear or set(names) & set(_NONLINEAR) else "linear"
+        )
+        self.functions = {}
+        self.substeps = rig.friction_substeps
+        self.n_inputs, self.n_outputs = 1, 1
+        self.state_parameters = ()
+        a = self.matrices(self.initial_values, 1.0)[0]
+        self.n_states = a.shape[0]
+        # The record starts at rest, as the rig's simulate does.
+        self._x0_given = self._initial_state(None)
+
+    @staticmethod
+    def _parameter(rig: FlexibleManipulator, p) -> Parameter:
+        if isinstance(p, Parameter):
+            one_of(p.name, "free", RIG_PARAMETERS)
+            return p
+        if not isinstance(p, str):
+            raise TypeError(
+                f"`free` holds field names or Parameters; got {type(p).__name__}"
+            )
+        return default_parameter(rig, p)
+
+    # -- the rig at a parameter vector ------------------------------------------
+
+    def rig_at(self, values) -> FlexibleManipulator:
+        """The rig with the parameters at `values` (every parameter of this
+        structure, in order); a ValueError when they make no rig."""
+        fields, derived = {}, {}
+        for p, v in zip(self.parameters, np.asarray(values, dtype=float), strict=True):
+            (derived if p.name in _DERIVED else fields)[p.name] = float(v)
+        rig = dataclasses.replace(self.rig, **fields)
+        if "flexural_rigidity" in derived:
+            second_moment = rig.width * rig.thickness**3 / 12.0
+            derived["youngs_modulus"] = derived.pop("flexural_rigidity") / second_moment
+        if "mass_per_length" in derived:
+            derived["density"] = derived.pop("mass_per_length") / rig.area
+        return dataclasses.replace(rig, **derived) if derived else rig
+
+    def matrices(self, values, ts: float = 1.0) -> tuple[np.ndarray, ...]:
+        """``(A, B, C, D)`` of the linear rig at `values` (friction and the
+        torque limit left out) for the output, with its anti-aliasing filter
+        for a sample time `ts` (the filter's cut-off is a share of the
+        Nyquist frequency)."""
+        s = self._sim_sensors
+        a, b, c, d, _ = _continuous(
+            self.rig_at(values),
+            float(ts),
+            s.antialias_order,
+            s.antialias_cutoff,
+            s.deflection_at,
+            s.acceleration_at,
+            self.n_modes,
+        )
+        row = slice(self._row, self._row + 1)
+        return a, b[:, None], c[row], d[row][:, None]
+
+    def discretise(self, values, ts: float) -> tuple[np.ndarray, ...]:
+        """The linear rig's exact zero-order hold ``(Ad, Bd, C, D)`` at
+        sample time `ts` for the output."""
+        s = self._sim_sensors
+        ad, bd, c, d, _ = _discrete(
+            self.rig_at(values),
+            float(ts),
+            s.antialias_order,
+            s.antialias_cutoff,
+            s.deflection_at,
+            s.acceleration_at,
+            self.n_modes,
+        )
+        row = slice(self._row, self._row + 1)
+        return (
+            np.array(ad),
+            np.array(bd)[:, None],
+            np.array(c[row]),
+            np.array(d[row])[:, None],
+        )
+
+    def simulate(self, values, u, ts: float) -> np.ndarray:
+        """The output, shape (N,), over the torque `u` from rest, by the
+        rig's own sampled simulation; NaN when the values make no rig or
+        the run leaves the floating-point range (the fit's penalty)."""
+        uu = np.asarray(u, dtype=float).reshape(len(u), -1)
+        if uu.shape[1] != 1:
+            raise ValueError(f"`u` must have 1 input column; got {uu.shape[1]}")
+        nan = np.full(uu.shape[0], np.nan)
+        try:
+            rig = self.rig_at(values)
+        except (TypeError, ValueError):
+            return nan
+        with np.errstate(all="ignore"):
+            try:
+                y, _, _ = rig._outputs(
+                    uu[:, 0],
+                    np.zeros(2 * rig.ndof),
+                    float(ts),
+                    self._sim_sensors,
+                    False,
+                    self.n_modes,
+                )
+            except (ValueError, np.linalg.LinAlgError):
+                return nan
+        return np.asarray(y[:, self._row], dtype=float)
+
+    # -- the modes beside the FEM's ----------------------------------------------
+
+    def modes_beside(self, values, n: int = 4) -> str:
+        """A table of the first `n` flexible modes (Hz) of the rig at
+        `values` beside those of `rig` (the finite-element model at its
+        preset), with the modal damping ratio of each.
+
+        Parameters
+        ----------
+        values : array_like
+            Every parameter's value, in order.
+        n : int, default 4
+            Modes listed (fewer where the rig has fewer, ``2 n_elements``).
+
+        Returns
+        -------
+        str
+        """
+        n = min(integer(n, "n", 1), 2 * self.rig.n_elements)
+        fitted = self.rig_at(values)
+        rows = ["mode  FEM preset Hz  fitted Hz  fitted damping"]
+        for k, (f0, f1) in enumerate(
+            zip(self.rig.modes(n), fitted.modes(n), strict=True), 1
+        ):
+            rows.append(f"{k:>4}  {f0:13.2f}  {f1:9.2f}  {fitted.damping_ratio:14.4f}")
+        return "\n".join(rows)
+
+    # -- text and JSON ----------------------------------------------------------
+
+    def function_paths(self) -> dict[str, str]:
+        """None: the rig's simulation is this class's own (model.json names
+        the class)."""
+        return {}
+
+    def to_dict(self) -> dict:
+        """The JSON form: this class's import path, the held rig, the
+        parameters, the output, the truncation and the sensors."""
+        return {
+            "class": f"{type(self).__module__}:{type(self).__qualname__}",
+            "kind": self.kind,
+            "rig": dataclasses.asdict(self.rig),
+            "parameters": [p.to_dict() for p in self.parameters],
+            "output": self.output,
+            "n_modes": self.n_modes,
+            "sensors": dataclasses.asdict(self.sensors),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> RigGreyBox:
+        """The structure :meth:`to_dict` wrote."""
+        sensors = {
+            k: tuple(v) if isinstance(v, list) else v for k, v in d["sensors"].items()
+        }
+        return cls(
+            [Parameter(**p) for p in d["parameters"]],
+            FlexibleManipulator(**d["rig"]),
+            output=d["output"],
+            n_modes=d.get("n_modes"),
+            sensors=Sensors(**sensors),
+        )
+
+    def __repr__(self) -> str:
+        modes = "all" if self.n_modes is None else self.n_modes
+        return (
+            f"RigGreyBox({self.kind}, {self.output}, modes {modes}; "
+            f"{', '.join(self.names)})"
+        )
+
+    __str__ = __repr__
