@@ -50,7 +50,7 @@ def subspace_denominator(
     Parameters
     ----------
     data : IOData
-        One input and one or several outputs.
+        One or several inputs and one or several outputs.
     n : int
         The model order (number of poles).
     horizon : int, optional
@@ -82,14 +82,15 @@ def subspace_denominator(
         raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     n = integer(n, "n", 1)
     i = max(2 * n, n + 1) if horizon is None else integer(horizon, "horizon", n + 1)
-    u = data.u[:, None]
+    u = data.inputs
     y = data.outputs
     p = y.shape[1]
+    channels = p + u.shape[1]
     cols = data.n - 2 * i + 1
-    if cols < 2 * i * (p + 1):
+    if cols < 2 * i * channels:
         raise ValueError(
-            f"`n` = {n} needs a longer record: {2 * i * (p + 1) + 2 * i - 1} samples "
-            f"for horizon {i}; got {data.n}"
+            f"`n` = {n} needs a longer record: {2 * i * channels + 2 * i - 1} "
+            f"samples for horizon {i}; got {data.n}"
         )
     uh, yh = _hankel(u, 2 * i, cols), _hankel(y, 2 * i, cols)
     up, uf = uh[:i], uh[i:]
