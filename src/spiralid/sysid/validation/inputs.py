@@ -9,8 +9,10 @@ does not assume one input: the fits, RMS errors, error ranges and cost of
 the free run and of the one-step prediction, both spectra and their peaks,
 and the whiteness of the simulation error (which an output-error model
 does not promise: reported, as for one input, as not applicable). The test
-of independence from the input is left out (``independence`` None): it
-is defined for one input.
+of independence from the input is made against each input and the least
+independent kept (the smallest p-value: an output-error model promises
+independence from every input). The zeros and the realisation tests are
+left out (empty, None): each pair ``B_ij / A`` has its own.
 """
 
 from __future__ import annotations
@@ -18,8 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..data import IOData
-from ..spectra import find_resonances, psd
-from .correlation import whiteness_test
+from ..spectra import find_resonances, modes_from_poles, psd
+from .correlation import independence_test, whiteness_test
 from .fit import fit_percent, rmse
 from .outputs import check_output_records, joint_fit
 from .result import Validation
@@ -65,8 +67,8 @@ def validate_inputs(model, data, warmup, label, options: dict) -> Validation:
     label : str or None
         The validation's label (default the model's method).
     options : dict
-        ``validate``'s options; ``lags``, ``levels``, ``n_peaks`` and
-        ``nperseg`` apply.
+        ``validate``'s options; ``lags``, ``levels``, ``n_peaks``,
+        ``nperseg`` and ``max_damping`` apply.
     """
     check_output_records(model, data, warmup)
     _check_inputs(model, data, "data")
@@ -98,10 +100,18 @@ def validate_inputs(model, data, warmup, label, options: dict) -> Validation:
             error_range_one_step=(float(e_pred.min()), float(e_pred.max())),
             residuals="simulation",
             whiteness=whiteness_test(e_sim, lags, levels),
+            independence=min(
+                (independence_test(u, e_sim, lags, levels) for u in data.inputs.T),
+                key=lambda test: test.p_value,
+            ),
             psd_measured=spec_y,
             psd_model=spec_m,
             peaks_measured=find_resonances(spec_y, options["n_peaks"]),
             peaks_model=find_resonances(spec_m, options["n_peaks"]),
+            modes=modes_from_poles(
+                model.poles, one.ts, max_damping=options["max_damping"]
+            ),
+            zeros=np.zeros(0, complex),
             stable=model.is_stable,
             max_pole_radius=model.max_pole_radius,
             poles=model.poles,
