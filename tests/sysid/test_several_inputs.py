@@ -226,3 +226,30 @@ def test_validation_of_two_inputs_fits_each_output_from_both():
     assert v.fit_percent > 95 and "joint fit" in str(v)
     with pytest.raises(ValueError, match="`data` must hold the model's 2 inputs"):
         validate(fit, val.input(0))
+
+
+def test_the_command_fits_and_validates_two_inputs(tmp_path):
+    """`identify --input f1,f2` fits one denominator over every pair and
+    `validate` reads the model's inputs back by name; a command of one
+    input refuses two in one line."""
+    from clitools import run
+
+    d = _record(900, noise=0.02)
+    table = np.column_stack([d.t, d.u, d.y])
+    np.savetxt(tmp_path / "two.csv", table, delimiter=",", comments="",
+               header="time_s,f1 [N],f2 [N],p [m],q [m]")  # fmt: skip
+    out = run("identify", "two.csv", "--input", "f1,f2", "--output", "p,q",
+              "--na", "4", "--nb", "2", "--nk", "1", "--method", "oe",
+              "--out", "m", cwd=tmp_path)  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    model = SharedDenominatorModel.from_dict(
+        __import__("json").loads((tmp_path / "m" / "model.json").read_text())
+    )
+    assert model.input_names == ("f1", "f2") and model.input_units == ("N", "N")
+    np.testing.assert_allclose(model.a, A[1:], atol=1e-3)
+    out = run("validate", "m/model.json", "two.csv", "--out", "v", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert "fit % of q" in (tmp_path / "v" / "summary.txt").read_text()
+    out = run("pareto", "two.csv", "--input", "f1,f2", "--output", "p", "--out", "x",
+              cwd=tmp_path)  # fmt: skip
+    assert out.returncode == 2 and "this command takes one input" in out.stderr
