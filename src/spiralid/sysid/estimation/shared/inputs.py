@@ -81,13 +81,11 @@ def _lagged(v: np.ndarray, nb: int, nk: int) -> np.ndarray:
     """``[v_j(t - nk - k)]``: column ``j nb + k`` is input `j` delayed by
     ``nk + k`` (zero before the record), shape (N, m nb)."""
     n, m = v.shape
-    out = np.zeros((n, m * nb))
-    for j in range(m):
-        for k in range(nb):
-            lag = nk + k
-            if lag < n:
-                out[lag:, j * nb + k] = v[: n - lag, j]
-    return out
+    pad = np.zeros((n + nk + nb - 1, m))
+    pad[nk + nb - 1 :] = v
+    # windows[t, j, i] = pad[t + i, j], and v(t - nk - k) = pad[t + nb - 1 - k].
+    windows = np.lib.stride_tricks.sliding_window_view(pad, nb, axis=0)[:n]
+    return np.ascontiguousarray(windows[:, :, ::-1]).reshape(n, m * nb)
 
 
 def _shifted(x: np.ndarray, count: int) -> np.ndarray:
