@@ -11,7 +11,9 @@ a single-input multi-output (SIMO) output-error model. The modes are the
 complex pole pairs of ``A``, with intervals from the covariance of ``a``
 (:func:`~spiralid.sysid.models.modes.mode_table`), and each mode's share in
 each output from that output's residues: a sensor near a node of a mode
-barely sees it, the others do.
+barely sees it, the others do. Several inputs (shakers) make it
+``y_i = sum_j B_ij(q) / A(q) u_j``, one numerator per pair over the same
+poles (run, predicted and realised in :mod:`._shared_inputs`).
 """
 
 from __future__ import annotations
@@ -109,7 +111,7 @@ _NULLABLE = ("cost", "gain")
 
 @dataclass
 class SharedDenominatorModel(Provenance):
-    """A single-input multi-output model with one denominator.
+    """A model of one or several outputs (and inputs) with one denominator.
 
     Its provenance (method, cost, result, timings, input name and offset,
     fraction...) is the record-wide :class:`~.fitted.Provenance` every
@@ -170,6 +172,12 @@ class SharedDenominatorModel(Provenance):
         the file unless ``to_dict(timings=False)``.
     fraction : float or None
         The share of the record that estimated the model, when known.
+    input_names, input_units : tuple of str
+        With several inputs, one name and unit per input (``b`` then has
+        ``m nb`` coefficients per output, input by input: output ``i`` is
+        ``sum_j B_ij / A u_j``); empty for the one input of `input_name`.
+    u_offsets : tuple of float
+        With several inputs, the offset removed from each.
     """
 
     a: np.ndarray
