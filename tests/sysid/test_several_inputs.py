@@ -12,6 +12,7 @@ from spiralid.sysid import (
     NARX,
     IOData,
     PaperCost,
+    PolynomialNARX,
     ProjectedCost,
     SharedDenominatorModel,
     arx_least_squares,
@@ -21,6 +22,7 @@ from spiralid.sysid import (
     subspace_denominator,
     validate,
 )
+from spiralid.sysid.estimation.linear.frequency import h1_estimate
 from spiralid.sysid.estimation.shared.denominator import SharedProjectedCost
 from spiralid.sysid.estimation.shared.inputs import SharedInputsCost
 
@@ -104,12 +106,16 @@ REFUSALS = [
     ("steiglitz_mcbride", lambda: steiglitz_mcbride(_ONE_OUT, ARX(2, 2, 1))),
     ("identify_pareto", lambda: identify_pareto(_ONE_OUT, [ARX(2, 2, 1)])),
     ("identify", lambda: identify(_ONE_OUT, NARX(2, 2, 1))),
+    ("identify", lambda: identify(_ONE_OUT, PolynomialNARX(2, 2, 1))),
+    ("the H1 estimate", lambda: h1_estimate(_ONE_OUT)),
     ("validate", lambda: validate(identify(_TWO.input(0).output(0), ARX(2, 2, 1),
                                            method="ls"), _ONE_OUT)),
 ]  # fmt: skip
 
 
-@pytest.mark.parametrize("what,call", REFUSALS, ids=[f"{i}" for i in range(8)])
+@pytest.mark.parametrize(
+    "what,call", REFUSALS, ids=[f"{i}" for i in range(len(REFUSALS))]
+)
 def test_functions_of_one_input_refuse_several_in_one_line(what, call):
     with pytest.raises(ValueError) as err:
         call()
