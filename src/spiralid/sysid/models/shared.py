@@ -13,7 +13,7 @@ complex pole pairs of ``A``, with intervals from the covariance of ``a``
 each output from that output's residues: a sensor near a node of a mode
 barely sees it, the others do. Several inputs (shakers) make it
 ``y_i = sum_j B_ij(q) / A(q) u_j``, one numerator per pair over the same
-poles (run, predicted and realised in :mod:`._shared_inputs`).
+poles (run, predicted and realised in ``_shared_inputs.py``).
 """
 
 from __future__ import annotations
