@@ -509,7 +509,9 @@ def _check_shared_options(args, est) -> None:
     )
 
     outputs = (
-        f"{est.n_outputs} output(s) and {est.n_inputs} input(s) (one shared "
+        f"{est.n_outputs} outputs (one shared denominator)"
+        if est.n_inputs == 1
+        else f"{est.n_outputs} output(s) and {est.n_inputs} inputs (one shared "
         "denominator)"
     )
     if args.method not in SHARED_METHODS:

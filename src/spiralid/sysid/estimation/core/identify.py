@@ -314,8 +314,12 @@ def identify(
         refuse_options(
             given,
             entry.options(given.get("refine", False)),
-            f"method {method!r} on a record of {data.n_outputs} output(s) and "
-            f"{data.n_inputs} input(s) (one shared denominator)",
+            f"method {method!r} on a record of {data.n_outputs} "
+            + (
+                "outputs (one shared denominator)"
+                if data.n_inputs == 1
+                else f"output(s) and {data.n_inputs} inputs (one shared denominator)"
+            ),
             IDENTIFY_DEFAULTS,
         )
     else:
