@@ -89,9 +89,10 @@ def test_bad_inputs():
     ):
         IOData([1, 2, 3], [1, 2], ts=1.0)
     with pytest.raises(
-        ValueError, match=r"`u` must be a 1-D signal .* got shape \(2, 2\)"
+        ValueError, match=r"`u` must be a 1-D signal .* got shape \(2, 2, 2\)"
     ):
-        IOData(np.ones((2, 2)), [1, 2], ts=1.0)
+        # (N, m) is a record of m inputs; three axes are no signal.
+        IOData(np.ones((2, 2, 2)), [1, 2], ts=1.0)
     with pytest.raises(ValueError, match="`ts` must be a finite number > 0"):
         IOData([1, 2], [1, 2], ts=0.0)
     with pytest.raises(ValueError, match="`u` must be a numeric 1-D signal"):

@@ -305,7 +305,11 @@ def _run_shared(args, progress, arx, est, val, options, argv) -> int:
     from spiralid.sysid import identify, stabilisation, validate
 
     with _open_folder(args.out, args.force) as folder:
-        progress.phase("estimation", f"estimating {arx} for {est.n_outputs} outputs")
+        progress.phase(
+            "estimation",
+            f"estimating {arx} for {est.n_outputs} output(s) of {est.n_inputs} "
+            "input(s)",
+        )
         model = identify(est, arx, method=args.method, **options)
         model.fraction = args.fraction
         progress.phase("validation", "validating every output on both parts")
@@ -510,7 +514,12 @@ def _check_shared_options(args, est) -> None:
         shared_options,
     )
 
-    outputs = f"{est.n_outputs} outputs (one shared denominator)"
+    outputs = (
+        f"{est.n_outputs} outputs (one shared denominator)"
+        if est.n_inputs == 1
+        else f"{est.n_outputs} output(s) and {est.n_inputs} inputs (one shared "
+        "denominator)"
+    )
     if args.method not in SHARED_METHODS:
         raise UsageError(
             f"--method {args.method} takes one output; a record of {outputs} is "
@@ -584,7 +593,7 @@ def run(args, argv: list[str]) -> int:
         arx, est, val = _load_parts(args, progress, _structure)
         # The budget rule is identify()'s (spiral/population.py: search_options).
         options = _identify_options(args, arx)
-        if est.n_outputs > 1:
+        if est.n_outputs > 1 or est.n_inputs > 1:
             _check_shared_options(args, est)
             return _run_shared(args, progress, arx, est, val, options, argv)
         with _open_folder(args.out, args.force) as folder:

@@ -284,6 +284,16 @@ def _one_column(value: str) -> str | int:
     return _column(value)
 
 
+def _one_input(value: str) -> str | int:
+    """--input of a command that models one input."""
+    if "," in value:
+        raise argparse.ArgumentTypeError(
+            f"this command takes one input; got {value!r} (`spiralid identify "
+            "--input a,b` fits one model of several inputs)"
+        )
+    return _column(value)
+
+
 def _add_data_options(
     p: argparse.ArgumentParser, several_outputs: bool = True, positional: bool = True
 ) -> None:
@@ -294,10 +304,15 @@ def _add_data_options(
         p.add_argument("data", help=_DATA_HELP)
     p.add_argument(
         "--input",
-        type=_column,
+        type=_columns if several_outputs else _one_input,
         default=None,
         help="input column (CSV name or 0-based index) or variable (NPZ/MAT); "
-        "default 'u', or 'torque_Nm' in files written by `spiralid simulate`",
+        "default 'u', or 'torque_Nm' in files written by `spiralid simulate`"
+        + (
+            "; several separated by commas (a,b) for one model of every input"
+            if several_outputs
+            else ""
+        ),
     )
     p.add_argument(
         "--output",
@@ -351,10 +366,11 @@ def _load_data(args, default_ts: float | None = None):
         for k, v in (("input_unit", args.input_unit), ("output_unit", args.output_unit))
         if v is not None
     }
-    if "output_unit" in units and data.n_outputs > 1:
-        # One unit for every output, or one each separated by commas.
-        given = units["output_unit"].split(",")
-        units["output_unit"] = given[0] if len(given) == 1 else tuple(given)
+    for key, count in (("output_unit", data.n_outputs), ("input_unit", data.n_inputs)):
+        if key in units and count > 1:
+            # One unit for every channel, or one each separated by commas.
+            given = units[key].split(",")
+            units[key] = given[0] if len(given) == 1 else tuple(given)
     return replace(data, **units) if units else data
 
 

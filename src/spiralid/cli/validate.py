@@ -59,7 +59,16 @@ def _outputs_of(model) -> list[str]:
 
 def _offsets_of(model) -> tuple[float, ...]:
     """The output offsets the model file records, one per output."""
+    several = getattr(model, "y_offsets", None)
+    if several is not None:
+        return tuple(several)
     return tuple(model.output_model(name).y_offset for name in model.output_names)
+
+
+def _inputs_of(model) -> list[str]:
+    """The inputs a model was estimated on: one, or several of a shared
+    denominator."""
+    return list(getattr(model, "input_names", (model.input_name,)))
 
 
 def _names_in(name: str) -> set[str] | None:
@@ -109,8 +118,9 @@ def _columns_of_the_model(args, model) -> None:
     if names is None:
         return
     outputs = _outputs_of(model)
+    inputs = _inputs_of(model)
     wanted = {
-        "input": [model.input_name] if args.input is None else [],
+        "input": inputs if args.input is None else [],
         "output": outputs if args.output is None else [],
     }
     missing = [v for vs in wanted.values() for v in vs if v not in names]
@@ -119,12 +129,13 @@ def _columns_of_the_model(args, model) -> None:
         plural = "s" if len(outputs) > 1 else ""
         order = ", in the model's order" if len(outputs) > 1 else ""
         raise UsageError(
-            f"the model was estimated on input {model.input_name!r} and "
+            f"the model was estimated on input {', '.join(map(repr, inputs))} and "
             f"output{plural} {', '.join(map(repr, outputs))}, but {args.data!r} has "
             f"no {kind} {' or '.join(map(repr, missing))}; give --input and "
             f"--output with the {kind}s that hold them{order}"
         )
-    args.input = args.input if not wanted["input"] else model.input_name
+    if wanted["input"]:
+        args.input = inputs if len(inputs) > 1 else inputs[0]
     if wanted["output"]:
         args.output = outputs if len(outputs) > 1 else outputs[0]
 
@@ -156,7 +167,8 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
     if not recorded:
         return _detrended(data, args.fraction) if args.detrend else data
     offsets = _offsets_of(model)
-    if model.u_offset == 0.0 and not any(offsets):
+    u_offsets = getattr(model, "u_offsets", (model.u_offset,))
+    if not any(u_offsets) and not any(offsets):
         if args.detrend:
             raise UsageError(
                 "--detrend does not apply: the model was estimated without it"
@@ -167,11 +179,12 @@ def _prepared_as_the_model(data, model, recorded: bool, args):
     import numpy as np
 
     y_offset = tuple(a + b for a, b in zip(data.y_offsets, offsets, strict=True))
+    u_offset = tuple(a + b for a, b in zip(data.u_offsets, u_offsets, strict=True))
     return replace(
         data,
-        u=data.u - model.u_offset,
+        u=data.u - (u_offsets[0] if data.u.ndim == 1 else np.asarray(u_offsets)),
         y=data.y - (offsets[0] if data.y.ndim == 1 else np.asarray(offsets)),
-        u_offset=data.u_offset + model.u_offset,
+        u_offset=u_offset[0] if data.u.ndim == 1 else u_offset,
         y_offset=y_offset[0] if data.y.ndim == 1 else y_offset,
     )
 

@@ -27,7 +27,7 @@ SIMULATE_UNITS = {
 
 def read_record(
     source: str | Path,
-    input: str | int | None = None,
+    input: str | int | list | None = None,
     output: str | int | list | None = None,
     ts: float | None = None,
     default_ts: float | None = None,
@@ -41,7 +41,8 @@ def read_record(
         ``.csv``, ``.npz`` or ``.mat``.
     input, output : str or int, optional
         Column (CSV: name or 0-based index) or variable (NPZ, MAT) names;
-        `output` may be a list of them (a record of several outputs).
+        either may be a list of them (a record of several outputs or
+        inputs).
         Default ``u`` and ``y``, or for a CSV written by ``spiralid
         simulate`` its torque and end-point acceleration (with their units).
     ts : float, optional
@@ -75,8 +76,11 @@ def read_record(
     if suffix in (".npz", ".mat"):
         input = "u" if input is None else input
         output = "y" if output is None else output
-        outputs = output if isinstance(output, list | tuple) else [output]
-        if isinstance(input, int) or any(isinstance(o, int) for o in outputs):
+        given = [
+            *(input if isinstance(input, list | tuple) else [input]),
+            *(output if isinstance(output, list | tuple) else [output]),
+        ]
+        if any(isinstance(key, int) for key in given):
             raise ValueError(
                 f"`input` and `output` must be variable names for {suffix} files"
             )
@@ -98,7 +102,12 @@ def _read_csv(file: Path, input, output, ts, default_ts) -> IOData:
     if written_by_us:
         data = replace(
             data,
-            input_unit=SIMULATE_UNITS.get(data.input_name, data.input_unit),
+            input_unit=tuple(
+                SIMULATE_UNITS.get(name, unit)
+                for name, unit in zip(data.input_names, data.input_units, strict=True)
+            )
+            if data.n_inputs > 1
+            else SIMULATE_UNITS.get(data.input_name, data.input_unit),
             output_unit=tuple(
                 SIMULATE_UNITS.get(name, unit)
                 for name, unit in zip(data.output_names, data.output_units, strict=True)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass, field
 
@@ -11,29 +10,29 @@ import numpy as np
 from spiralid._checks import named_index, positive
 
 from .readers import (
-    NoSampleTimeError,
-    _csv_column,
-    _csv_lookup,
-    _csv_sample_time,
+    NoSampleTimeError as NoSampleTimeError,
+)
+from .readers import (
     _csv_table,
-    _file_sample_time,
+    _mapping_fields,
     _mat_variables,
     _npz_arrays,
-    _output_keys,
-    _split_unit,
+    _table_fields,
 )
-from .signals import _check_magnitude, check_outputs, check_signal
+from .signals import _check_magnitude, check_outputs, per_channel
 
 __all__ = ["IOData"]
 
 
 def single_output_record(data, what: str):
-    """`data` checked as an :class:`IOData` of one output, for `what` (a
-    function that models one output): a one-line TypeError (not an IOData)
-    or ValueError (several outputs) otherwise."""
+    """`data` checked as an :class:`IOData` of one input and one output,
+    for `what` (a function that models one output from one input): a
+    one-line TypeError (not an IOData) or ValueError (several outputs or
+    inputs) otherwise."""
     if not isinstance(data, IOData):
         raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     data.require_single_output(what)
+    data.require_single_input(what)
     return data
 
 
@@ -43,42 +42,6 @@ def _frozen(checked: np.ndarray) -> np.ndarray:
     arr = np.array(checked, dtype=float, order="C", copy=True)
     arr.flags.writeable = False
     return arr
-
-
-def _per_output(value, p: int, name: str, kind):
-    """`value` for each of p outputs: one value for all, or a sequence of
-    p values; converted by `kind` (str or float)."""
-    if isinstance(value, str | int | float | np.number) and not isinstance(value, bool):
-        return (kind(value),) * p
-    try:
-        values = tuple(kind(v) for v in value)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"`{name}` must be one value or one per output ({p}); got {value!r}"
-        ) from None
-    if len(values) != p:
-        raise ValueError(
-            f"`{name}` must have one entry per output ({p}); got {len(values)}"
-        )
-    return values
-
-
-def _same_length(outputs: dict, path) -> None:
-    """Several output variables, each a vector, all of one length: a
-    one-line ValueError that names them otherwise."""
-    for key, y in outputs.items():
-        if y.ndim != 1:
-            raise ValueError(
-                f"`output` variable {key!r} of {str(path)!r} must be a vector to "
-                f"be one of several outputs; got shape {y.shape}"
-            )
-    lengths = {key: y.size for key, y in outputs.items()}
-    if len(set(lengths.values())) > 1:
-        listed = ", ".join(f"{key!r} {n}" for key, n in lengths.items())
-        raise ValueError(
-            f"`output` variables must have the same length; got {listed} samples "
-            f"in {str(path)!r}"
-        )
 
 
 def _label(name: str, unit: str) -> str:
@@ -91,13 +54,15 @@ def _check_ts(ts) -> float:
 
 @dataclass(frozen=True, eq=False)
 class IOData:
-    """A single-input record of one or several outputs, sampled every `ts`
-    seconds.
+    """A record of one or several inputs and one or several outputs,
+    sampled every `ts` seconds.
 
     Parameters
     ----------
-    u : array_like, shape (N,) or (N, 1)
-        Input samples; finite.
+    u : array_like, shape (N,), (N, 1) or (N, m)
+        Input samples; finite: one input (stored as shape (N,), the simple
+        case every single-input function takes), or ``m >= 2`` inputs, one
+        per column (a structure driven by several shakers).
     y : array_like, shape (N,), (N, 1) or (N, p)
         Output samples, as long as `u` and finite: one output (stored as
         shape (N,), the simple case every single-output function takes), or
@@ -107,15 +72,17 @@ class IOData:
         Sample time in seconds (> 0).
     input_name, output_name : str
         Labels used in tables and plots; with several outputs
-        `output_name` is one name per output (default ``y1, y2, ...``).
+        `output_name` is one name per output (default ``y1, y2, ...``),
+        with several inputs `input_name` one per input (``u1, u2, ...``).
     input_unit, output_unit : str
         Units of `u` and `y` (e.g. ``"N m"``, ``"m/s^2"``), shown in every
         figure and table; empty when unknown. With several outputs
-        `output_unit` is one unit for all or one per output.
+        (inputs) `output_unit` (`input_unit`) is one unit for all or one
+        per output (input).
     u_offset, y_offset : float
         Offsets already removed from the signals (set by :meth:`detrend`);
         add them back to recover the raw signals. With several outputs
-        `y_offset` is one per output.
+        (inputs) `y_offset` (`u_offset`) is one per output (input).
 
     Notes
     -----
@@ -124,7 +91,12 @@ class IOData:
     :attr:`output_units` and :attr:`y_offsets` are tuples in every case,
     :meth:`output` picks one output as a single-output record, and a
     function that models one output refuses several in one line
-    (:meth:`require_single_output`).
+    (:meth:`require_single_output`). Several inputs mirror it:
+    ``input_name``, ``input_unit`` and ``u_offset`` are then tuples,
+    :attr:`input_names`, :attr:`input_units`, :attr:`u_offsets` and
+    :attr:`inputs` (N, m) hold in every case, :meth:`input` picks one, and
+    a function that takes one input refuses several
+    (:meth:`require_single_input`).
 
     Examples
     --------
@@ -139,52 +111,54 @@ class IOData:
     u: np.ndarray
     y: np.ndarray
     ts: float
-    input_name: str = "u"
+    input_name: str | tuple[str, ...] = "u"
     output_name: str | tuple[str, ...] = "y"
-    u_offset: float = field(default=0.0)
+    u_offset: float | tuple[float, ...] = field(default=0.0)
     y_offset: float | tuple[float, ...] = field(default=0.0)
-    input_unit: str = ""
+    input_unit: str | tuple[str, ...] = ""
     output_unit: str | tuple[str, ...] = ""
 
     def __post_init__(self) -> None:
-        u = _frozen(check_signal(self.u, "u"))
+        u = _frozen(check_outputs(self.u, "u"))
         y = _frozen(check_outputs(self.y, "y"))
-        if u.size != y.shape[0]:
+        if u.shape[0] != y.shape[0]:
             raise ValueError(
-                f"`u` and `y` must have the same length; got {u.size} and {y.shape[0]}"
+                f"`u` and `y` must have the same length; got {u.shape[0]} and "
+                f"{y.shape[0]}"
             )
         _check_magnitude(u, "u")
         _check_magnitude(y, "y")
         object.__setattr__(self, "u", u)
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "ts", _check_ts(self.ts))
-        object.__setattr__(self, "input_name", str(self.input_name))
-        object.__setattr__(self, "u_offset", float(self.u_offset))
-        object.__setattr__(self, "input_unit", str(self.input_unit))
-        if y.ndim == 1:
-            object.__setattr__(self, "output_name", str(self.output_name))
-            object.__setattr__(self, "y_offset", float(self.y_offset))
-            object.__setattr__(self, "output_unit", str(self.output_unit))
+        self._channels(u, ("input_name", "u_offset", "input_unit"), "input")
+        self._channels(y, ("output_name", "y_offset", "output_unit"), "output")
+
+    def _channels(self, x: np.ndarray, fields: tuple, what: str) -> None:
+        """The name, offset and unit fields of the inputs or the outputs
+        `x`: scalars for one, tuples of one per column for several."""
+        name, offset, unit = fields
+        if x.ndim == 1:
+            object.__setattr__(self, name, str(getattr(self, name)))
+            object.__setattr__(self, offset, float(getattr(self, offset)))
+            object.__setattr__(self, unit, str(getattr(self, unit)))
             return
-        p = y.shape[1]
-        names = self.output_name
+        p = x.shape[1]
+        names = getattr(self, name)
         if isinstance(names, str):
             names = tuple(f"{names}{k + 1}" for k in range(p))
-        names = _per_output(names, p, "output_name", str)
+        names = per_channel(names, p, name, str, what)
         if len(set(names)) != p:
-            raise ValueError(f"`output_name` must name each output once; got {names}")
-        object.__setattr__(self, "output_name", names)
-        object.__setattr__(
-            self, "y_offset", _per_output(self.y_offset, p, "y_offset", float)
-        )
-        object.__setattr__(
-            self, "output_unit", _per_output(self.output_unit, p, "output_unit", str)
-        )
+            raise ValueError(f"`{name}` must name each {what} once; got {names}")
+        object.__setattr__(self, name, names)
+        for field_, kind in ((offset, float), (unit, str)):
+            value = per_channel(getattr(self, field_), p, field_, kind, what)
+            object.__setattr__(self, field_, value)
 
     @property
     def n(self) -> int:
         """Number of samples."""
-        return int(self.u.size)
+        return int(self.u.shape[0])
 
     def __len__(self) -> int:
         return self.n
@@ -210,6 +184,56 @@ class IOData:
         return (self.y_offset,) if self.y.ndim == 1 else self.y_offset
 
     @property
+    def n_inputs(self) -> int:
+        """Number of inputs ``m`` (1 for a single-input record)."""
+        return 1 if self.u.ndim == 1 else int(self.u.shape[1])
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        """One name per input."""
+        return (self.input_name,) if self.u.ndim == 1 else self.input_name
+
+    @property
+    def input_units(self) -> tuple[str, ...]:
+        """One unit per input."""
+        return (self.input_unit,) if self.u.ndim == 1 else self.input_unit
+
+    @property
+    def u_offsets(self) -> tuple[float, ...]:
+        """One removed offset per input."""
+        return (self.u_offset,) if self.u.ndim == 1 else self.u_offset
+
+    @property
+    def inputs(self) -> np.ndarray:
+        """The inputs as an (N, m) array, whatever ``m`` (a read-only view)."""
+        return self.u.reshape(self.n, self.n_inputs)
+
+    def input(self, which: int | str) -> IOData:
+        """One input, by 0-based index or name, as a single-input record of
+        the same outputs (the record itself when it has one input and
+        `which` names it): the part of a several-input record a function
+        of one input takes, the others' response then left in ``y``."""
+        k = named_index(which, "which", self.input_names)
+        if self.u.ndim == 1:
+            return self
+        return self._replace(
+            self.u[:, k],
+            self.y,
+            input_name=self.input_names[k],
+            u_offset=self.u_offsets[k],
+            input_unit=self.input_units[k],
+        )
+
+    def require_single_input(self, what: str) -> None:
+        """A one-line ValueError when the record has several inputs: `what`
+        (e.g. ``"identify with an ARX structure"``) takes one."""
+        if self.u.ndim != 1:
+            raise ValueError(
+                f"`data` has {self.n_inputs} inputs {self.input_names}; {what} "
+                "takes one: pass data.input(name), or fit a shared denominator"
+            )
+
+    @property
     def outputs(self) -> np.ndarray:
         """The outputs as an (N, p) array, whatever ``p`` (a read-only view)."""
         return self.y.reshape(self.n, self.n_outputs)
@@ -222,15 +246,11 @@ class IOData:
         k = named_index(which, "which", names)
         if self.y.ndim == 1:
             return self
-        return IOData(
+        return self._replace(
             self.u,
             self.y[:, k],
-            ts=self.ts,
-            input_name=self.input_name,
             output_name=names[k],
-            u_offset=self.u_offset,
             y_offset=self.y_offsets[k],
-            input_unit=self.input_unit,
             output_unit=self.output_units[k],
         )
 
@@ -284,8 +304,12 @@ class IOData:
 
     @property
     def input_label(self) -> str:
-        """``"name (unit)"``, or the name alone when the unit is unknown."""
-        return _label(self.input_name, self.input_unit)
+        """``"name (unit)"``, or the name alone when the unit is unknown
+        (joined by commas for several inputs)."""
+        return ", ".join(
+            _label(n, unit)
+            for n, unit in zip(self.input_names, self.input_units, strict=True)
+        )
 
     @property
     def output_label(self) -> str:
@@ -388,7 +412,19 @@ class IOData:
                 f"`like` must have the record's {self.n_outputs} output(s); got "
                 f"{ref.n_outputs}"
             )
-        mu = float(ref.u.mean())
+        if ref.n_inputs != self.n_inputs:
+            raise ValueError(
+                f"`like` must have the record's {self.n_inputs} input(s); got "
+                f"{ref.n_inputs}"
+            )
+        if self.u.ndim == 1:
+            mu = float(ref.u.mean())
+            u_offset = self.u_offset + mu
+        else:
+            mu = ref.u.mean(axis=0)
+            u_offset = tuple(
+                float(a + b) for a, b in zip(self.u_offset, mu, strict=True)
+            )
         if self.y.ndim == 1:
             my = float(ref.y.mean())
             offset = self.y_offset + my
@@ -396,7 +432,7 @@ class IOData:
             my = ref.y.mean(axis=0)
             offset = tuple(float(a + b) for a, b in zip(self.y_offset, my, strict=True))
         return self._replace(
-            self.u - mu, self.y - my, u_offset=self.u_offset + mu, y_offset=offset
+            self.u - mu, self.y - my, u_offset=u_offset, y_offset=offset
         )
 
     # -- loading ---------------------------------------------------------------
@@ -405,7 +441,7 @@ class IOData:
     def from_csv(
         cls,
         path: str | os.PathLike,
-        input: str | int = "u",
+        input: str | int | list = "u",
         output: str | int | list = "y",
         ts: float | None = None,
         delimiter: str = ",",
@@ -418,13 +454,13 @@ class IOData:
         ----------
         path : path-like
             The file. A first line that is not all numbers is read as a header.
-        input, output : str or int
+        input, output : str, int or list
             Column names (needs a header) or 0-based column indices. A header
             may carry units as ``name [unit]`` or ``name (unit)``; the column
             is then named by either the whole header or ``name``, and the
-            unit goes to ``input_unit`` / ``output_unit``. `output` may be a
+            unit goes to ``input_unit`` / ``output_unit``. Either may be a
             list of columns: a record of several outputs, ``y`` of shape
-            (N, p).
+            (N, p), or of several inputs, ``u`` of shape (N, m).
         ts : float, optional
             Sample time in seconds; default the step of an evenly spaced
             ``time_s`` column, else `default_ts`.
@@ -440,69 +476,13 @@ class IOData:
     @classmethod
     def _from_table(cls, header, rows, input, output, ts, default_ts, path) -> IOData:
         """:meth:`from_csv` on a table :func:`_csv_table` has read."""
-        where = repr(str(path))
-        time = None if header is None else _csv_lookup(header, "time_s", where)
-        ts_file = None if time is None else _csv_sample_time(where, rows, time)
-        if (
-            ts is not None
-            and ts_file is not None
-            and not math.isclose(ts, ts_file, rel_tol=1e-5, abs_tol=1e-8)
-        ):
-            raise ValueError(
-                f"`ts` {ts:g} contradicts the time_s column of {where} (steps "
-                f"of {ts_file:g} s); leave `ts` out or correct the file"
-            )
-        ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
-        if ts is None:
-            raise NoSampleTimeError(
-                f"`ts` is required for {where}: a CSV file carries no sample "
-                "time (or give a 'time_s' column)"
-            )
-        ncol = len(header) if header is not None else len(rows[0][1])
-
-        def column(key, argname):
-            if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
-                if not 0 <= key < ncol:
-                    raise ValueError(
-                        f"`{argname}` column index must be in [0, {ncol - 1}]; "
-                        f"got {key!r}"
-                    )
-                j = int(key)
-            elif header is None:
-                raise ValueError(
-                    f"`{argname}` must be a column index: {where} has no header "
-                    f"line; got {key!r}"
-                )
-            else:
-                j = _csv_lookup(header, key, where, argname)
-                if j is None:
-                    raise ValueError(
-                        f"`{argname}` must be one of the columns {header}; got {key!r}"
-                    )
-            return j, *(_split_unit(header[j]) if header else (f"column {j}", ""))
-
-        iu, name_u, unit_u = column(input, "input")
-        keys = _output_keys(output)
-        found = [column(key, "output") for key in keys]
-        ys = [_csv_column(rows, j, name, where) for j, name, _ in found]
-        names = tuple(name for _, name, _ in found)
-        units = tuple(unit for _, _, unit in found)
-        several = len(keys) > 1
-        return cls(
-            _csv_column(rows, iu, name_u, where),
-            np.column_stack(ys) if several else ys[0],
-            ts,
-            name_u,
-            names if several else names[0],
-            input_unit=unit_u,
-            output_unit=units if several else units[0],
-        )
+        return cls(**_table_fields(header, rows, input, output, ts, default_ts, path))
 
     @classmethod
     def from_npz(
         cls,
         path: str | os.PathLike,
-        input: str = "u",
+        input: str | list = "u",
         output: str | list = "y",
         ts: float | None = None,
         *,
@@ -514,10 +494,11 @@ class IOData:
         ----------
         path : path-like
             The archive, as :func:`numpy.savez` writes it.
-        input, output : str
+        input, output : str or list
             The names of the input and output arrays; a (1, N) or (N, 1)
-            array is read as a vector. `output` may be a list of names: a
-            record of several outputs, ``y`` of shape (N, p).
+            array is read as a vector. Either may be a list of names: a
+            record of several outputs, ``y`` of shape (N, p), or inputs,
+            ``u`` of shape (N, m).
         ts : float, optional
             Sample time in seconds; default the scalar array named ``ts``,
             else `default_ts`.
@@ -531,7 +512,7 @@ class IOData:
     def from_mat(
         cls,
         path: str | os.PathLike,
-        input: str = "u",
+        input: str | list = "u",
         output: str | list = "y",
         ts: float | None = None,
         *,
@@ -548,47 +529,4 @@ class IOData:
     def _from_mapping(cls, mapping, input, output, ts, path, default_ts) -> IOData:
         """The one reader of the formats that hold named arrays (.npz, .mat):
         `mapping` is the file's arrays by name."""
-        names = sorted(mapping)
-        keys = _output_keys(output)
-        for key, arg in ((input, "input"), *((k, "output") for k in keys)):
-            if key not in mapping:
-                raise ValueError(
-                    f"`{arg}` must be one of the variables {names}; got {key!r}"
-                )
-        if ts is None and "ts" not in mapping and default_ts is not None:
-            ts = default_ts
-        if ts is None:
-            if "ts" not in mapping:
-                raise NoSampleTimeError(
-                    f"`ts` must be given: {str(path)!r} has no variable 'ts' "
-                    f"(variables: {names})"
-                )
-            ts = _file_sample_time(mapping["ts"], path)
-
-        def arr(key, arg):
-            a = np.asarray(mapping[key])
-            if a.dtype.kind == "c":
-                raise ValueError(
-                    f"`{arg}` variable {key!r} of {str(path)!r} must be real-valued; "
-                    "got complex values (save its real part or magnitude instead)"
-                )
-            if a.dtype.kind not in "fiub":
-                raise ValueError(
-                    f"`{arg}` variable {key!r} must be numeric; got dtype {a.dtype} "
-                    f"in {str(path)!r}"
-                )
-            a = a.astype(float)
-            # MATLAB stores vectors as (1, N) or (N, 1).
-            return a.ravel() if a.ndim == 2 and 1 in a.shape else a
-
-        ys = [arr(key, "output") for key in keys]
-        several = len(keys) > 1
-        if several:
-            _same_length(dict(zip(keys, ys, strict=True)), path)
-        return cls(
-            arr(input, "input"),
-            np.column_stack(ys) if several else ys[0],
-            ts,
-            str(input),
-            tuple(str(k) for k in keys) if several else str(keys[0]),
-        )
+        return cls(**_mapping_fields(mapping, input, output, ts, path, default_ts))

@@ -21,16 +21,34 @@ def _split_unit(header: str) -> tuple[str, str]:
     return text, ""
 
 
-def _output_keys(output) -> list:
-    """The readers' `output`: one column or variable, or a list of them for
-    a record of several outputs."""
+def _output_keys(output, argname: str = "output") -> list:
+    """The readers' `output` (or `input`): one column or variable, or a
+    list of them for a record of several outputs (inputs)."""
     if isinstance(output, list | tuple):
         if not output:
-            raise ValueError("`output` must name at least one column; got []")
+            raise ValueError(f"`{argname}` must name at least one column; got []")
         if len(set(output)) != len(output):
-            raise ValueError(f"`output` must name each column once; got {output!r}")
+            raise ValueError(f"`{argname}` must name each column once; got {output!r}")
         return list(output)
     return [output]
+
+
+def _same_length(signals: dict, path, argname: str = "output") -> None:
+    """Several output (input) variables, each a vector, all of one length:
+    a one-line ValueError that names them otherwise."""
+    for key, y in signals.items():
+        if y.ndim != 1:
+            raise ValueError(
+                f"`{argname}` variable {key!r} of {str(path)!r} must be a vector "
+                f"to be one of several; got shape {y.shape}"
+            )
+    lengths = {key: y.size for key, y in signals.items()}
+    if len(set(lengths.values())) > 1:
+        listed = ", ".join(f"{key!r} {n}" for key, n in lengths.items())
+        raise ValueError(
+            f"`{argname}` variables must have the same length; got {listed} "
+            f"samples in {str(path)!r}"
+        )
 
 
 def _npz_arrays(path) -> dict:
@@ -265,3 +283,114 @@ def _is_number(text: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def _several(values: list, stack: bool = False):
+    """One value for one channel, a tuple (or the columns stacked) for
+    several."""
+    if len(values) == 1:
+        return values[0]
+    return np.column_stack(values) if stack else tuple(values)
+
+
+def _table_fields(header, rows, input, output, ts, default_ts, path) -> dict:
+    """The keyword arguments of an :class:`~spiralid.sysid.IOData` read from
+    a table :func:`_csv_table` has read (``IOData.from_csv``)."""
+    import math
+
+    where = repr(str(path))
+    time = None if header is None else _csv_lookup(header, "time_s", where)
+    ts_file = None if time is None else _csv_sample_time(where, rows, time)
+    if (
+        ts is not None
+        and ts_file is not None
+        and not math.isclose(ts, ts_file, rel_tol=1e-5, abs_tol=1e-8)
+    ):
+        raise ValueError(
+            f"`ts` {ts:g} contradicts the time_s column of {where} (steps "
+            f"of {ts_file:g} s); leave `ts` out or correct the file"
+        )
+    ts = next((t for t in (ts, ts_file, default_ts) if t is not None), None)
+    if ts is None:
+        raise NoSampleTimeError(
+            f"`ts` is required for {where}: a CSV file carries no sample "
+            "time (or give a 'time_s' column)"
+        )
+    ncol = len(header) if header is not None else len(rows[0][1])
+
+    def column(key, argname):
+        if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
+            if not 0 <= key < ncol:
+                raise ValueError(
+                    f"`{argname}` column index must be in [0, {ncol - 1}]; got {key!r}"
+                )
+            j = int(key)
+        elif header is None:
+            raise ValueError(
+                f"`{argname}` must be a column index: {where} has no header "
+                f"line; got {key!r}"
+            )
+        else:
+            j = _csv_lookup(header, key, where, argname)
+            if j is None:
+                raise ValueError(
+                    f"`{argname}` must be one of the columns {header}; got {key!r}"
+                )
+        return j, *(_split_unit(header[j]) if header else (f"column {j}", ""))
+
+    fields = {"ts": ts}
+    for arg, kind, short in (("input", input, "u"), ("output", output, "y")):
+        found = [column(key, arg) for key in _output_keys(kind, arg)]
+        fields[short] = _several(
+            [_csv_column(rows, j, name, where) for j, name, _ in found], stack=True
+        )
+        fields[f"{arg}_name"] = _several([name for _, name, _ in found])
+        fields[f"{arg}_unit"] = _several([unit for _, _, unit in found])
+    return fields
+
+
+def _mapping_fields(mapping, input, output, ts, path, default_ts) -> dict:
+    """The keyword arguments of an :class:`~spiralid.sysid.IOData` read
+    from a file's arrays by name (``.npz``, ``.mat``)."""
+    names = sorted(mapping)
+    keys = {"input": _output_keys(input, "input"), "output": _output_keys(output)}
+    for arg, some in keys.items():
+        for key in some:
+            if key not in mapping:
+                raise ValueError(
+                    f"`{arg}` must be one of the variables {names}; got {key!r}"
+                )
+    if ts is None and "ts" not in mapping and default_ts is not None:
+        ts = default_ts
+    if ts is None:
+        if "ts" not in mapping:
+            raise NoSampleTimeError(
+                f"`ts` must be given: {str(path)!r} has no variable 'ts' "
+                f"(variables: {names})"
+            )
+        ts = _file_sample_time(mapping["ts"], path)
+
+    def arr(key, arg):
+        a = np.asarray(mapping[key])
+        if a.dtype.kind == "c":
+            raise ValueError(
+                f"`{arg}` variable {key!r} of {str(path)!r} must be real-valued; "
+                "got complex values (save its real part or magnitude instead)"
+            )
+        if a.dtype.kind not in "fiub":
+            raise ValueError(
+                f"`{arg}` variable {key!r} must be numeric; got dtype {a.dtype} "
+                f"in {str(path)!r}"
+            )
+        a = a.astype(float)
+        # MATLAB stores vectors as (1, N) or (N, 1).
+        return a.ravel() if a.ndim == 2 and 1 in a.shape else a
+
+    fields = {"ts": ts}
+    for (arg, some), short in zip(keys.items(), "uy", strict=True):
+        signals = [arr(key, arg) for key in some]
+        if len(some) > 1:
+            _same_length(dict(zip(some, signals, strict=True)), path, arg)
+        fields[short] = _several(signals, stack=True)
+        fields[f"{arg}_name"] = _several([str(k) for k in some])
+    return fields

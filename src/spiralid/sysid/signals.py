@@ -91,3 +91,21 @@ def _check_magnitude(x: np.ndarray, name: str) -> None:
             f"outside [{_SMALLEST:g}, {_LARGEST:g}], where sums of squares "
             "overflow or vanish in double precision (e.g. convert it to SI units)"
         )
+
+
+def per_channel(value, p: int, name: str, kind, what: str = "output"):
+    """`value` for each of p channels (outputs or inputs): one value for
+    all, or a sequence of p values; converted by `kind` (str or float)."""
+    if isinstance(value, str | int | float | np.number) and not isinstance(value, bool):
+        return (kind(value),) * p
+    try:
+        values = tuple(kind(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`{name}` must be one value or one per {what} ({p}); got {value!r}"
+        ) from None
+    if len(values) != p:
+        raise ValueError(
+            f"`{name}` must have one entry per {what} ({p}); got {len(values)}"
+        )
+    return values

@@ -11,7 +11,9 @@ a single-input multi-output (SIMO) output-error model. The modes are the
 complex pole pairs of ``A``, with intervals from the covariance of ``a``
 (:func:`~spiralid.sysid.models.modes.mode_table`), and each mode's share in
 each output from that output's residues: a sensor near a node of a mode
-barely sees it, the others do.
+barely sees it, the others do. Several inputs (shakers) make it
+``y_i = sum_j B_ij(q) / A(q) u_j``, one numerator per pair over the same
+poles (run, predicted and realised in ``_shared_inputs.py``).
 """
 
 from __future__ import annotations
@@ -24,6 +26,8 @@ from scipy import signal
 from spiralid._checks import named_index
 
 from . import _fields
+from . import _shared_inputs as _several_inputs
+from ._shared_inputs import one_per, simo_state_space
 from .arx import ARX
 from .fitted import Provenance
 from .identified import IdentifiedModel, python_control
@@ -93,18 +97,6 @@ class SharedModes:
         return "\n".join(lines)
 
 
-def _one_per_output(values, p: int, name: str, default) -> tuple:
-    """`values` as a tuple of p entries of `default`'s type (p defaults
-    when empty)."""
-    kind = type(default)
-    values = tuple(kind(v) for v in values) or (default,) * p
-    if len(values) != p:
-        raise ValueError(
-            f"`{name}` must have one entry per output ({p}); got {len(values)}"
-        )
-    return values
-
-
 def _plain(value) -> float | None:
     return float(value) if np.isfinite(value) else None
 
@@ -119,7 +111,7 @@ _NULLABLE = ("cost", "gain")
 
 @dataclass
 class SharedDenominatorModel(Provenance):
-    """A single-input multi-output model with one denominator.
+    """A model of one or several outputs (and inputs) with one denominator.
 
     Its provenance (method, cost, result, timings, input name and offset,
     fraction...) is the record-wide :class:`~.fitted.Provenance` every
@@ -180,6 +172,12 @@ class SharedDenominatorModel(Provenance):
         the file unless ``to_dict(timings=False)``.
     fraction : float or None
         The share of the record that estimated the model, when known.
+    input_names, input_units : tuple of str
+        With several inputs, one name and unit per input (``b`` then has
+        ``m nb`` coefficients per output, input by input: output ``i`` is
+        ``sum_j B_ij / A u_j``); empty for the one input of `input_name`.
+    u_offsets : tuple of float
+        With several inputs, the offset removed from each.
     """
 
     a: np.ndarray
@@ -199,16 +197,24 @@ class SharedDenominatorModel(Provenance):
     method: str = "spiral"
     penalty: float = 0.0
     result: dict = field(default_factory=dict)
+    # Several inputs: one name, unit and offset each (empty: the one input
+    # of the provenance's input_name, input_unit and u_offset).
+    input_names: tuple[str, ...] = ()
+    input_units: tuple[str, ...] = ()
+    u_offsets: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         self._check_provenance()
+        _several_inputs.check_inputs(self)
         self.a = np.asarray(self.a, dtype=float).ravel()
         self.b = np.atleast_2d(np.asarray(self.b, dtype=float))
         p = self.b.shape[0]
-        if self.a.shape != (self.arx.na,) or self.b.shape[1] != self.arx.nb:
+        width = self.n_inputs * self.arx.nb
+        if self.a.shape != (self.arx.na,) or self.b.shape[1] != width:
             raise ValueError(
                 f"`a` and `b` must have shapes ({self.arx.na},) and (p, "
-                f"{self.arx.nb}) for {self.arx}; got {self.a.shape} and {self.b.shape}"
+                f"{width}) for {self.arx} and {self.n_inputs} input(s); got "
+                f"{self.a.shape} and {self.b.shape}"
             )
         if not (np.all(np.isfinite(self.a)) and np.all(np.isfinite(self.b))):
             raise ValueError("`a` and `b` must be finite")
@@ -218,11 +224,11 @@ class SharedDenominatorModel(Provenance):
                 f"`output_names` must name each of the {p} outputs once; got "
                 f"{self.output_names}"
             )
-        self.output_units = _one_per_output(self.output_units, p, "output_units", "")
-        self.y_offsets = _one_per_output(self.y_offsets, p, "y_offsets", 0.0)
+        self.output_units = one_per(self.output_units, p, "output_units", "")
+        self.y_offsets = one_per(self.y_offsets, p, "y_offsets", 0.0)
         if not all(np.isfinite(self.y_offsets)):
             raise ValueError(f"`y_offsets` must be finite; got {self.y_offsets}")
-        self.integrators = _one_per_output(self.integrators, p, "integrators", 0)
+        self.integrators = one_per(self.integrators, p, "integrators", 0)
         if not all(0 <= k <= MOST_INTEGRATORS for k in self.integrators):
             raise ValueError(
                 f"`integrators` must be counts in [0, {MOST_INTEGRATORS}], one per "
@@ -248,6 +254,19 @@ class SharedDenominatorModel(Provenance):
         return int(self.b.shape[0])
 
     @property
+    def n_inputs(self) -> int:
+        """Number of inputs ``m`` (1: the single-input model)."""
+        return len(self.input_names)
+
+    def numerator(self, which: int | str, input: int | str = 0) -> np.ndarray:
+        """``B_ij``'s coefficients (nb,): output `which`'s numerator from
+        input `input` (names or 0-based indices)."""
+        i = named_index(which, "which", self.output_names)
+        j = named_index(input, "input", self.input_names)
+        nb = self.arx.nb
+        return self.b[i, j * nb : (j + 1) * nb]
+
+    @property
     def structure(self) -> ARX:
         """The structure every output has (:attr:`arx`), under the name
         every fitted model answers to."""
@@ -256,7 +275,8 @@ class SharedDenominatorModel(Provenance):
     @property
     def params(self) -> np.ndarray:
         """Every estimated parameter, ``[a, b_1, ..., b_p]`` (the shared
-        denominator, then each output's numerator)."""
+        denominator, then each output's numerator; with several inputs
+        ``b_i = [b_i1, .., b_im]``)."""
         return np.r_[self.a, self.b.ravel()]
 
     @property
@@ -274,18 +294,24 @@ class SharedDenominatorModel(Provenance):
         """The linear model inside this one: the model itself."""
         return self
 
-    def output_theta(self, i: int) -> np.ndarray:
-        """Output `i`'s ARX theta ``[a, b_i]`` with its known integrators in
-        the denominator (the structure of :meth:`output_arx`)."""
-        return np.r_[with_integrator(self.a, self.integrators[i]), self.b[i]]
+    def output_theta(self, i: int, j: int = 0) -> np.ndarray:
+        """Output `i`'s ARX theta ``[a, b_ij]`` from input `j` with its
+        known integrators in the denominator (the structure of
+        :meth:`output_arx`)."""
+        nb = self.arx.nb
+        b = self.b[i] if self.n_inputs == 1 else self.b[i, j * nb : (j + 1) * nb]
+        return np.r_[with_integrator(self.a, self.integrators[i]), b]
 
     def output_arx(self, i: int) -> ARX:
         """Output `i`'s structure: the shared poles and its integrators."""
         return ARX(self.arx.na + self.integrators[i], self.arx.nb, self.arx.nk)
 
     def simulate(self, u) -> np.ndarray:
-        """Free run of every output from rest, shape (N, p)."""
+        """Free run of every output from rest, shape (N, p); `u` of shape
+        (N, m) with several inputs (the sum of each input's response)."""
         u = np.asarray(getattr(u, "u", u), dtype=float)
+        if self.n_inputs > 1:
+            return _several_inputs.simulate(self, u)
         return np.column_stack(
             [
                 self.output_arx(i).simulate(self.output_theta(i), u)
@@ -296,6 +322,8 @@ class SharedDenominatorModel(Provenance):
     def predict(self, data) -> np.ndarray:
         """One-step-ahead prediction of every output on `data` (a record
         holding the model's outputs by name), shape (N, p)."""
+        if self.n_inputs > 1:
+            return _several_inputs.predict(self, data)
         return np.column_stack(
             [
                 self.output_model(name).predict(data.output(name))
@@ -303,24 +331,34 @@ class SharedDenominatorModel(Provenance):
             ]
         )
 
-    def output_model(self, which: int | str) -> IdentifiedModel:
+    def output_model(
+        self, which: int | str, input: int | str | None = None
+    ) -> IdentifiedModel:
         """One output's transfer function ``B_i / A`` as an
         :class:`IdentifiedModel`, which :func:`~spiralid.sysid.validate`
         validates on that output (its covariance is not carried: the
-        intervals belong to the shared modes)."""
+        intervals belong to the shared modes). With several inputs `input`
+        names one: ``B_ij / A``, one pair's transfer function (the output
+        is the sum over the inputs; a one-line ValueError without it)."""
         i = named_index(which, "which", self.output_names)
+        if self.n_inputs > 1 and input is None:
+            raise ValueError(
+                f"`input` must name one of the model's inputs {self.input_names}: "
+                "each output of a model of several inputs is their sum"
+            )
+        j = 0 if input is None else named_index(input, "input", self.input_names)
         return IdentifiedModel(
-            self.output_theta(i),
+            self.output_theta(i, j),
             arx=self.output_arx(i),
             integrator=self.integrators[i],
             ts=self.ts,
             method=self.method,
             cost=float(self.costs[i]) if self.costs is not None else float("nan"),
-            input_name=self.input_name,
+            input_name=self.input_names[j],
             output_name=self.output_names[i],
-            input_unit=self.input_unit,
+            input_unit=self.input_units[j],
             output_unit=self.output_units[i],
-            u_offset=self.u_offset,
+            u_offset=self.u_offsets[j],
             y_offset=self.y_offsets[i],
         )
 
@@ -340,6 +378,8 @@ class SharedDenominatorModel(Provenance):
     def modes(self) -> SharedModes:
         """The shared modes with 95 % intervals and each one's share per
         output."""
+        if self.n_inputs > 1:
+            return _several_inputs.modes(self, SharedModes)
         b_full = [np.r_[np.zeros(self.arx.nk), bi] for bi in self.b]
         tables = [
             mode_table(
@@ -359,7 +399,14 @@ class SharedDenominatorModel(Provenance):
 
     def tf_string(self, digits: int = 4) -> str:
         """Each output's transfer function in z (:meth:`output_model`'s),
-        one line per output after its name."""
+        one line per output after its name (per input-output pair with
+        several inputs)."""
+        if self.n_inputs > 1:
+            return "\n".join(
+                f"{name} <- {u}: {self.output_model(name, u).tf_string(digits)}"
+                for name in self.output_names
+                for u in self.input_names
+            )
         return "\n".join(
             f"{name}: {self.output_model(name).tf_string(digits)}"
             for name in self.output_names
@@ -393,22 +440,11 @@ class SharedDenominatorModel(Provenance):
 
     def _state_space(self):
         """``(A, B, C, D)`` of one state-space realisation of every output
-        over the shared denominator."""
-        # Over the common denominator A (1 - z^-1)^kmax: each numerator times
-        # the integrators its output lacks.
-        kmax = max(self.integrators)
-        common = ARX(self.arx.na + kmax, self.arx.nb + kmax, self.arx.nk)
-        polys = []
-        for i, k in enumerate(self.integrators):
-            extra = np.convolve(self.b[i], np.r_[1.0, with_integrator([], kmax - k)])
-            extra = np.r_[extra, np.zeros(common.nb - extra.size)]
-            theta = np.r_[with_integrator(self.a, kmax), extra]
-            polys.append(common.polynomials(theta))
-        num = np.array([n for n, _ in polys])
-        # Leading zero columns (the delay nk) are a strictly proper system's:
-        # left in, scipy warns of badly conditioned coefficients.
-        lead = np.argmax(np.any(num != 0.0, axis=0)) if np.any(num) else 0
-        return signal.tf2ss(num[:, lead:], polys[0][1])
+        over the shared denominator (with several inputs, one block per
+        input: not minimal, the poles repeated per input)."""
+        if self.n_inputs > 1:
+            return _several_inputs.state_space(self, simo_state_space)
+        return simo_state_space(self.a, self.b, self.arx, self.integrators)
 
     def to_dict(self, *, timings: bool = True) -> dict:
         """A JSON-safe form (what ``model.json`` holds).
@@ -442,6 +478,10 @@ class SharedDenominatorModel(Provenance):
         }
         # The provenance every fitted model writes, after the keys this
         # file had before it shared them (NaN as null, as for the cost).
+        if self.n_inputs > 1:
+            out["input_names"] = list(self.input_names)
+            out["input_units"] = list(self.input_units)
+            out["u_offsets"] = list(self.u_offsets)
         prov = self._provenance_dict()
         prov["gain"] = _plain(self.gain)
         if not timings:
@@ -485,6 +525,15 @@ class SharedDenominatorModel(Provenance):
         # names what estimated it, nothing here depends on it).
         known = {k: v for k, v in d.items() if v is not None or k not in _NULLABLE}
         provenance = cls._provenance_fields({"method": "", **known}, None, penalty=0.0)
+        inputs = _fields.texts(d, "input_names", None, [])
+        m = max(len(inputs), 1)
+        several = {}
+        if m > 1:
+            several = dict(
+                input_names=tuple(inputs),
+                input_units=tuple(_fields.texts(d, "input_units", m, [""] * m)),
+                u_offsets=tuple(_fields.numbers(d, "u_offsets", (m,), [0.0] * m)),
+            )
         integrators = _fields.numbers(d, "integrators", (p,), [0] * p)
         if not np.all(integrators == np.round(integrators)):
             raise ValueError(
@@ -493,7 +542,7 @@ class SharedDenominatorModel(Provenance):
             )
         return cls(
             a=_fields.numbers(d, "a", (na,)),
-            b=_fields.numbers(d, "b", (p, nb)),
+            b=_fields.numbers(d, "b", (p, m * nb)),
             arx=ARX(na, nb, nk),
             ts=_fields.number(d, "ts", "a number > 0", _fields.positive),
             output_names=names,
@@ -505,6 +554,7 @@ class SharedDenominatorModel(Provenance):
             covariance=optional("covariance", (na, na), null=np.inf),
             integrators=tuple(int(k) for k in integrators),
             **provenance,
+            **several,
         )
 
     def __repr__(self) -> str:

@@ -88,6 +88,8 @@ def _signals_of(data, name: str = "data"):
     if np.ndim(data.y) == 2 and np.shape(data.y)[1] > 1:
         # Before .ravel() would interleave the outputs into one signal.
         data.require_single_output(f"validate (`{name}`)")
+    if np.ndim(data.u) == 2 and np.shape(data.u)[1] > 1:
+        data.require_single_input(f"validate (`{name}`)")
     u = np.asarray(data.u, dtype=float).ravel()
     y = np.asarray(data.y, dtype=float).ravel()
     if u.size != y.size:

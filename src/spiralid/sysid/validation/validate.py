@@ -47,6 +47,7 @@ from .fit import (
     responses,
     rmse,
 )
+from .inputs import validate_inputs
 from .linear import absent, linear_checks, runaway_note
 from .nonlinear import nonlinear_checks
 from .outputs import check_output_records, joint_fit
@@ -99,7 +100,11 @@ def validate(
         with every option here): its :class:`Validation` holds each
         output's in ``outputs``, the joint fit as ``fit_percent``
         (:func:`~spiralid.sysid.validation.outputs.joint_fit`) and the
-        model's modes as ``mode_table``.
+        model's modes as ``mode_table``. A model of several inputs is
+        validated output by output from all its inputs
+        (:func:`~spiralid.sysid.validation.inputs.validate_inputs`: fits,
+        errors, spectra and whiteness; no test of independence from one
+        input).
     data : IOData
         The validation record, usually the last third (the paper's split);
         for a model of several outputs, a record holding each of them by
@@ -207,6 +212,8 @@ def validate(
         gain=gain,
     )
     check_fitted(model)
+    if getattr(model, "n_inputs", 1) > 1:
+        return validate_inputs(model, data, warmup, label, options)
     names = tuple(model.output_names)
     if len(names) > 1 or model.output_model(names[0]) is not model:
         return _validate_outputs(model, data, warmup, label, options)

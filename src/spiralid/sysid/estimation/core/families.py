@@ -254,9 +254,9 @@ def estimator(family: str, method: str, structure=None) -> Estimator:
         able = methods_of(family)
         if family == "shared-denominator":
             raise ValueError(
-                f"`method` {method!r} takes one output; a record of several outputs "
-                f"is identified by one of {able} (one shared denominator), or pass "
-                "data.output(name)"
+                f"`method` {method!r} takes one output (and one input); a record "
+                f"of several outputs or inputs is identified by one of {able} (one "
+                "shared denominator), or pass data.output(name) / data.input(name)"
             )
         name = type(structure).__name__ if structure is not None else family
         raise ValueError(

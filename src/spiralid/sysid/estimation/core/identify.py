@@ -313,8 +313,9 @@ def identify(
         cancel=cancel,
         **options,
     )
-    several = isinstance(data, IOData) and data.n_outputs > 1
-    family = family_of(structure, data.n_outputs if several else 1)
+    # Several outputs or several inputs: one shared denominator.
+    several = isinstance(data, IOData) and max(data.n_outputs, data.n_inputs) > 1
+    family = family_of(structure, 2 if several else 1)
     if family is None or not several:
         single_output_record(data, "identify")
     method = _check_method(method)
@@ -323,8 +324,12 @@ def identify(
         refuse_options(
             given,
             entry.options(given.get("refine", False)),
-            f"method {method!r} on a record of {data.n_outputs} outputs (one shared "
-            "denominator)",
+            f"method {method!r} on a record of {data.n_outputs} "
+            + (
+                "outputs (one shared denominator)"
+                if data.n_inputs == 1
+                else f"output(s) and {data.n_inputs} inputs (one shared denominator)"
+            ),
             IDENTIFY_DEFAULTS,
         )
     else:

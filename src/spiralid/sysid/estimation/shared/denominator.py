@@ -39,7 +39,6 @@ noise realisations (one interval of zero width; the factor's varied by
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import replace
 
@@ -50,10 +49,11 @@ from spiralid._checks import generator, integer
 from ...data import IOData
 from ...models.arx import ARX
 from ...models.polynomials import is_stable_polynomial
-from ...models.shared import MOST_INTEGRATORS, SharedDenominatorModel
+from ...models.shared import SharedDenominatorModel
 from ..linear.margin import AUTO, is_auto, max_radius
 from ..linear.modal import ModalParametrization
 from ..linear.varpro import ProjectedCost, gauss_newton_polish
+from .inputs import SharedInputsCost, equation_regressors, shared_integrators, summed
 
 __all__ = [
     "SHARED_METHODS",
@@ -73,42 +73,6 @@ def shared_options(method: str) -> tuple[str, ...]:
     """The options `identify` takes with `method` on a record of several
     outputs (one shared denominator)."""
     return ("rng", "predictor", "initial", "integrator", *SHARED_METHODS[method])
-
-
-def _integrators(integrators, p: int) -> tuple[int, ...]:
-    """Each output's count of known integrators: one count for all, or one
-    per output; a one-line ValueError otherwise."""
-    from ...models.polynomials import integrator_count
-
-    if integrators is None:
-        return (0,) * p
-    values = (
-        list(integrators)
-        if isinstance(integrators, list | tuple)
-        else [integrators] * p
-    )
-    if len(values) != p:
-        raise ValueError(
-            f"`integrator` must be one count or one per output ({p}); got "
-            f"{integrators!r}"
-        )
-    # Checked against the most a shared fit takes, not against a
-    # denominator's order: the shared A holds none of them.
-    counts = tuple(integrator_count(v, math.inf) for v in values)
-    if max(counts) > MOST_INTEGRATORS:
-        raise ValueError(
-            f"`integrator` must be at most {MOST_INTEGRATORS} known integrators per "
-            f"output; got {integrators!r}"
-        )
-    return counts
-
-
-def _summed(one: IOData, count: int) -> IOData:
-    """`one` with its input summed `count` times (the known integrators)."""
-    u = one.u
-    for _ in range(count):
-        u = np.cumsum(u)
-    return replace(one, u=u) if count else one
 
 
 class SharedProjectedCost:
@@ -137,9 +101,9 @@ class SharedProjectedCost:
     def __init__(self, arx: ARX, data: IOData, weights=None, integrators=None) -> None:
         self.arx = arx
         self.data = data
-        self.integrators = _integrators(integrators, data.n_outputs)
+        self.integrators = shared_integrators(integrators, data.n_outputs)
         self.parts = [
-            ProjectedCost(arx, _summed(data.output(i), k))
+            ProjectedCost(arx, summed(data.output(i), k))
             for i, k in enumerate(self.integrators)
         ]
         energy = np.array([float(np.sum(part.data.y**2)) for part in self.parts])
@@ -226,8 +190,8 @@ def _coordinates(theta_a, par: ModalParametrization, arx: ARX) -> np.ndarray:
 
 def _subspace_start(cost: SharedProjectedCost, par: ModalParametrization):
     """The subspace (PO-MOESP) poles of every output, in modal coordinates,
-    when the outputs share one input (the same integrators) and the record
-    is long enough; None otherwise."""
+    when the outputs share their inputs (the same integrators) and the
+    record is long enough; None otherwise."""
     from .subspace import subspace_denominator
 
     if len(set(cost.integrators)) != 1:
@@ -248,12 +212,15 @@ def _starts(cost: SharedProjectedCost, par: ModalParametrization) -> np.ndarray:
     from ...models.arx import arx_least_squares
 
     arx = cost.arx
+    # Several inputs: each output's least squares over all of them.
+    fit = arx_least_squares if cost.data.n_inputs == 1 else _one_joint
     return np.array(
-        [
-            _coordinates(arx_least_squares(part.data, arx)[: arx.na], par, arx)
-            for part in cost.parts
-        ]
+        [_coordinates(fit(part.data, arx)[: arx.na], par, arx) for part in cost.parts]
     )
+
+
+def _one_joint(one: IOData, arx: ARX) -> np.ndarray:
+    return joint_least_squares([one], arx)
 
 
 # The methods a record of several outputs takes, and the options of each
@@ -282,10 +249,14 @@ def identify_shared(
     Parameters
     ----------
     data : IOData
-        A record of ``p >= 2`` outputs (``y`` of shape (N, p)) from rest.
+        A record of ``p >= 2`` outputs (``y`` of shape (N, p)) from rest,
+        or of ``m >= 2`` inputs (``u`` of shape (N, m)) and any outputs:
+        then every output is ``y_i = sum_j B_ij / A u_j``, all ``p m``
+        numerators projected out
+        (:class:`~spiralid.sysid.estimation.shared.inputs.SharedInputsCost`).
     arx : ARX
-        Each output's structure: ``na`` shared poles, ``nb`` numerator
-        coefficients per output after ``nk`` delays.
+        Each input-output pair's structure: ``na`` shared poles, ``nb``
+        numerator coefficients per pair after ``nk`` delays.
     method : {"spiral", "oe", "ls"}
         ``"spiral"``: the spiral search over the shared modes (Eb-SDA over
         the modal coordinates, Gauss-Newton polish every 5 iterations,
@@ -333,10 +304,12 @@ def identify_shared(
         )
     n_points = integer(n_points, "n_points", 2)
     max_nfev = integer(max_nfev, "max_nfev", n_points)
-    first = SharedProjectedCost(arx, data, weights, integrator)
+    several = SharedInputsCost if data.n_inputs > 1 else SharedProjectedCost
+    first = several(arx, data, weights, integrator)
     if method == "ls":
         theta = joint_least_squares(_parts_record(first), arx, first.weights)
-        a, b = theta[: arx.na], theta[arx.na :].reshape(data.n_outputs, arx.nb)
+        a = theta[: arx.na]
+        b = theta[arx.na :].reshape(data.n_outputs, data.n_inputs * arx.nb)
         return _model(data, arx, "ls", first, a, b, None, {}, t0)
     par = ModalParametrization(
         arx.na, data.ts, max_radius=_radius(data, max_time_constant)
@@ -440,6 +413,9 @@ def _model(data, arx, method, cost, a, b, covariance, result, t0):
         input_name=data.input_name,
         input_unit=data.input_unit,
         u_offset=data.u_offset,
+        input_names=data.input_names,
+        input_units=data.input_units,
+        u_offsets=data.u_offsets,
         y_offsets=data.y_offsets,
         method=method,
         cost=float(cost(a)) if stable else float("nan"),
@@ -464,7 +440,8 @@ def joint_least_squares(data, arx: ARX, weights=None) -> np.ndarray:
     ``y_i(t) + sum_k a_k y_i(t-k) - sum_j b_ij u(t-nk-j)`` with one ``a``,
     each output's rows weighted by ``sqrt(lambda_i)``. `data` is a record
     of several outputs, or a list of single-output records (one per output,
-    each with its own input).
+    each with its own input). With several inputs ``b_i`` is ``[b_i1, ..,
+    b_im]``, one numerator per input.
 
     Examples
     --------
@@ -484,13 +461,19 @@ def joint_least_squares(data, arx: ARX, weights=None) -> np.ndarray:
     )
     p = len(records)
     weights = np.ones(p) if weights is None else np.asarray(weights, dtype=float)
+    # Several inputs: each output's numerators, input by input.
+    nb = records[0].n_inputs * arx.nb
     blocks, rhs = [], []
     for i, one in enumerate(records):
-        phi = arx.regressors(one)[arx.max_lag :]
+        phi = (
+            arx.regressors(one)[arx.max_lag :]
+            if one.n_inputs == 1
+            else equation_regressors(one, arx)
+        )
         w = np.sqrt(weights[i])
-        row = np.zeros((phi.shape[0], arx.na + p * arx.nb))
+        row = np.zeros((phi.shape[0], arx.na + p * nb))
         row[:, : arx.na] = phi[:, : arx.na]
-        row[:, arx.na + i * arx.nb : arx.na + (i + 1) * arx.nb] = phi[:, arx.na :]
+        row[:, arx.na + i * nb : arx.na + (i + 1) * nb] = phi[:, arx.na :]
         blocks.append(w * row)
         rhs.append(w * one.y[arx.max_lag :])
     return np.linalg.lstsq(np.vstack(blocks), np.concatenate(rhs), rcond=None)[0]
@@ -504,7 +487,7 @@ def _covariance(cost: SharedProjectedCost, a, data: IOData, arx: ARX):
     value below ``1e-12`` of the largest)."""
     if not is_stable_polynomial(a):
         return None
-    dof = data.n * data.n_outputs - arx.na - data.n_outputs * arx.nb
+    dof = data.n * data.n_outputs - arx.na - data.n_outputs * data.n_inputs * arx.nb
     if dof <= 0:
         return None
     rows, residual = [], []

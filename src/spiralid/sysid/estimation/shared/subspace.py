@@ -41,6 +41,25 @@ def _hankel(x: np.ndarray, rows: int, cols: int) -> np.ndarray:
     return out
 
 
+def _merged(poles: np.ndarray, n: int, copies: int) -> np.ndarray:
+    """The `n` poles that `poles` holds `copies` times each (the state of
+    several inputs over one denominator): neighbours by angle averaged in
+    groups of `copies`; a ValueError when they do not group so."""
+    upper = poles[poles.imag > 1e-9]
+    real = np.sort(poles[np.abs(poles.imag) <= 1e-9].real)
+    if upper.size % copies or real.size % copies:
+        raise ValueError(
+            f"the subspace poles do not come {copies} times each; got {poles}"
+        )
+    upper = upper[np.argsort(np.angle(upper))]
+    pairs = upper.reshape(-1, copies).mean(axis=1)
+    singles = real.reshape(-1, copies).mean(axis=1)
+    out = np.r_[pairs, pairs.conj(), singles]
+    if out.size != n:
+        raise ValueError(f"`n` = {n} poles do not fit the subspace's {poles}")
+    return out
+
+
 def subspace_denominator(
     data: IOData, n: int, horizon: int | None = None
 ) -> np.ndarray:
@@ -50,9 +69,12 @@ def subspace_denominator(
     Parameters
     ----------
     data : IOData
-        One input and one or several outputs.
+        One or several inputs and one or several outputs.
     n : int
-        The model order (number of poles).
+        The model order (number of poles). With ``m`` inputs and ``p``
+        outputs the state holds each pole ``min(m, p)`` times (one
+        denominator, several independent numerator columns); the copies
+        are merged (neighbours by angle averaged).
     horizon : int, optional
         Block rows of the past and future Hankel matrices; default
         ``max(2 n, n + 1)``.
@@ -81,18 +103,28 @@ def subspace_denominator(
     if not isinstance(data, IOData):
         raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     n = integer(n, "n", 1)
-    i = max(2 * n, n + 1) if horizon is None else integer(horizon, "horizon", n + 1)
-    u = data.u[:, None]
+    u = data.inputs
     y = data.outputs
-    p = y.shape[1]
+    p, m = y.shape[1], u.shape[1]
+    # Several inputs over one denominator: a state per pole and input (the
+    # McMillan degree of B(q) / A(q) with r = min(m, p) independent
+    # columns), each pole then seen r times.
+    copies = min(m, p)
+    states = n * copies
+    i = (
+        max(2 * states, states + 1)
+        if horizon is None
+        else integer(horizon, "horizon", states + 1)
+    )
+    channels = p + m
     cols = data.n - 2 * i + 1
-    if cols < 2 * i * (p + 1):
+    if cols < 2 * i * channels:
         raise ValueError(
-            f"`n` = {n} needs a longer record: {2 * i * (p + 1) + 2 * i - 1} samples "
-            f"for horizon {i}; got {data.n}"
+            f"`n` = {n} needs a longer record: {2 * i * channels + 2 * i - 1} "
+            f"samples for horizon {i}; got {data.n}"
         )
     uh, yh = _hankel(u, 2 * i, cols), _hankel(y, 2 * i, cols)
-    up, uf = uh[:i], uh[i:]
+    up, uf = uh[: i * m], uh[i * m :]
     yp, yf = yh[: i * p], yh[i * p :]
     stacked = np.vstack([uf, up, yp, yf]) / np.sqrt(cols)
     # LQ of the stacked matrix through QR of its transpose.
@@ -101,9 +133,11 @@ def subspace_denominator(
     # The future outputs' part along the past, orthogonal to the future inputs.
     l32 = r[nu + nw :, nu : nu + nw]
     left, sing, _ = np.linalg.svd(l32, full_matrices=False)
-    gamma = left[:, :n] * np.sqrt(sing[:n])
+    gamma = left[:, :states] * np.sqrt(sing[:states])
     a_state = np.linalg.lstsq(gamma[:-p], gamma[p:], rcond=None)[0]
     poles = np.linalg.eigvals(a_state)
+    if copies > 1:
+        poles = _merged(poles, n, copies)
     outside = np.abs(poles) >= 1.0
     poles[outside] = 1.0 / np.conj(poles[outside])
     return np.poly(poles).real[1:]
