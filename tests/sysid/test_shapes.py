@@ -125,3 +125,24 @@ def test_mode_shapes_refuse_a_wrong_factor_or_names():
         mode_shapes(A[1:], B[:, 1:], TS, nk=1, factor=np.eye(3))
     with pytest.raises(ValueError, match="`output_names` must name each of the 2"):
         mode_shapes(A[1:], B[:, 1:], TS, nk=1, output_names=("one",))
+
+
+def test_the_validation_and_the_report_show_the_shapes_and_their_mac():
+    from spiralid.report.shared_output import mac_table, shapes_table
+    from spiralid.sysid import validate
+
+    est, val = record(6).split(2 / 3)
+    fit = identify(est, ARX(4, 4, 1), method="oe")
+    v = validate(fit, val, warmup=est)
+    assert v.mode_shapes is not None and len(v.mode_shapes) == 2
+    text = v.summary()
+    assert "Mode shapes over the outputs" in text and "MAC between the modes" in text
+    assert "Mode shapes" not in v.summary(modes=False)
+    shapes = v.to_dict()["shapes"]
+    assert shapes["output_names"] == ["near", "far"]
+    np.testing.assert_allclose(shapes["auto_mac"], fit.shapes.auto_mac)
+    head, rows = shapes_table(fit.shapes)
+    assert head[:2] == ["mode", "frequency (Hz)"] and len(rows) == 2
+    assert rows[0][2].startswith(f"{fit.shapes.shapes[0, 0].real:+.3f} +- ")
+    head, rows = mac_table([[1.0, 0.5], [0.5, 1.0]])
+    assert head == ["MAC", "1", "2"] and rows[1] == ["2", "0.500", "1.000"]
