@@ -120,6 +120,13 @@ def test_least_squares_shapes_have_no_interval():
     assert np.isnan(fit.shapes.real_se).all()
 
 
+def test_a_denominator_without_a_complex_pair_has_no_shapes():
+    shapes = mode_shapes([-0.5], [[1.0], [2.0]], TS, nk=1)
+    assert len(shapes) == 0 and shapes.shapes.shape == (0, 2)
+    assert shapes.auto_mac.shape == (0, 0)
+    assert str(shapes).startswith("no modes")
+
+
 def test_mode_shapes_refuse_a_wrong_factor_or_names():
     with pytest.raises(ValueError, match="`factor` must have 12 columns"):
         mode_shapes(A[1:], B[:, 1:], TS, nk=1, factor=np.eye(3))

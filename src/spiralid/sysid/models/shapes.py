@@ -295,8 +295,9 @@ class ModeShapes:
     @property
     def auto_mac(self) -> np.ndarray:
         """Shape (m, m): the MAC between every two modes (1 on the
-        diagonal; off it, how alike two modes look to these sensors)."""
-        return mac(self.shapes)
+        diagonal; off it, how alike two modes look to these sensors);
+        empty without modes."""
+        return mac(self.shapes) if len(self) else np.zeros((0, 0))
 
     def mac(self, reference) -> np.ndarray:
         """The MAC of each mode's shape with each reference shape.
