@@ -126,3 +126,32 @@ def test_the_experiment_adds_a_shaker_half_a_period_after_each_torque_pulse():
     assert paper_experiment().force() is None
     with pytest.raises(ValueError, match="`force_at` must be a fraction"):
         replace(paper_experiment(), force_at=-0.1)
+
+
+@pytest.mark.parametrize("force_at", [None, 0.6])
+def test_the_rigs_residues_are_the_fems_shapes_at_the_sensors(force_at):
+    # The reference the mode shapes are compared with: the exact sampled
+    # rig's residues at each mode's pole, over accelerometers (through the
+    # anti-aliasing filter) and deflection sensors, are the FEM's inertial
+    # and hub-frame shapes at their positions up to one complex factor,
+    # from the torque and from the shaker alike.
+    from spiralid.fms.rig import _discrete
+    from spiralid.sysid.models.shapes import mac
+
+    rig = FlexibleManipulator()
+    at = (0.25, 0.5, 0.75, 1.0)
+    ts = 1 / 500
+    Ad, Bd, C, _, _ = _discrete(rig, ts, 4, 0.35, at, at, force_at)
+    lam, vec = np.linalg.eig(Ad)
+    left = np.linalg.inv(vec)
+    for k, f in enumerate(rig.modes(3), 1):
+        pole = np.exp(2 * np.pi * f * ts * (-0.02 + 1j * np.sqrt(1 - 0.02**2)))
+        i = int(np.argmin(np.abs(lam - pole)))
+        assert abs(lam[i] - pole) < 1e-9
+        residues = (C @ vec[:, i]) * (left[i] @ Bd)
+        hub = rig.mode_shape(k, at)
+        inertial = rig.mode_shape(k, at, frame="inertial")
+        assert mac(residues[4:8], hub)[0, 0] == pytest.approx(1.0, abs=1e-10)
+        assert mac(residues[8:], inertial)[0, 0] == pytest.approx(1.0, abs=1e-10)
+        # Not a MAC that is 1 for anything: the other frame's shape is off.
+        assert mac(residues[8:], hub)[0, 0] < 0.999
