@@ -126,6 +126,8 @@ def test_the_experiment_adds_a_shaker_half_a_period_after_each_torque_pulse():
     assert paper_experiment().force() is None
     with pytest.raises(ValueError, match="`force_at` must be a fraction"):
         replace(paper_experiment(), force_at=-0.1)
+    with pytest.raises(ValueError, match="`force_amplitude` must be a finite"):
+        replace(paper_experiment(), force_at=0.6, force_amplitude=np.nan)
 
 
 @pytest.mark.parametrize("force_at", [None, 0.6])

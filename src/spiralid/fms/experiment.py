@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid._checks import integer, positive
+from spiralid._checks import integer, positive, real
 from spiralid.fms.rig import FlexibleManipulator, Recording, _position
 from spiralid.fms.sensors import Sensors
 from spiralid.fms.signals import _nsamples, bang_bang
@@ -86,6 +86,7 @@ class Experiment:
             )
         # Validate the rest by building the signals once.
         self.torque()
+        real(self.force_amplitude, "force_amplitude")
         if self.force_at is not None:
             object.__setattr__(self, "force_at", _position(self.force_at, "force_at"))
             self.force()
