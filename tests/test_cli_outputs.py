@@ -90,6 +90,14 @@ def test_the_report_holds_the_modes_the_fits_and_the_diagram(made):
         assert f"share in {name} (%)" in page
         share = model["modes"]["share_by_output"][name][0]
         assert f"{100 * share:.1f}" in cells
+    # Each mode's shape over the outputs (real part and half width) and the
+    # MAC matrix between the modes, as validation.json holds them.
+    shapes = checked["validation"]["shapes"]
+    assert "<h2>Mode shapes</h2>" in page
+    assert len(shapes["modes"]) == len(modes)
+    first = shapes["modes"][0]
+    assert any(c.startswith(f"{first['shape_real'][0]:+.3f} +- ") for c in cells)
+    assert f"{shapes['auto_mac'][0][1]:.3f}" in cells
     # Each output's fit on both parts and the joint fit.
     for part in ("estimation", "validation"):
         for name, v in checked[part]["outputs"].items():

@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from spiralid._checks import integer, positive
-from spiralid.fms.rig import FlexibleManipulator, Recording
+from spiralid._checks import integer, positive, real
+from spiralid.fms.rig import FlexibleManipulator, Recording, _position
 from spiralid.fms.sensors import Sensors
 from spiralid.fms.signals import _nsamples, bang_bang
 
@@ -49,6 +49,14 @@ class Experiment:
       outputs ``deflection_<x>`` and ``acceleration_<x>`` (see
       :class:`~spiralid.fms.sensors.Sensors`), and leave the four channels
       and their noise as without them.
+    - ``force_at = None``: no shaker. A position (a fraction of the length
+      in (0, 1]) adds a second input, a shaker's force there
+      (:meth:`force`): a train of ``n_pulses`` bang-bang pulses of
+      ``force_amplitude`` (default 1 N: at 0.6 of the length its moment
+      about the hub, 0.54 N m, is of the torque's order) and the torque's
+      width, each half a period after a torque pulse: with a period of at
+      least four widths (the default's is 25) the two inputs never act at
+      once.
     """
 
     amplitude: float = 0.3
@@ -62,6 +70,8 @@ class Experiment:
     tach_noise: float = 0.01
     deflection_at: tuple[float, ...] = ()
     acceleration_at: tuple[float, ...] = ()
+    force_at: float | None = None
+    force_amplitude: float = 1.0
 
     def __post_init__(self) -> None:
         integer(self.n_pulses, "n_pulses", 1)
@@ -74,8 +84,12 @@ class Experiment:
                 f"`period` must be finite and >= 2 * width = {2 * self.width:g}; "
                 f"got {self.period!r}"
             )
-        # Validate the rest by building the signal once.
+        # Validate the rest by building the signals once.
         self.torque()
+        real(self.force_amplitude, "force_amplitude")
+        if self.force_at is not None:
+            object.__setattr__(self, "force_at", _position(self.force_at, "force_at"))
+            self.force()
         sensors = self.sensors()
         object.__setattr__(self, "deflection_at", sensors.deflection_at)
         object.__setattr__(self, "acceleration_at", sensors.acceleration_at)
@@ -100,6 +114,31 @@ class Experiment:
             )
         return u
 
+    def force(self) -> np.ndarray | None:
+        """The shaker's force record (N), sampled at ``fs``: pulse ``j``
+        starts half a period after torque pulse ``j``, with its sign; None
+        without a shaker (``force_at`` None).
+
+        Examples
+        --------
+        >>> from dataclasses import replace
+        >>> f = replace(paper_experiment(), force_at=0.6).force()
+        >>> f.size, float(f.max()), int(np.argmax(f != 0)) / 500
+        (3000, 1.0, 0.6)
+        """
+        if self.force_at is None:
+            return None
+        f = np.zeros(_nsamples(self.duration, self.fs))
+        for j in range(self.n_pulses):
+            f += (-1) ** j * bang_bang(
+                self.force_amplitude,
+                self.width,
+                self.start + (j + 0.5) * self.period,
+                self.duration,
+                self.fs,
+            )
+        return f
+
     def sensors(self) -> Sensors:
         """Default sensors with this experiment's noise levels and sensors
         along the beam."""
@@ -111,7 +150,8 @@ class Experiment:
         )
 
     def run(self, rig: FlexibleManipulator | None = None, rng=None) -> Recording:
-        """Simulate the experiment on ``rig`` (default rig if None).
+        """Simulate the experiment on ``rig`` (default rig if None): the
+        torque, and the shaker's force when ``force_at`` is set.
 
         Examples
         --------
@@ -123,7 +163,18 @@ class Experiment:
             rig = FlexibleManipulator()
         elif not isinstance(rig, FlexibleManipulator):
             raise TypeError(f"`rig` must be a FlexibleManipulator or None; got {rig!r}")
-        return rig.simulate(self.torque(), fs=self.fs, rng=rng, sensors=self.sensors())
+        if self.force_at is None:
+            return rig.simulate(
+                self.torque(), fs=self.fs, rng=rng, sensors=self.sensors()
+            )
+        return rig.simulate(
+            self.torque(),
+            fs=self.fs,
+            rng=rng,
+            sensors=self.sensors(),
+            force=self.force(),
+            force_at=self.force_at,
+        )
 
 
 def paper_experiment() -> Experiment:

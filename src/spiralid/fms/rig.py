@@ -22,7 +22,7 @@ documented there.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property, lru_cache
 
 import numpy as np
@@ -35,6 +35,7 @@ from spiralid._checks import (
     nonneg,
     one_of,
     positive,
+    real,
     real_array,
 )
 from spiralid.fms._zoh import discretise_zoh, simulate_discrete
@@ -44,6 +45,9 @@ from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
 __all__ = ["FlexibleManipulator", "Recording", "nonlinear_rig"]
 
 _OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
+# The rig's inputs: the hub torque, and a shaker's force on the beam.
+_INPUTS = ("torque", "force")
+_INPUT_UNITS = {"torque": "N m", "force": "N"}
 _UNITS = {
     "hub_angle": "rad",
     "hub_velocity": "rad/s",
@@ -97,6 +101,11 @@ class Recording:
         Their accelerations ``x theta'' + w''(x)`` as the accelerometers
         report them (m/s^2), shape ``(N, len(acceleration_at))``; None
         without them.  Column ``j`` is the output ``acceleration_<x_j>``.
+    force : ndarray or None
+        A shaker's force (N), the second input, when the experiment had one
+        (:meth:`FlexibleManipulator.simulate`'s `force`); None otherwise.
+    force_at : float or None
+        Where it acted, a fraction of the length.
     """
 
     t: np.ndarray
@@ -111,6 +120,14 @@ class Recording:
     deflection: np.ndarray | None = None
     acceleration_at: tuple[float, ...] = ()
     acceleration: np.ndarray | None = None
+    force: np.ndarray | None = None
+    force_at: float | None = None
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        """The inputs :meth:`iodata` takes: ``"torque"``, and ``"force"``
+        when a shaker drove the beam too."""
+        return _INPUTS if self.force is not None else _INPUTS[:1]
 
     @property
     def output_names(self) -> tuple[str, ...]:
@@ -130,16 +147,19 @@ class Recording:
             return self.deflection[:, k]
         return self.acceleration[:, k - len(self.deflection_at)]
 
-    def iodata(self, name: str | list[str] = "end_acceleration"):
-        """The torque and one output channel, or several, as a
-        :class:`spiralid.IOData`.
+    def iodata(self, name: str | list[str] = "end_acceleration", input: str = "torque"):
+        """The torque (or the shaker's force) and one output channel, or
+        several, as a :class:`spiralid.IOData`.
 
         `name` is one of the recorded outputs (``"hub_angle"``,
         ``"hub_velocity"``, ``"end_acceleration"``, ``"tip_deflection"``, and
         ``"deflection_<x>"`` for each deflection sensor, see
         :attr:`output_names`), or a list of them: a record of several
         outputs that share the torque (``y`` of shape (N, p), each output
-        with its own name and unit).
+        with its own name and unit). `input` is one of
+        :attr:`input_names`: ``"torque"`` (N m), or ``"force"`` (N) of a
+        record with a shaker, whose outputs respond to both (an IOData of
+        one input holds the other's response as disturbance).
 
         ``spiralid.sysid.data`` is imported here, inside the method: it is the
         one sanctioned dependency of ``fms`` on the rest of the package, kept
@@ -158,6 +178,7 @@ class Recording:
         """
         from spiralid.sysid.data import IOData
 
+        one_of(input, "input", self.input_names)
         names = list(name) if isinstance(name, list | tuple) else [name]
         known = self.output_names
         for one in names:
@@ -167,12 +188,12 @@ class Recording:
         several = len(names) > 1
         y = [self._output(one) for one in names]
         return IOData(
-            self.u,
+            self.u if input == "torque" else self.force,
             np.column_stack(y) if several else y[0],
             ts=self.ts,
-            input_name="torque",
+            input_name=input,
             output_name=tuple(names) if several else names[0],
-            input_unit="N m",
+            input_unit=_INPUT_UNITS[input],
             output_unit=tuple(_unit(one) for one in names)
             if several
             else _unit(names[0]),
@@ -460,6 +481,42 @@ class FlexibleManipulator:
             rows[k, cols] = shape[k, 4 - cols.size :]
         return rows
 
+    def load_vector(self, position: float) -> np.ndarray:
+        """The generalised force of a unit point force at a point of the
+        beam: the consistent load vector of a shaker.
+
+        The force (1 N) acts at the fraction `position` of the length, in
+        the plane of motion, perpendicular to the undeformed beam, and is
+        fixed in space (a shaker's stinger), so it does the virtual work
+        ``delta W = x L delta theta + w(x L)`` of the point's displacement
+        in the inertial frame (:meth:`mode_shape`'s ``"inertial"``): the
+        hub angle's entry is its moment ``x L`` about the axis, and the
+        nodal entries are the Hermite shape functions of the element that
+        holds the point (:meth:`deflection_rows`), the consistent loads.
+
+        Parameters
+        ----------
+        position : float
+            Fraction of the length from the hub, in (0, 1].
+
+        Returns
+        -------
+        ndarray, shape (ndof,)
+
+        Examples
+        --------
+        At a node the load is that node's deflection alone, plus its moment
+        about the hub:
+
+        >>> rig = FlexibleManipulator(n_elements=4, length=1.0)
+        >>> rig.load_vector(0.5).round(12).tolist()
+        [0.5, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        """
+        x = _position(position, "position")
+        load = self.deflection_rows([x])[0]
+        load[0] += x * self.length
+        return load
+
     def mode_shape(self, mode: int, positions, *, frame: str = "hub") -> np.ndarray:
         """The deflection of a flexible mode along the beam, scaled so that
         its largest magnitude on the beam is 1.
@@ -565,6 +622,7 @@ class FlexibleManipulator:
         deflection_at: tuple[float, ...] = (),
         acceleration_at: tuple[float, ...] = (),
         n_modes: int | None = None,
+        force_at: float | None = None,
     ) -> tuple[np.ndarray, ...]:
         """Continuous model in modal coordinates, scaled for the exponential.
 
@@ -576,7 +634,9 @@ class FlexibleManipulator:
         deflection at each of `deflection_at` and the acceleration at each
         of `acceleration_at`, plus the velocity scaling. With `n_modes`, only
         the rigid mode and the first `n_modes` flexible ones are kept (a
-        modal truncation: the grey box's reduced model).
+        modal truncation: the grey box's reduced model). The input is the
+        hub torque, or with `force_at` a point force there
+        (:meth:`load_vector`): ``B`` and ``D`` are that input's.
         """
         omega, phi = self._modal
         if n_modes is not None:
@@ -585,6 +645,8 @@ class FlexibleManipulator:
         scale = omega.copy()
         scale[0] = 1.0
         g = phi[0]  # hub torque's modal participation
+        # The input's participation: the torque's, or the force's load.
+        gi = g if force_at is None else phi.T @ self.load_vector(force_at)
         cm = np.diag(2.0 * self.damping_ratio * omega) + self.hub_friction * np.outer(
             g, g
         )
@@ -592,7 +654,7 @@ class FlexibleManipulator:
         A[:n, n:] = np.diag(scale)
         A[n:, :n] = -np.diag(omega**2 / scale)
         A[n:, n:] = -(cm * scale[None, :]) / scale[:, None]
-        B = np.concatenate([np.zeros(n), g / scale])
+        B = np.concatenate([np.zeros(n), gi / scale])
         tip = phi[self.ndof - 2]
         h = self.length * phi[0] + tip  # end point's share of each mode
         nd = len(deflection_at)
@@ -602,7 +664,7 @@ class FlexibleManipulator:
         C[1, n:] = g * scale
         C[2, :n] = -h * omega**2
         C[2, n:] = -(h @ cm) * scale
-        D[2] = h @ g
+        D[2] = h @ gi
         C[3, :n] = tip
         if deflection_at:
             C[4 : 4 + nd, :n] = self.deflection_rows(deflection_at) @ phi
@@ -612,7 +674,7 @@ class FlexibleManipulator:
             hx = np.outer(x, self.length * phi[0]) + self.deflection_rows(x) @ phi
             C[4 + nd :, :n] = -hx * omega**2
             C[4 + nd :, n:] = -(hx @ cm) * scale
-            D[4 + nd :] = hx @ g
+            D[4 + nd :] = hx @ gi
         return A, B, C, D, scale
 
     def simulate(
@@ -624,8 +686,11 @@ class FlexibleManipulator:
         sensors: Sensors | None = None,
         x0=None,
         return_state: bool = False,
+        force=None,
+        force_at: float | None = None,
     ) -> Recording:
-        """Drive the hub with a sampled torque held constant between samples.
+        """Drive the hub with a sampled torque held constant between samples,
+        and optionally the beam with a shaker's force.
 
         The continuous model (plus the anti-aliasing filters) is discretised
         exactly for a zero-order hold, ``Ad = e^{A ts}``, ``Bd = int e^{As} ds
@@ -651,6 +716,16 @@ class FlexibleManipulator:
             Anti-aliasing filters start at rest.
         return_state : bool
             Also return the exact ``(q, q')`` at every sample.
+        force : array_like, shape (N,), optional
+            A second input: a shaker's force in N at ``t = k / fs``, held
+            for one sample, as many samples as `torque`, acting at
+            `force_at` (:meth:`load_vector`). Its response is added to the
+            torque's (the linear rig's superposition); the torque limit
+            does not clip it, and a rig with hub friction refuses it.
+            Default none: the record is exactly as without this option.
+        force_at : float, optional
+            Where the force acts, a fraction of the length in (0, 1];
+            required with `force`.
 
         Returns
         -------
@@ -676,10 +751,13 @@ class FlexibleManipulator:
             raise TypeError(
                 f"`return_state` must be True or False; got {return_state!r}"
             )
+        shaker = self._shaker(force, force_at, u.size)
         # Checked even without noise, so a bad seed never goes unnoticed.
         gen = generator(rng)
         ts = 1.0 / fs_v
         y, s, scale = self._outputs(u, x0v, ts, sensors, return_state)
+        if shaker is not None:
+            y, s = self._add_force(y, s, shaker, ts, sensors)
         if not np.all(np.isfinite(y)):
             # Only absurd inputs get here (a sample time of 1e300 s, torques
             # near the float limit): say so rather than return NaN.
@@ -692,7 +770,51 @@ class FlexibleManipulator:
         if s is not None:
             n, phi = self.ndof, self._modal[1]
             state = np.hstack([s[:, :n] @ phi.T, (s[:, n : 2 * n] * scale) @ phi.T])
-        return _recording(u, y, ts, sensors, gen, state)
+        recording = _recording(u, y, ts, sensors, gen, state)
+        if shaker is None:
+            return recording
+        return replace(recording, force=shaker[0].copy(), force_at=shaker[1])
+
+    def _shaker(self, force, force_at, n: int) -> tuple[np.ndarray, float] | None:
+        """`force` and `force_at` of :meth:`simulate` checked: None without
+        a force, else the force as a 1-D array of `n` finite samples and
+        its position."""
+        if force is None:
+            if force_at is not None:
+                raise ValueError("`force_at` needs a `force` to place; got no force")
+            return None
+        if force_at is None:
+            raise ValueError("`force` needs `force_at`, where along the beam it acts")
+        if self.has_friction:
+            raise ValueError(
+                "`force` is simulated on the linear rig only (superposition); "
+                "this rig has hub friction"
+            )
+        f = _torque(force, "force").copy()
+        if f.size != n:
+            raise ValueError(
+                f"`force` must have as many samples as `torque` ({n}); got shape "
+                f"{np.shape(force)}"
+            )
+        return f, _position(force_at, "force_at")
+
+    def _add_force(self, y, s, shaker, ts: float, sensors: Sensors):
+        """The outputs (and modal states) with the force's response, from
+        rest, added: the rig is linear without friction."""
+        force, at = shaker
+        Ad, Bd, C, D, _ = _discrete(
+            self,
+            ts,
+            sensors.antialias_order,
+            sensors.antialias_cutoff,
+            sensors.deflection_at,
+            sensors.acceleration_at,
+            force_at=at,
+        )
+        yf, sf = simulate_discrete(
+            Ad, Bd, C, D, force, np.zeros(Ad.shape[0]), s is not None
+        )
+        return y + yf, (None if s is None else s + sf)
 
     def _outputs(
         self,
@@ -800,23 +922,37 @@ def nonlinear_rig(**overrides) -> FlexibleManipulator:
     return FlexibleManipulator(**fields)
 
 
-def _torque(torque) -> np.ndarray:
-    """`torque` of :meth:`FlexibleManipulator.simulate` as a finite,
-    non-empty 1-D float array (an (N, 1) column is flattened)."""
-    u = real_array(torque, "torque")
+def _torque(torque, name: str = "torque") -> np.ndarray:
+    """`torque` (or the input `name`) of :meth:`FlexibleManipulator.simulate`
+    as a finite, non-empty 1-D float array (an (N, 1) column is flattened)."""
+    u = real_array(torque, name)
     if u.ndim == 2 and u.shape[1] == 1:
         u = u[:, 0]
     if u.ndim != 1 or u.size == 0:
         raise ValueError(
-            "`torque` must be a non-empty 1-D array or (N, 1); "
+            f"`{name}` must be a non-empty 1-D array or (N, 1); "
             f"got shape {np.shape(torque)}"
         )
     if not np.all(np.isfinite(u)):
         bad = int(np.flatnonzero(~np.isfinite(u))[0])
         raise ValueError(
-            f"`torque` must be finite; got {float(u[bad])!r} at index {bad}"
+            f"`{name}` must be finite; got {float(u[bad])!r} at index {bad}"
         )
     return u
+
+
+def _position(value, name: str) -> float:
+    """`value` as a fraction of the beam's length in (0, 1]."""
+    what = f"`{name}` must be a fraction of the length in (0, 1]; got {value!r}"
+    try:
+        x = real(value, name)
+    except TypeError:
+        raise TypeError(what) from None
+    except ValueError:
+        x = math.nan
+    if not 0.0 < x <= 1.0:
+        raise ValueError(what)
+    return x
 
 
 def _initial_state(x0, n: int) -> np.ndarray:
@@ -873,11 +1009,13 @@ def _discrete(
     deflection_at: tuple[float, ...] = (),
     acceleration_at: tuple[float, ...] = (),
     n_modes: int | None = None,
+    force_at: float | None = None,
 ) -> tuple[np.ndarray, ...]:
     """Exact ZOH model of the rig plus anti-aliasing filters (cached); the
-    sensors along the beam are outputs after the four channels."""
+    sensors along the beam are outputs after the four channels; the input
+    is the hub torque, or a point force at `force_at`."""
     A, B, C, D, scale = _continuous(
-        rig, ts, order, cutoff, deflection_at, acceleration_at, n_modes
+        rig, ts, order, cutoff, deflection_at, acceleration_at, n_modes, force_at
     )
     Ad, Bd = discretise_zoh(A, B, ts)
     for arr in (Ad, Bd, C, D, scale):
@@ -893,12 +1031,14 @@ def _continuous(
     deflection_at: tuple[float, ...] = (),
     acceleration_at: tuple[float, ...] = (),
     n_modes: int | None = None,
+    force_at: float | None = None,
 ) -> tuple[np.ndarray, ...]:
     """The continuous model :func:`_discrete` samples: the rig's plant
-    (`n_modes` flexible modes, all by default) with an anti-aliasing filter
-    of `order` in front of each analogue channel (`cutoff` a fraction of
-    the Nyquist frequency of `ts`)."""
-    A, B, C, D, scale = rig._plant(deflection_at, acceleration_at, n_modes)
+    (`n_modes` flexible modes, all by default; the input a point force at
+    `force_at`, or the hub torque) with an anti-aliasing filter of `order`
+    in front of each analogue channel (`cutoff` a fraction of the Nyquist
+    frequency of `ts`)."""
+    A, B, C, D, scale = rig._plant(deflection_at, acceleration_at, n_modes, force_at)
     if order > 0:
         af, bf, cf = butterworth_ss(order, cutoff * 0.5 / ts)
         npl = A.shape[0]

@@ -2,7 +2,8 @@
 
 ``spiralid identify --output a,b,...`` writes ``report.html`` from
 :func:`write_shared_report`: the shared modes with their 95 % intervals and
-each one's share in each output, every output's fit on both parts and the
+each one's share in each output, the modes' shapes over the outputs and
+their MAC matrix, every output's fit on both parts and the
 joint fit, each output's validation figures, and a stabilisation diagram
 over a range of orders. The numbers are computed in :mod:`spiralid.sysid`
 (the model's ``modes``, ``validate``, ``stabilisation``); this
@@ -29,8 +30,10 @@ __all__ = [
     "every_sensor_section",
     "fit_percents_table",
     "fits_table",
+    "mac_table",
     "modes_table",
     "output_stems",
+    "shapes_table",
     "shared_report",
     "write_shared_report",
 ]
@@ -92,6 +95,64 @@ def modes_table(modes) -> tuple[list[str], list[list[str]]]:
                 "; ".join(t.notes(i)),
             ]
         )
+    return header, rows
+
+
+def shapes_table(shapes) -> tuple[list[str], list[list[str]]]:
+    """The header and rows of a :class:`~spiralid.sysid.models.shapes.ModeShapes`:
+    each mode's frequency and each output's normalised component (real
+    part, unit norm, the largest positive) with its 95 % interval's half
+    width; the imaginary parts, small for a lightly damped mode, are left
+    to the model's ``shapes``.
+
+    Parameters
+    ----------
+    shapes : ModeShapes
+        ``model.shapes`` of a shared-denominator model.
+
+    Returns
+    -------
+    header : list of str
+    rows : list of list of str
+    """
+    pct = round(100 * shapes.level)
+    header = [
+        "mode",
+        "frequency (Hz)",
+        *(f"{name} [+- {pct} %]" for name in shapes.output_names),
+    ]
+    half = shapes.real_interval[..., 1] - shapes.shapes.real
+    rows = [
+        [
+            str(r + 1),
+            f"{shapes.frequency[r]:.4g}",
+            *(
+                f"{shapes.shapes[r, i].real:+.3f}"
+                + (f" +- {half[r, i]:.3f}" if np.isfinite(half[r, i]) else "")
+                for i in range(len(shapes.output_names))
+            ),
+        ]
+        for r in range(len(shapes))
+    ]
+    return header, rows
+
+
+def mac_table(matrix) -> tuple[list[str], list[list[str]]]:
+    """The header and rows of a MAC matrix (modes numbered from 1).
+
+    Parameters
+    ----------
+    matrix : array_like, shape (m, k)
+        MAC values, e.g. ``model.shapes.auto_mac``.
+
+    Returns
+    -------
+    header : list of str
+    rows : list of list of str
+    """
+    matrix = np.asarray(matrix, dtype=float)
+    header = ["MAC", *(str(k + 1) for k in range(matrix.shape[1]))]
+    rows = [[str(i + 1), *(f"{v:.3f}" for v in row)] for i, row in enumerate(matrix)]
     return header, rows
 
 
@@ -380,6 +441,7 @@ def shared_report(
         "integrators are taken out): a sensor near a node of a mode barely "
         "sees it. An interval shown as - has no covariance behind it.</p>",
         table(m_head, m_rows, "html"),
+        *_shapes_parts(model),
         "<h2>Fits</h2><p>Free-run fit (MATLAB's compare fit) of each output's "
         "transfer function on the estimation part and, run on from it, the "
         "validation part; the joint fit is 100 (1 - sqrt(mean_i (1 - "
@@ -406,6 +468,27 @@ def shared_report(
             parts.append(figure(title, data_png, caption))
             images[stem] = data_png
     return page(headline, parts), images
+
+
+def _shapes_parts(model) -> list[str]:
+    """The report's mode shapes and MAC matrix (none without modes)."""
+    shapes = model.shapes
+    if not len(shapes):
+        return []
+    return [
+        "<h2>Mode shapes</h2><p>Each mode's shape over the outputs: every "
+        "output's residue at the mode's pole, normalised to unit norm with "
+        "the largest component real and positive (real parts shown; a "
+        "lightly damped mode's shape is nearly real), with 95 % intervals "
+        "from the covariance of every parameter (delta method). The norm "
+        "adds the outputs in their own units: compare shapes over sensors "
+        "of one quantity. The MAC (modal assurance criterion) of two modes "
+        "is |phi_a<sup>H</sup> phi_b|<sup>2</sup> / (|phi_a|<sup>2</sup> "
+        "|phi_b|<sup>2</sup>): near 1, these sensors cannot tell the two "
+        "apart.</p>",
+        table(*shapes_table(shapes), "html"),
+        table(*mac_table(shapes.auto_mac), "html"),
+    ]
 
 
 def write_shared_report(staged: Path, model, v_est, v_val, **kwargs) -> None:

@@ -38,6 +38,9 @@ from .models.polynomials import random_stable_polynomial as random_stable_polyno
 from .models.polynomials import step_down as step_down
 from .models.polynomials import step_up as step_up
 from .models.protocol import FittedModelProtocol as FittedModelProtocol
+from .models.shapes import ModeShapes as ModeShapes
+from .models.shapes import mac as mac
+from .models.shapes import mode_shapes as mode_shapes
 from .models.shared import SharedDenominatorModel as SharedDenominatorModel
 from .models.shared import SharedModes as SharedModes
 
@@ -82,6 +85,7 @@ __all__ = [
     "IdentifiedModel",
     "LinearGreyBoxModel",
     "ModalParametrization",
+    "ModeShapes",
     "ModeTable",
     "NARXModel",
     "NonlinearChecks",
@@ -113,7 +117,9 @@ __all__ = [
     "joint_fit",
     "knee_point",
     "load_model",
+    "mac",
     "max_pole_radius",
+    "mode_shapes",
     "modes_from_poles",
     "projected_spiral",
     "psd",

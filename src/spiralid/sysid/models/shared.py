@@ -33,6 +33,7 @@ from .fitted import Provenance
 from .identified import IdentifiedModel, python_control
 from .modes import ModeTable, interval_format, mode_table
 from .polynomials import is_stable_polynomial, max_pole_radius, with_integrator
+from .shapes import ModeShapes, mode_shapes
 
 __all__ = ["MOST_INTEGRATORS", "SharedDenominatorModel", "SharedModes"]
 
@@ -157,6 +158,11 @@ class SharedDenominatorModel(Provenance):
     result : dict
         What the estimator reports (budget, messages); the model file keeps
         its scalars.
+    shape_factor : ndarray or None, shape (k, na + p nb)
+        A square-root factor of the covariance of every parameter
+        (:attr:`params`), for the mode shapes' intervals
+        (:attr:`shapes`); not saved in model.json (a model read back has
+        shapes without intervals).
     predictor, initial : str
         ``"simulation"`` and ``"rest"``: the joint cost is the outputs'
         free-run error from rest.
@@ -202,6 +208,7 @@ class SharedDenominatorModel(Provenance):
     input_names: tuple[str, ...] = ()
     input_units: tuple[str, ...] = ()
     u_offsets: tuple[float, ...] = ()
+    shape_factor: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self._check_provenance()
@@ -396,6 +403,27 @@ class SharedDenominatorModel(Provenance):
         )
         strongest = int(np.argmax(np.nansum(share, axis=0))) if share.size else 0
         return SharedModes(tables[strongest], share, self.output_names)
+
+    @property
+    def shapes(self) -> ModeShapes:
+        """The shapes of :attr:`modes` over the outputs, from each output's
+        residues, with 95 % intervals (:func:`~.shapes.mode_shapes`); one
+        input only."""
+        if self.n_inputs > 1:
+            raise ValueError(
+                "mode shapes are computed for a model of one input; this one has "
+                f"{self.n_inputs} ({', '.join(self.input_names)})"
+            )
+        return mode_shapes(
+            self.a,
+            self.b,
+            self.ts,
+            nk=self.arx.nk,
+            integrators=self.integrators,
+            factor=self.shape_factor,
+            output_names=self.output_names,
+            poles=self.modes.table.poles,
+        )
 
     def tf_string(self, digits: int = 4) -> str:
         """Each output's transfer function in z (:meth:`output_model`'s),

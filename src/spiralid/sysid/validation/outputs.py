@@ -21,7 +21,13 @@ import numpy as np
 
 from ..data import IOData
 
-__all__ = ["check_output_records", "joint_dict", "joint_fit", "joint_summary"]
+__all__ = [
+    "check_output_records",
+    "joint_dict",
+    "joint_fit",
+    "joint_summary",
+    "mac_text",
+]
 
 
 def joint_fit(fits) -> float:
@@ -72,7 +78,35 @@ def joint_summary(v, modes: bool = True) -> str:
     lines.append(f"joint fit %{' ' * (width - 2)}  {v.fit_percent:8.2f}")
     if modes and v.mode_table is not None:
         lines += ["", "Shared modes (share of each output's peaks)", str(v.mode_table)]
+    shapes = v.mode_shapes
+    if modes and shapes is not None and len(shapes):
+        lines += ["", "Mode shapes over the outputs (from the residues)", str(shapes)]
+        lines += ["", "MAC between the modes", mac_text(shapes.auto_mac)]
     return "\n".join(lines)
+
+
+def mac_text(matrix) -> str:
+    """A MAC matrix as plain text, modes numbered from 1.
+
+    Parameters
+    ----------
+    matrix : array_like, shape (m, k)
+        MAC values in [0, 1].
+
+    Examples
+    --------
+    >>> print(mac_text([[1.0, 0.25], [0.25, 1.0]]))
+    mode      1      2
+       1  1.000  0.250
+       2  0.250  1.000
+    """
+    matrix = np.asarray(matrix, dtype=float)
+    head = "mode" + "".join(f"{k + 1:>7}" for k in range(matrix.shape[1]))
+    rows = [
+        f"{i + 1:>4}" + "".join(f"{v:7.3f}" for v in row)
+        for i, row in enumerate(matrix)
+    ]
+    return "\n".join([head, *rows])
 
 
 def joint_dict(v) -> dict:
@@ -82,4 +116,5 @@ def joint_dict(v) -> dict:
         "joint_fit_percent": v.fit_percent,
         "outputs": {name: one.to_dict() for name, one in v.outputs.items()},
         "modes": None if v.mode_table is None else v.mode_table.to_dict(),
+        "shapes": None if v.mode_shapes is None else v.mode_shapes.to_dict(),
     }

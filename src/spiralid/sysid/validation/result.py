@@ -12,6 +12,7 @@ import numpy as np
 
 from ..models.modes import ModeTable
 from ..models.polynomials import format_pole_radius
+from ..models.shapes import ModeShapes
 from ..models.shared import SharedModes
 from ..spectra import PSD, Modes, Peaks
 from .correlation import CorrelationTest
@@ -148,6 +149,11 @@ class Validation:
         mode's share per output), and the fields of one output's record
         (signals, tests, spectra) are None: they are in each output's.
         None for a model of one output.
+    mode_shapes : ModeShapes or None
+        For a model of several outputs with a shared denominator, its modes'
+        shapes over the outputs, with intervals and their auto-MAC
+        (:attr:`~spiralid.sysid.SharedDenominatorModel.shapes`); None
+        otherwise.
     """
 
     label: str
@@ -191,6 +197,7 @@ class Validation:
     choice: str | None = None
     nonlinear: NonlinearChecks | None = None
     outputs: dict[str, Validation] | None = None
+    mode_shapes: ModeShapes | None = None
 
     @property
     def is_linear(self) -> bool:

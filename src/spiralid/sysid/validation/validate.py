@@ -319,6 +319,7 @@ def _validate_outputs(model, data, warmup, label, options: dict) -> Validation:
         fit_percent=joint_fit([v.fit_percent for v in outputs.values()]),
         mode_table=model.modes if model.is_linear else None,
         outputs=outputs,
+        mode_shapes=getattr(model, "shapes", None),
     )
 
 

@@ -400,6 +400,8 @@ def _weighted_polish(first, par, z, data, arx, reweight: bool):
 def _model(data, arx, method, cost, a, b, covariance, result, t0):
     """The model; `covariance` is ``(C, R)`` or None. Its wall time goes
     to ``timings`` as every fitted model's does, not to ``result``."""
+    from .covariance import parameter_factor
+
     covariance, root = (None, None) if covariance is None else covariance
     # Least squares' poles may be unstable: no simulation cost then.
     stable = is_stable_polynomial(a)
@@ -425,6 +427,7 @@ def _model(data, arx, method, cost, a, b, covariance, result, t0):
         covariance_factor=root,
         integrators=cost.integrators,
         result=result,
+        shape_factor=None if covariance is None else parameter_factor(cost, a, b),
         timings={"total": time.perf_counter() - t0},
     )
 
