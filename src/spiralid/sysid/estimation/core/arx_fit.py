@@ -39,7 +39,16 @@ from .estimators import DEFAULT_METHOD, METHODS
 from .problem import IDENTIFY_DEFAULTS, Problem
 from .uncertainty import parameter_covariance
 
-__all__ = ["fit_arx", "margin_options"]
+__all__ = ["INTEGRATED", "NOISE_MODELS", "WHITE", "fit_arx", "margin_options"]
+
+#: identify's ``noise``: the disturbance model of the output-error fit. White
+#: (the default): ``y = B/A u + e``. Integrated: ``y = B/A u + e / (1 -
+#: q^-1)``, a drift of independent steps (MATLAB's ``IntegrateNoise``), whose
+#: prediction error is ``dy - B/A du``: the same fit on the differenced
+#: record, so the plant's poles are not spent on a slow disturbance.
+WHITE = "white"
+INTEGRATED = "integrated"
+NOISE_MODELS = (WHITE, INTEGRATED)
 
 
 def _check_bounds(bounds, p: int) -> np.ndarray:
@@ -69,6 +78,8 @@ def fit_arx(data: IOData, arx: ARX, method: str, given: dict) -> IdentifiedModel
     """
     t_start = time.perf_counter()
     given = dict(given)
+    if noise_model(given.pop("noise", WHITE)) == INTEGRATED:
+        return _identify_integrated_noise(data, arx, method, given)
     max_time_constant = given.get("max_time_constant", AUTO)
     count = integrator_count(given.get("integrator", False), arx.na)
     if count:
@@ -258,6 +269,38 @@ def _time_constant(value, ts: float) -> float | None:
             f"ts = {ts:g} s; got {value!r}"
         )
     return seconds
+
+
+def noise_model(noise) -> str:
+    """identify's ``noise``, checked: a key of :data:`NOISE_MODELS`."""
+    if not isinstance(noise, str):
+        raise TypeError(
+            f"`noise` must be a string, one of {NOISE_MODELS}; got {noise!r}"
+        )
+    if noise not in NOISE_MODELS:
+        raise ValueError(f"`noise` must be one of {NOISE_MODELS}; got {noise!r}")
+    return noise
+
+
+def _identify_integrated_noise(
+    data: IOData, arx: ARX, method: str, given: dict
+) -> IdentifiedModel:
+    """`identify` with integrated noise: the plant ``B / A`` fitted on the
+    differenced record ``(du, dy)`` (every other option as given; the
+    default margin's ``T`` is that record's length, one sample shorter),
+    then returned with `data`'s provenance. Its cost and noise variance are
+    the differenced record's: the integrated noise's innovations."""
+    if data.n < 3:
+        raise ValueError(
+            f"`noise='integrated'` needs a record of at least 3 samples; got {data.n}"
+        )
+    diff = replace(data, u=np.diff(data.u), y=np.diff(data.y))
+    inner = fit_arx(diff, arx, method, given)
+    inner.result.noise = INTEGRATED
+    inner.result.message = (
+        f"{inner.result.message} Fitted on the differenced record (integrated noise)."
+    )
+    return inner
 
 
 def _identify_integrating(
