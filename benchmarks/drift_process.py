@@ -34,8 +34,8 @@ integrated noise (``noise="integrated"``: ``spiral-I``, ``OE-I``) and
 prints their fits and counts against OE.
 
 Run: ``python benchmarks/drift_process.py [--seeds 10] [--orders 8]
-[--workers 2] [--integrated]``. To measure the code before a change, put its source first
-on ``PYTHONPATH``.
+[--workers 2] [--integrated]``. To measure the code before a change, put
+its source first on ``PYTHONPATH``.
 """
 
 import os
