@@ -31,7 +31,7 @@ from ..linear.parametrizations import (
     PARAMETRIZATIONS,
     make_parametrization,
 )
-from ..spiral import margin_choice
+from ..spiral import folds, margin_choice
 from ..spiral.cancellation import effective, embed_covariance, embed_factor
 from ..spiral.heldback import HOLDBACK
 from .cost import PaperCost
@@ -97,6 +97,10 @@ def fit_arx(data: IOData, arx: ARX, method: str, given: dict) -> IdentifiedModel
         # The recommended method acts on its own modes table's diagnosis:
         # a flagged pole is removed where the cost allows.
         _act_on_modes(problem, res, (res.get("caps") or {}).get("cancel"))
+    if method == DEFAULT_METHOD and options.get("folds") and arx.na:
+        # Then the folds across the record choose among it, output error
+        # and output error with integrated noise.
+        folds.choose(problem, res)
     return _packaged(method, problem, res, t_start, margin)
 
 
