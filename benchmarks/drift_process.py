@@ -29,13 +29,15 @@ summary: medians, on how many seeds the default is at least OE - 1 point
 and on how many it is 5 points or more below OE. Speed is printed, never
 asserted.
 
-With ``--integrated`` it also runs the default and output error with
-integrated noise (``noise="integrated"``: ``spiral-I``, ``OE-I``) and
-prints their fits and counts against OE.
+With ``--folds`` it also runs the default with ``folds=True`` (the model
+chosen by folds across the record, ``folds``). With ``--integrated`` it
+also runs the default and output error with integrated noise
+(``noise="integrated"``: ``spiral-I``, ``OE-I``). Each prints its fits and
+counts against OE.
 
 Run: ``python benchmarks/drift_process.py [--seeds 10] [--orders 8]
-[--workers 2] [--integrated]``. To measure the code before a change, put
-its source first on ``PYTHONPATH``.
+[--workers 2] [--integrated] [--folds]``. To measure the code before a
+change, put its source first on ``PYTHONPATH``.
 """
 
 import os
@@ -91,7 +93,10 @@ INTEGRATED = {
     "spiral-I": {"noise": "integrated"},
     "OE-I": {"method": "oe", "noise": "integrated"},
 }
-EVERY = {**METHODS, **INTEGRATED}
+# With --folds: the default with folds=True (the model chosen by folds
+# across the record among its own, OE's and OE with integrated noise).
+FOLDS = {"folds": {"folds": True}}
+EVERY = {**METHODS, **INTEGRATED, **FOLDS}
 
 
 def run_one(task) -> dict:
@@ -152,13 +157,14 @@ def table(rows: list[dict], order: int) -> str:
             f"{m} >= OE - 1 on {sum(x >= -1 for x in diff)}/{len(seeds)}; "
             f"{m} <= OE - 5 on {sum(x <= -5 for x in diff)}/{len(seeds)}"
         )
-    if "OE-I" in names:
-        lines.append("\n| seed | " + " | ".join(INTEGRATED) + " |")
-        lines.append("|---|" + "---|" * len(INTEGRATED))
+    extra = [m for m in names if m not in METHODS]
+    if extra:
+        lines.append("\n| seed | " + " | ".join(extra) + " |")
+        lines.append("|---|" + "---|" * len(extra))
         for s in seeds:
             lines.append(
                 f"| {s} | "
-                + " | ".join(f"{cell[(s, m)]['fit']:.1f}" for m in INTEGRATED)
+                + " | ".join(f"{cell[(s, m)]['fit']:.1f}" for m in extra)
                 + " |"
             )
     return "\n".join(lines)
@@ -174,9 +180,14 @@ def main(argv=None) -> None:
         action="store_true",
         help="also both output-error methods with noise='integrated'",
     )
+    ap.add_argument("--folds", action="store_true", help="also the default, folds=True")
     args = ap.parse_args(argv)
     orders = [int(v) for v in args.orders.split(",")]
-    methods = EVERY if args.integrated else METHODS
+    methods = {
+        **METHODS,
+        **(INTEGRATED if args.integrated else {}),
+        **(FOLDS if args.folds else {}),
+    }
     tasks = [(s, n, m) for n in orders for s in range(args.seeds) for m in methods]
     t0 = time.perf_counter()
     if args.workers > 1:
