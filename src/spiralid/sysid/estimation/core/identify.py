@@ -266,7 +266,7 @@ def identify(
       ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
       ``rule``, ``n_points``, ``max_nfev``, ``polish_every``,
       ``polish_nfev``, ``restarts``, ``frequency_seeds``, ``holdback``,
-      ``stop``, ``x0``, ``max_iter``, ``callback``.
+      ``folds``, ``stop``, ``x0``, ``max_iter``, ``callback``.
     - ``"de"``: ``max_time_constant`` (with ``refine=True``),
       ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
       ``n_points``, ``max_iter``, ``max_nfev``, ``x0``, ``callback``.
