@@ -210,7 +210,7 @@ def _estimate_recommended(
     (``benchmarks/identification.py`` measures what each ingredient does).
 
     With ``folds=True`` the model is then chosen among the method's own,
-    output error's minimum and output error with integrated noise by
+    output error's model and output error with integrated noise by
     forward-chaining folds across the record
     (:mod:`~spiralid.sysid.estimation.spiral.folds`; applied after the
     modes-table step, by the ARX fit, ``model.selection`` says which and
