@@ -149,7 +149,18 @@ def choose(problem: Problem, result: EstimatorResult) -> FoldChoice | None:
     }
     choice = FoldChoice(FOLD_ENDS)
     for name, theta in candidates.items():
-        choice.rms[name] = _fold_rms(problem, theta, name == "integrated")
+        # The default is often output error's model itself (to 1e-8): one
+        # refit serves both.
+        same = [
+            k
+            for k in choice.rms
+            if k != "integrated" and name != "integrated"
+            and np.allclose(candidates[k], theta, rtol=1e-8, atol=1e-10)
+        ]  # fmt: skip
+        if same:
+            choice.rms[name] = list(choice.rms[same[0]])
+        else:
+            choice.rms[name] = _fold_rms(problem, theta, name == "integrated")
     # A run that diverged scores as the largest finite error.
     rms = np.nan_to_num(np.array(list(choice.rms.values())), posinf=1e300)
     best = np.maximum(rms.min(axis=0), np.finfo(float).tiny)
