@@ -67,5 +67,7 @@ def test_folds_is_checked_and_only_the_recommended_method_s():
     data = _drifting(1, 200)
     with pytest.raises(TypeError, match="`folds` of method 'spiral' must be True"):
         sid.identify(data, ARX, rng=0, folds="yes")
+    with pytest.raises(ValueError, match="`folds=True` already weighs"):
+        sid.identify(data, ARX, rng=0, folds=True, noise="integrated")
     with pytest.raises(ValueError, match="`folds` does not apply to method 'oe'"):
         sid.identify(data, ARX, method="oe", folds=True)

@@ -298,6 +298,12 @@ def _identify_integrated_noise(
         raise ValueError(
             f"`noise='integrated'` needs a record of at least 3 samples; got {data.n}"
         )
+    if given.get("folds"):
+        # The folds choose between white and integrated noise themselves.
+        raise ValueError(
+            "`folds=True` already weighs output error with integrated noise; "
+            "give it with noise='white'"
+        )
     diff = replace(data, u=np.diff(data.u), y=np.diff(data.y))
     inner = fit_arx(diff, arx, method, given)
     inner.result.noise = INTEGRATED
