@@ -29,9 +29,15 @@ summary: medians, on how many seeds the default is at least OE - 1 point
 and on how many it is 5 points or more below OE. Speed is printed, never
 asserted.
 
+With ``--folds`` it also runs the default with ``folds=True`` (the model
+chosen by folds across the record, ``folds``). With ``--integrated`` it
+also runs the default and output error with integrated noise
+(``noise="integrated"``: ``spiral-I``, ``OE-I``). Each prints its fits and
+counts against OE.
+
 Run: ``python benchmarks/drift_process.py [--seeds 10] [--orders 8]
-[--workers 2]``. To measure the code before a change, put its source first
-on ``PYTHONPATH``.
+[--workers 2] [--integrated] [--folds]``. To measure the code before a
+change, put its source first on ``PYTHONPATH``.
 """
 
 import os
@@ -81,13 +87,23 @@ def record(seed: int, n: int = N, drift: float = DRIFT) -> IOData:
 
 
 METHODS = {"default": {}, "OE": {"method": "oe"}, "LS": {"method": "ls"}}
+# With --integrated: both output-error methods with integrated noise
+# (identify's noise="integrated", the plant fitted on the differenced record).
+INTEGRATED = {
+    "spiral-I": {"noise": "integrated"},
+    "OE-I": {"method": "oe", "noise": "integrated"},
+}
+# With --folds: the default with folds=True (the model chosen by folds
+# across the record among its own, OE's and OE with integrated noise).
+FOLDS = {"folds": {"folds": True}}
+EVERY = {**METHODS, **INTEGRATED, **FOLDS}
 
 
 def run_one(task) -> dict:
     seed, order, name = task
     est, val = record(seed).split(FRACTION)
     t0 = time.perf_counter()
-    model = identify(est, ARX(order, order, 0), rng=seed, **METHODS[name])
+    model = identify(est, ARX(order, order, 0), rng=seed, **EVERY[name])
     elapsed = time.perf_counter() - t0
     diagnosis = getattr(model, "diagnosis", None) or {}
     return dict(
@@ -124,19 +140,33 @@ def table(rows: list[dict], order: int) -> str:
             f"{d['fit'] - o['fit']:+.1f} | {na}, {nb} | {d['removed']} / "
             f"{d['kept']} | {d['flagged']} | {d['time']:.2f} | {o['time']:.2f} |"
         )
-    diff = [cell[(s, "default")]["fit"] - cell[(s, "OE")]["fit"] for s in seeds]
-    med = {m: np.median([cell[(s, m)]["fit"] for s in seeds]) for m in METHODS}
+    names = [m for m in EVERY if (seeds[0], m) in cell]
+    med = {m: np.median([cell[(s, m)]["fit"] for s in seeds]) for m in names}
     lines.append(
-        f"\nmedian fit: default {med['default']:.1f}, OE {med['OE']:.1f}, "
-        f"LS {med['LS']:.1f}; median default - OE {np.median(diff):+.1f}; "
-        f"default >= OE - 1 on {sum(x >= -1 for x in diff)}/{len(seeds)}; "
-        f"default <= OE - 5 on {sum(x <= -5 for x in diff)}/{len(seeds)}; "
-        "median time s: "
+        "\nmedian fit: "
+        + ", ".join(f"{m} {med[m]:.1f}" for m in names)
+        + "; median time s: "
         + ", ".join(
-            f"{m} {np.median([cell[(s, m)]['time'] for s in seeds]):.2f}"
-            for m in METHODS
+            f"{m} {np.median([cell[(s, m)]['time'] for s in seeds]):.2f}" for m in names
         )
     )
+    for m in [m for m in names if m not in ("OE", "LS")]:
+        diff = [cell[(s, m)]["fit"] - cell[(s, "OE")]["fit"] for s in seeds]
+        lines.append(
+            f"{m}: median {m} - OE {np.median(diff):+.1f}; "
+            f"{m} >= OE - 1 on {sum(x >= -1 for x in diff)}/{len(seeds)}; "
+            f"{m} <= OE - 5 on {sum(x <= -5 for x in diff)}/{len(seeds)}"
+        )
+    extra = [m for m in names if m not in METHODS]
+    if extra:
+        lines.append("\n| seed | " + " | ".join(extra) + " |")
+        lines.append("|---|" + "---|" * len(extra))
+        for s in seeds:
+            lines.append(
+                f"| {s} | "
+                + " | ".join(f"{cell[(s, m)]['fit']:.1f}" for m in extra)
+                + " |"
+            )
     return "\n".join(lines)
 
 
@@ -145,9 +175,20 @@ def main(argv=None) -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--orders", default="8")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument(
+        "--integrated",
+        action="store_true",
+        help="also both output-error methods with noise='integrated'",
+    )
+    ap.add_argument("--folds", action="store_true", help="also the default, folds=True")
     args = ap.parse_args(argv)
     orders = [int(v) for v in args.orders.split(",")]
-    tasks = [(s, n, m) for n in orders for s in range(args.seeds) for m in METHODS]
+    methods = {
+        **METHODS,
+        **(INTEGRATED if args.integrated else {}),
+        **(FOLDS if args.folds else {}),
+    }
+    tasks = [(s, n, m) for n in orders for s in range(args.seeds) for m in methods]
     t0 = time.perf_counter()
     if args.workers > 1:
         with ProcessPoolExecutor(args.workers) as pool:

@@ -80,6 +80,7 @@ NON_DEFAULT = {
     "integrator": 1,
     "max_time_constant": 5.0,
     "cancel": True,
+    "noise": "integrated",
     "parametrization": "reflection",
     "bounds": [[0.0, 1.0]],
     "refine": True,

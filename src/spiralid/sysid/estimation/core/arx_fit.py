@@ -31,7 +31,7 @@ from ..linear.parametrizations import (
     PARAMETRIZATIONS,
     make_parametrization,
 )
-from ..spiral import margin_choice
+from ..spiral import folds, margin_choice
 from ..spiral.cancellation import effective, embed_covariance, embed_factor
 from ..spiral.heldback import HOLDBACK
 from .cost import PaperCost
@@ -39,7 +39,16 @@ from .estimators import DEFAULT_METHOD, METHODS
 from .problem import IDENTIFY_DEFAULTS, Problem
 from .uncertainty import parameter_covariance
 
-__all__ = ["fit_arx", "margin_options"]
+__all__ = ["INTEGRATED", "NOISE_MODELS", "WHITE", "fit_arx", "margin_options"]
+
+#: identify's ``noise``: the disturbance model of the output-error fit. White
+#: (the default): ``y = B/A u + e``. Integrated: ``y = B/A u + e / (1 -
+#: q^-1)``, a drift of independent steps (MATLAB's ``IntegrateNoise``), whose
+#: prediction error is ``dy - B/A du``: the same fit on the differenced
+#: record, so the plant's poles are not spent on a slow disturbance.
+WHITE = "white"
+INTEGRATED = "integrated"
+NOISE_MODELS = (WHITE, INTEGRATED)
 
 
 def _check_bounds(bounds, p: int) -> np.ndarray:
@@ -69,6 +78,8 @@ def fit_arx(data: IOData, arx: ARX, method: str, given: dict) -> IdentifiedModel
     """
     t_start = time.perf_counter()
     given = dict(given)
+    if noise_model(given.pop("noise", WHITE)) == INTEGRATED:
+        return _identify_integrated_noise(data, arx, method, given)
     max_time_constant = given.get("max_time_constant", AUTO)
     count = integrator_count(given.get("integrator", False), arx.na)
     if count:
@@ -86,6 +97,10 @@ def fit_arx(data: IOData, arx: ARX, method: str, given: dict) -> IdentifiedModel
         # The recommended method acts on its own modes table's diagnosis:
         # a flagged pole is removed where the cost allows.
         _act_on_modes(problem, res, (res.get("caps") or {}).get("cancel"))
+    if method == DEFAULT_METHOD and options.get("folds") and arx.na:
+        # Then the folds across the record choose among it, output error
+        # and output error with integrated noise.
+        folds.choose(problem, res)
     return _packaged(method, problem, res, t_start, margin)
 
 
@@ -258,6 +273,44 @@ def _time_constant(value, ts: float) -> float | None:
             f"ts = {ts:g} s; got {value!r}"
         )
     return seconds
+
+
+def noise_model(noise) -> str:
+    """identify's ``noise``, checked: a key of :data:`NOISE_MODELS`."""
+    if not isinstance(noise, str):
+        raise TypeError(
+            f"`noise` must be a string, one of {NOISE_MODELS}; got {noise!r}"
+        )
+    if noise not in NOISE_MODELS:
+        raise ValueError(f"`noise` must be one of {NOISE_MODELS}; got {noise!r}")
+    return noise
+
+
+def _identify_integrated_noise(
+    data: IOData, arx: ARX, method: str, given: dict
+) -> IdentifiedModel:
+    """`identify` with integrated noise: the plant ``B / A`` fitted on the
+    differenced record ``(du, dy)`` (every other option as given; the
+    default margin's ``T`` is that record's length, one sample shorter),
+    then returned with `data`'s provenance. Its cost and noise variance are
+    the differenced record's: the integrated noise's innovations."""
+    if data.n < 3:
+        raise ValueError(
+            f"`noise='integrated'` needs a record of at least 3 samples; got {data.n}"
+        )
+    if given.get("folds"):
+        # The folds choose between white and integrated noise themselves.
+        raise ValueError(
+            "`folds=True` already weighs output error with integrated noise; "
+            "give it with noise='white'"
+        )
+    diff = replace(data, u=np.diff(data.u), y=np.diff(data.y))
+    inner = fit_arx(diff, arx, method, given)
+    inner.result.noise = INTEGRATED
+    inner.result.message = (
+        f"{inner.result.message} Fitted on the differenced record (integrated noise)."
+    )
+    return inner
 
 
 def _identify_integrating(

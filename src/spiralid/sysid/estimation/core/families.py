@@ -93,7 +93,8 @@ def _arx_options(method: str, refine=False) -> tuple[str, ...]:
     """An ARX's options by `method`: ``rng``, ``predictor``, ``initial``,
     ``gain``, ``penalty`` and ``integrator`` always; ``max_time_constant``
     for the methods with ``Method.margin`` and a search with
-    ``refine=True``; ``cancel`` for those with ``Method.cancel``; then
+    ``refine=True``; ``cancel`` for those with ``Method.cancel``;
+    ``noise`` for those with ``Method.margin``; then
     :func:`~.estimators.method_options`."""
     spec = METHODS[method]
     out = ["rng", "predictor", "initial", "gain", "penalty", "integrator"]
@@ -102,6 +103,9 @@ def _arx_options(method: str, refine=False) -> tuple[str, ...]:
         out.append("max_time_constant")
     if spec.cancel:
         out.append("cancel")
+    if spec.margin:
+        # The output-error methods' disturbance model (arx_fit.NOISE_MODELS).
+        out.append("noise")
     return (*out, *method_options(method))
 
 

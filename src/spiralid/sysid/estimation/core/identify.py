@@ -218,6 +218,14 @@ def identify(
 
     Other Parameters
     ----------------
+    noise : {"white", "integrated"}, default "white"
+        The disturbance model of ``"spiral"`` and ``"oe"``: ``"white"``,
+        output error (``y = B/A u + e``); ``"integrated"``, output error
+        with integrated noise (``y = B/A u + e / (1 - q^-1)``, MATLAB's
+        ``IntegrateNoise``): the same method on the differenced record
+        ``(du, dy)``, so a slow drift of the output is not fitted by the
+        plant's poles. The model is the plant ``B / A``; its cost and
+        noise variance are the differenced record's.
     parametrization : str, optional
         What a search moves, a key of
         :data:`spiralid.sysid.estimation.linear.parametrizations.PARAMETRIZATIONS`:
@@ -257,12 +265,12 @@ def identify(
     only set the reported cost):
 
     - ``"ls"``: none.
-    - ``"oe"``: ``max_time_constant``, ``cancel``.
-    - ``"spiral"``: ``max_time_constant``, ``cancel``,
+    - ``"oe"``: ``max_time_constant``, ``cancel``, ``noise``.
+    - ``"spiral"``: ``max_time_constant``, ``cancel``, ``noise``,
       ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
       ``rule``, ``n_points``, ``max_nfev``, ``polish_every``,
       ``polish_nfev``, ``restarts``, ``frequency_seeds``, ``holdback``,
-      ``stop``, ``x0``, ``max_iter``, ``callback``.
+      ``folds``, ``stop``, ``x0``, ``max_iter``, ``callback``.
     - ``"de"``: ``max_time_constant`` (with ``refine=True``),
       ``parametrization``, ``bounds``, ``refine``, ``safe_start``,
       ``n_points``, ``max_iter``, ``max_nfev``, ``x0``, ``callback``.

@@ -30,6 +30,7 @@ IDENTIFY_DEFAULTS = dict(
     integrator=False,
     max_time_constant=AUTO,
     cancel=None,
+    noise="white",
     parametrization=None,
     bounds=None,
     refine=False,

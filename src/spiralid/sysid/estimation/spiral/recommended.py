@@ -165,6 +165,7 @@ def _estimate_recommended(
     restarts: bool | Restarts = SPIRAL_RESTARTS,
     frequency_seeds: int = 0,
     holdback: float | None = HOLDBACK,
+    folds: bool = False,
     stop: str = "work",
     x0=None,
     max_iter: int | None = None,
@@ -208,6 +209,14 @@ def _estimate_recommended(
     10_000`` evaluations of the search, its polish steps included
     (``benchmarks/identification.py`` measures what each ingredient does).
 
+    With ``folds=True`` the model is then chosen among the method's own,
+    output error's model and output error with integrated noise by
+    forward-chaining folds across the record
+    (:mod:`~spiralid.sysid.estimation.spiral.folds`; applied after the
+    modes-table step, by the ARX fit, ``model.selection`` says which and
+    why), a choice a continuing drift cannot win as it wins the held-back
+    end. Default False.
+
     `stop` says when the search ends: ``"converged"`` as soon as a fresh
     population (a restart) stalls without lowering the best cost by more
     than 1e-6 of it, i.e. it fell back into a basin already found or a
@@ -250,6 +259,10 @@ def _estimate_recommended(
             f"{problem.parametrization.name!r}"
         )
     holdback = _holdback_share(holdback)
+    if not isinstance(folds, bool | np.bool_):
+        raise TypeError(
+            f"`folds` of method 'spiral' must be True or False; got {folds!r}"
+        )
     restarts = _spiral_restarts(restarts)
     if stop not in SPIRAL_STOPS:
         raise ValueError(

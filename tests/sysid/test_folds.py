@@ -1,0 +1,73 @@
+"""The recommended method's choice by folds across the record
+(``folds=True``, spiral/folds.py)."""
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+import spiralid as sid
+from spiralid.sysid import PaperCost
+from spiralid.sysid.estimation.spiral.folds import CANDIDATES, FOLD_ENDS
+
+TRUE = np.array([-1.5, 0.7, 1.0, 0.5])
+ARX = sid.ARX(2, 2, 1)
+
+
+def _drifting(seed: int, n: int = 600) -> sid.IOData:
+    """A known plant plus a random walk larger than its output."""
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = lfilter([0.0, 1.0, 0.5], [1.0, -1.5, 0.7], u)
+    return sid.IOData(u, y + np.cumsum(0.5 * rng.standard_normal(n)), ts=0.01)
+
+
+@pytest.fixture(scope="module")
+def chosen():
+    data = _drifting(0)
+    return data, sid.identify(data, ARX, rng=0, folds=True)
+
+
+def test_the_folds_score_is_each_candidate_s_log_error_against_the_best(chosen):
+    _, model = chosen
+    sel = model.selection
+    assert sel["fold_ends"] == list(FOLD_ENDS)
+    names = list(sel["rms"])
+    assert set(names) <= set(CANDIDATES) and "integrated" in names
+    rms = np.array([sel["rms"][n] for n in names])
+    assert rms.shape == (len(names), len(FOLD_ENDS) - 1)
+    # The score by hand: sum over folds of log(rms / the fold's best).
+    by_hand = np.log(rms / rms.min(axis=0)).sum(axis=1)
+    np.testing.assert_allclose([sel["score"][n] for n in names], by_hand)
+    assert sel["chosen"] == names[int(np.argmin(by_hand))]
+    assert sel["chosen"] in sel["note"]
+
+
+def test_under_a_random_walk_the_folds_choose_models_nearer_the_plant():
+    errors, picks = [], []
+    for seed in range(3):
+        data = _drifting(seed)
+        model = sid.identify(data, ARX, rng=0, folds=True)
+        default = sid.identify(data, ARX, rng=0)
+        errors.append(
+            (np.abs(model.theta - TRUE).max(), np.abs(default.theta - TRUE).max())
+        )
+        picks.append(model.selection["chosen"])
+        # The reported cost stays the paper's on the record as given.
+        assert model.cost == pytest.approx(PaperCost(ARX, data)(model.theta), rel=1e-9)
+    # The drift's own noise model wins most folds and recovers the plant;
+    # where the folds keep the default, the model is the default's.
+    assert picks.count("integrated") >= 2
+    for (folds, default), pick in zip(errors, picks, strict=True):
+        assert folds <= default + 1e-9
+        if pick == "integrated":
+            assert folds < 0.1
+
+
+def test_folds_is_checked_and_only_the_recommended_method_s():
+    data = _drifting(1, 200)
+    with pytest.raises(TypeError, match="`folds` of method 'spiral' must be True"):
+        sid.identify(data, ARX, rng=0, folds="yes")
+    with pytest.raises(ValueError, match="`folds=True` already weighs"):
+        sid.identify(data, ARX, rng=0, folds=True, noise="integrated")
+    with pytest.raises(ValueError, match="`folds` does not apply to method 'oe'"):
+        sid.identify(data, ARX, method="oe", folds=True)
