@@ -90,6 +90,12 @@ def test_without_a_force_the_record_is_as_before():
     assert (d.input_name, d.input_unit) == ("force", "N")
     with pytest.raises(ValueError, match="`input` must be one of"):
         plain.iodata(input="force")
+    both = zero.iodata("end_acceleration", input=["torque", "force"])
+    assert both.input_names == ("torque", "force")
+    assert both.input_units == ("N m", "N")
+    np.testing.assert_array_equal(both.u, np.column_stack([zero.u, zero.force]))
+    with pytest.raises(ValueError, match="each input once"):
+        zero.iodata(input=["force", "force"])
 
 
 def test_the_shaker_refuses_bad_input_in_one_line():

@@ -18,6 +18,7 @@ from spiralid.sysid import (
     arx_least_squares,
     identify,
     identify_pareto,
+    mac,
     steiglitz_mcbride,
     subspace_denominator,
     validate,
@@ -25,6 +26,7 @@ from spiralid.sysid import (
 from spiralid.sysid.estimation.linear.frequency import h1_estimate
 from spiralid.sysid.estimation.shared.denominator import SharedProjectedCost
 from spiralid.sysid.estimation.shared.inputs import SharedInputsCost
+from spiralid.sysid.models.shapes import normalise_shapes
 
 A = np.poly(
     [0.95 * np.exp(0.4j), 0.95 * np.exp(-0.4j), 0.9 * np.exp(1.2j), 0.9 * np.exp(-1.2j)]
@@ -259,3 +261,23 @@ def test_the_command_fits_and_validates_two_inputs(tmp_path):
     out = run("pareto", "two.csv", "--input", "f1,f2", "--output", "p", "--out", "x",
               cwd=tmp_path)  # fmt: skip
     assert out.returncode == 2 and "this command takes one input" in out.stderr
+
+
+def test_each_input_s_shapes_are_scipys_residues_of_its_pairs():
+    """A model of two inputs has shapes per input: each output's residue of
+    ``B_ij / A`` at each mode's pole (SciPy's ``residuez``), normalised;
+    ``shapes`` alone asks which input, in one line."""
+    fit = identify(_record(), ARX(4, 2, 1), method="ls")
+    with pytest.raises(ValueError, match=r"input_shapes\(input\)"):
+        fit.shapes
+    for j, name in enumerate(("f1", "f2")):
+        got = fit.input_shapes(name)
+        poles = fit.modes.table.poles
+        want = np.empty((len(poles), 2), dtype=complex)
+        for i in range(2):
+            r, p, _ = signal.residuez(np.r_[0.0, B[i][j]], A)
+            want[:, i] = [r[np.argmin(np.abs(p - pole))] for pole in poles]
+        np.testing.assert_allclose(
+            np.abs(mac(got.shapes, want).diagonal()), 1.0, rtol=1e-9
+        )
+        np.testing.assert_allclose(got.shapes, normalise_shapes(want), atol=1e-7)

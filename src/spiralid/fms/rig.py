@@ -147,7 +147,9 @@ class Recording:
             return self.deflection[:, k]
         return self.acceleration[:, k - len(self.deflection_at)]
 
-    def iodata(self, name: str | list[str] = "end_acceleration", input: str = "torque"):
+    def iodata(
+        self, name: str | list[str] = "end_acceleration", input: str | list = "torque"
+    ):
         """The torque (or the shaker's force) and one output channel, or
         several, as a :class:`spiralid.IOData`.
 
@@ -159,7 +161,8 @@ class Recording:
         with its own name and unit). `input` is one of
         :attr:`input_names`: ``"torque"`` (N m), or ``"force"`` (N) of a
         record with a shaker, whose outputs respond to both (an IOData of
-        one input holds the other's response as disturbance).
+        one input holds the other's response as disturbance), or a list of
+        them: a record of several inputs (``u`` of shape (N, m)).
 
         ``spiralid.sysid.data`` is imported here, inside the method: it is the
         one sanctioned dependency of ``fms`` on the rest of the package, kept
@@ -178,7 +181,11 @@ class Recording:
         """
         from spiralid.sysid.data import IOData
 
-        one_of(input, "input", self.input_names)
+        inputs = list(input) if isinstance(input, list | tuple) else [input]
+        for one in inputs:
+            one_of(one, "input", self.input_names)
+        if not inputs or len(set(inputs)) != len(inputs):
+            raise ValueError(f"`input` must list each input once; got {input!r}")
         names = list(name) if isinstance(name, list | tuple) else [name]
         known = self.output_names
         for one in names:
@@ -187,13 +194,17 @@ class Recording:
             raise ValueError(f"`name` must list each output once; got {name!r}")
         several = len(names) > 1
         y = [self._output(one) for one in names]
+        u = [self.u if one == "torque" else self.force for one in inputs]
+        driven = len(inputs) > 1
         return IOData(
-            self.u if input == "torque" else self.force,
+            np.column_stack(u) if driven else u[0],
             np.column_stack(y) if several else y[0],
             ts=self.ts,
-            input_name=input,
+            input_name=tuple(inputs) if driven else inputs[0],
             output_name=tuple(names) if several else names[0],
-            input_unit=_INPUT_UNITS[input],
+            input_unit=tuple(_INPUT_UNITS[one] for one in inputs)
+            if driven
+            else _INPUT_UNITS[inputs[0]],
             output_unit=tuple(_unit(one) for one in names)
             if several
             else _unit(names[0]),

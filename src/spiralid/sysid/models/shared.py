@@ -407,20 +407,48 @@ class SharedDenominatorModel(Provenance):
     @property
     def shapes(self) -> ModeShapes:
         """The shapes of :attr:`modes` over the outputs, from each output's
-        residues, with 95 % intervals (:func:`~.shapes.mode_shapes`); one
-        input only."""
+        residues, with 95 % intervals (:func:`~.shapes.mode_shapes`); a
+        model of several inputs has them per input (:meth:`input_shapes`)."""
         if self.n_inputs > 1:
             raise ValueError(
-                "mode shapes are computed for a model of one input; this one has "
-                f"{self.n_inputs} ({', '.join(self.input_names)})"
+                f"this model has {self.n_inputs} inputs "
+                f"({', '.join(self.input_names)}): take the shapes one input "
+                "excites with model.input_shapes(input)"
             )
+        return self.input_shapes(0)
+
+    def input_shapes(self, input: int | str = 0) -> ModeShapes:
+        """The shapes of :attr:`modes` over the outputs as the input `input`
+        (a name or 0-based index) excites them: each output's residues of
+        ``B_ij / A``, with 95 % intervals from the covariance of that
+        input's numerators and the denominator.
+
+        Parameters
+        ----------
+        input : int or str, default 0
+            The input.
+
+        Returns
+        -------
+        ModeShapes
+        """
+        j = named_index(input, "input", self.input_names)
+        nb, m = self.arx.nb, self.n_inputs
+        mine = np.arange(j * nb, (j + 1) * nb)
+        factor = self.shape_factor
+        if factor is not None and m > 1:
+            # A factor's columns of a subset of the parameters factor the
+            # covariance of that subset: C_sub = R[:, S]' R[:, S].
+            na = self.a.size
+            rows = [na + i * m * nb + mine for i in range(self.b.shape[0])]
+            factor = factor[:, np.r_[np.arange(na), *rows]]
         return mode_shapes(
             self.a,
-            self.b,
+            self.b[:, mine],
             self.ts,
             nk=self.arx.nk,
             integrators=self.integrators,
-            factor=self.shape_factor,
+            factor=factor,
             output_names=self.output_names,
             poles=self.modes.table.poles,
         )
