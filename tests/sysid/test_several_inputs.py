@@ -269,7 +269,7 @@ def test_each_input_s_shapes_are_scipys_residues_of_its_pairs():
     ``shapes`` alone asks which input, in one line."""
     fit = identify(_record(), ARX(4, 2, 1), method="ls")
     with pytest.raises(ValueError, match=r"input_shapes\(input\)"):
-        fit.shapes
+        _ = fit.shapes
     for j, name in enumerate(("f1", "f2")):
         got = fit.input_shapes(name)
         poles = fit.modes.table.poles

@@ -471,12 +471,26 @@ def shared_report(
 
 
 def _shapes_parts(model) -> list[str]:
-    """The report's mode shapes and MAC matrix (none without modes)."""
-    shapes = model.shapes
+    """The report's mode shapes and MAC matrix (none without modes), one
+    set per input of a model of several inputs."""
+    names = model.input_names
+    if len(names) == 1:
+        return _input_shapes_parts(model.shapes, "")
+    return [
+        part
+        for j, name in enumerate(names)
+        for part in _input_shapes_parts(
+            model.input_shapes(j), f" from {html.escape(name)}"
+        )
+    ]
+
+
+def _input_shapes_parts(shapes, source: str) -> list[str]:
+    """The shapes of one input (`source`: where they come from, or empty)."""
     if not len(shapes):
         return []
     return [
-        "<h2>Mode shapes</h2><p>Each mode's shape over the outputs: every "
+        f"<h2>Mode shapes{source}</h2><p>Each mode's shape over the outputs: every "
         "output's residue at the mode's pole, normalised to unit norm with "
         "the largest component real and positive (real parts shown; a "
         "lightly damped mode's shape is nearly real), with 95 % intervals "

@@ -52,6 +52,7 @@ __all__ = [
     "mode_shapes",
     "normalise_shapes",
     "output_residues",
+    "pair_shapes",
     "residue_gradient",
 ]
 
@@ -471,3 +472,41 @@ def _normalisation_jacobian(phi: np.ndarray) -> np.ndarray:
         diff = (hi - lo) / (2 * h)
         out[:, k] = np.r_[diff.real, diff.imag]
     return out
+
+
+def pair_shapes(model, j: int) -> ModeShapes:
+    """The shapes of a shared-denominator `model`'s modes as its input `j`
+    excites them: each output's residues of ``B_ij / A``, with 95 %
+    intervals from the covariance of that input's numerators and the
+    denominator (``model.shape_factor``, where the fit kept one).
+
+    Parameters
+    ----------
+    model : SharedDenominatorModel
+        The fitted model.
+    j : int
+        The input's 0-based index.
+
+    Returns
+    -------
+    ModeShapes
+    """
+    nb, m = model.arx.nb, model.n_inputs
+    mine = np.arange(j * nb, (j + 1) * nb)
+    factor = model.shape_factor
+    if factor is not None and m > 1:
+        # A factor's columns of a subset of the parameters factor the
+        # covariance of that subset: C_sub = R[:, S]' R[:, S].
+        na = model.a.size
+        rows = [na + i * m * nb + mine for i in range(model.b.shape[0])]
+        factor = factor[:, np.r_[np.arange(na), *rows]]
+    return mode_shapes(
+        model.a,
+        model.b[:, mine],
+        model.ts,
+        nk=model.arx.nk,
+        integrators=model.integrators,
+        factor=factor,
+        output_names=model.output_names,
+        poles=model.modes.table.poles,
+    )

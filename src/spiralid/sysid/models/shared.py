@@ -33,7 +33,7 @@ from .fitted import Provenance
 from .identified import IdentifiedModel, python_control
 from .modes import ModeTable, interval_format, mode_table
 from .polynomials import is_stable_polynomial, max_pole_radius, with_integrator
-from .shapes import ModeShapes, mode_shapes
+from .shapes import ModeShapes, pair_shapes
 
 __all__ = ["MOST_INTEGRATORS", "SharedDenominatorModel", "SharedModes"]
 
@@ -419,9 +419,7 @@ class SharedDenominatorModel(Provenance):
 
     def input_shapes(self, input: int | str = 0) -> ModeShapes:
         """The shapes of :attr:`modes` over the outputs as the input `input`
-        (a name or 0-based index) excites them: each output's residues of
-        ``B_ij / A``, with 95 % intervals from the covariance of that
-        input's numerators and the denominator.
+        (a name or 0-based index) excites them (:func:`~.shapes.pair_shapes`).
 
         Parameters
         ----------
@@ -433,25 +431,7 @@ class SharedDenominatorModel(Provenance):
         ModeShapes
         """
         j = named_index(input, "input", self.input_names)
-        nb, m = self.arx.nb, self.n_inputs
-        mine = np.arange(j * nb, (j + 1) * nb)
-        factor = self.shape_factor
-        if factor is not None and m > 1:
-            # A factor's columns of a subset of the parameters factor the
-            # covariance of that subset: C_sub = R[:, S]' R[:, S].
-            na = self.a.size
-            rows = [na + i * m * nb + mine for i in range(self.b.shape[0])]
-            factor = factor[:, np.r_[np.arange(na), *rows]]
-        return mode_shapes(
-            self.a,
-            self.b[:, mine],
-            self.ts,
-            nk=self.arx.nk,
-            integrators=self.integrators,
-            factor=factor,
-            output_names=self.output_names,
-            poles=self.modes.table.poles,
-        )
+        return pair_shapes(self, j)
 
     def tf_string(self, digits: int = 4) -> str:
         """Each output's transfer function in z (:meth:`output_model`'s),
