@@ -442,7 +442,6 @@ def identify_narx(
     holdout: float = 0.2,
     decay: float = 1e-3,
     training: str = "free-run",
-    horizon: int | None = None,
     linear_estimator=None,
     **options,
 ) -> NARXModel:
@@ -481,13 +480,12 @@ def identify_narx(
         free run's error over the training part; ``"subsequences"`` the
         error of overlapping stretches of `horizon` samples, each run from
         the measured samples before it (:mod:`.subsequences`), with the
-        held-back part in 5 blocks spread over the record instead of its
-        end. The early stopping scores the free run either way.
-    horizon : int or None
-        Samples per stretch of ``training="subsequences"`` (>= 2), or None
-        for the curriculum :data:`~.subsequences.HORIZONS` (each stage
-        starting where the one before stopped, up to the training part's
-        length).
+        held-back part in 10 blocks spread over the record instead of its
+        end. The early stopping scores the free run either way. The
+        option ``horizon`` (in `options`) is the stretches' length
+        (>= 2), or None (default) for the curriculum
+        :data:`~.subsequences.HORIZONS` (each stage starting where the one
+        before stopped, up to the training part's length).
     linear_estimator : callable or None
         ``linear_estimator(data, arx, integrator, rng) -> theta``: the
         default method's ARX, the linear start of a free run from rest.
@@ -495,7 +493,8 @@ def identify_narx(
         imports neither it nor the estimators' table (no import circle,
         tests/test_layout.py). None: the least-squares ARX.
     **options
-        The estimator's own options (a search's ``max_nfev``...).
+        The estimator's own options (a search's ``max_nfev``...), and
+        ``horizon`` (see `training`).
 
     Returns
     -------
@@ -522,10 +521,10 @@ def identify_narx(
         raise ValueError(f"`decay` must be a finite number >= 0; got {decay!r}")
     if training not in TRAININGS:
         raise ValueError(f"`training` must be one of {TRAININGS}; got {training!r}")
-    horizon = check_horizon(horizon)
+    horizon = check_horizon(options.pop("horizon", None))
     if training == "subsequences" and predictor != "simulation":
         raise ValueError(
-            "`training='subsequences'` trains the simulation error; got "
+            "`training` 'subsequences' trains the simulation error; got "
             f"predictor={predictor!r}"
         )
     if horizon is not None and training != "subsequences":
