@@ -55,8 +55,9 @@ def test_held_back_blocks_share_and_disjointness():
 
 
 def test_curriculum_stops_at_the_training_part():
-    assert curriculum(None, 2, 1024) == HORIZONS
-    assert curriculum(None, 2, 62) == (10, 30, 60)
+    # The free run of the training part (None) ends the curriculum.
+    assert curriculum(None, 2, 1024) == (*HORIZONS, None)
+    assert curriculum(None, 2, 62) == (10, 30, None)
     assert curriculum(50, 2, 1024) == (50,)
     assert curriculum(5000, 2, 1024) == (1022,)
 

