@@ -178,19 +178,23 @@ def curriculum(horizon, lo: int, stop: int) -> tuple[int, ...]:
     return (*(h for h in HORIZONS if h < room), None)
 
 
-def check_horizon(horizon) -> int | None:
+def check_horizon(horizon, name: str = "horizon") -> int | None:
     """`horizon` checked: None or an integer >= 2.
 
     Parameters
     ----------
     horizon : int or None
+    name : str
+        The argument's name in the message.
     """
     if horizon is None:
         return None
-    if isinstance(horizon, bool) or not isinstance(horizon, int | np.integer):
-        raise ValueError(f"`horizon` must be an integer >= 2 or None; got {horizon!r}")
-    if horizon < 2:
-        raise ValueError(f"`horizon` must be an integer >= 2 or None; got {horizon!r}")
+    if (
+        isinstance(horizon, bool)
+        or not isinstance(horizon, int | np.integer)
+        or horizon < 2
+    ):
+        raise ValueError(f"`{name}` must be an integer >= 2 or None; got {horizon!r}")
     return int(horizon)
 
 
