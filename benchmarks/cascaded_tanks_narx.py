@@ -17,8 +17,8 @@ Nonlinear rig (``--rig``): the paper's experiment on the nonlinear rig,
 end acceleration, estimation on the first two thirds, validation fit on
 the last, as ``benchmarks/nonparametric.py --goals``: the default ARX(8, 8,
 0) against NARX(8, 8, 0) (10 units) by the default method (or
-``--method``) with ``training="subsequences"``; the goal is the ARX fit plus min(5, half the
-remaining misfit).
+``--method``) with ``training="subsequences"``; the goal is the ARX fit
+plus min(5, half the remaining misfit).
 
 Seconds are processor time of this process (the machine is shared).
 
