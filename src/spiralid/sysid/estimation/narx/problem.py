@@ -75,8 +75,11 @@ class NARXProblem:
         self.phi, self.target = structure.regressors(data.u, data.y, s)
         n = data.n
         lo = max(self.t0, structure.max_lag if predictor == "one-step" else 0)
-        self.horizon = None  # the subsequences' length while training on them
-        self.stages = (None,)  # the horizons training runs through
+        # Training on subsequences (.subsequences): the stretches' length
+        # while a polish runs on them (None: the free run), and the lengths
+        # a training runs through (identify_narx sets them).
+        self.horizon = None
+        self.stages = (None,)
         if blocks > 1 and holdout > 0:
             self.split = n
             self.train, self.hold = _interleaved(lo, n, holdout, blocks)

@@ -48,6 +48,10 @@ so the held-back cost decides the training length; ``"ls"`` and ``"oe"``
 keep a fixed patience and 50 rounds. Searches minimise the training
 cost only. The Levenberg-Marquardt fits add a weight decay on the
 network's weights (``decay``, default 1e-3; see :func:`identify_narx`).
+With ``training="subsequences"`` each Levenberg-Marquardt polish runs on
+the error of short stretches started from measured samples, through a
+curriculum of lengths, and the held-back share is spread over the record
+in blocks (:mod:`.subsequences`).
 The reported ``cost`` is the paper's (eq. (2) with the gain
 ``100 sqrt(K) / rms(y)``, the error's RMS in percent of the output's) over
 the whole estimation record.
@@ -481,7 +485,10 @@ def identify_narx(
         error of overlapping stretches of `horizon` samples, each run from
         the measured samples before it (:mod:`.subsequences`), with the
         held-back part in 10 blocks spread over the record instead of its
-        end. The early stopping scores the free run either way. The
+        end. The early stopping scores the free run either way; the
+        searches (and ``"spiral"``'s memetic polish) still move on the
+        free run's cost, and every final Levenberg-Marquardt polish runs
+        through the stretches' lengths. The
         option ``horizon`` (in `options`) is the stretches' length
         (>= 2), or None (default) for the curriculum
         :data:`~.subsequences.HORIZONS` (each stage starting where the one
