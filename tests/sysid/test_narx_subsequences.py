@@ -154,3 +154,21 @@ def test_cascaded_tanks_training_keeps_to_its_linear_start_or_below():
 def test_bad_training_options_are_refused_in_one_line(options, name):
     with pytest.raises(ValueError, match=f"`{name}`"):
         identify(_record(100), NARX(2, 2, 1, hidden=(2,)), method="oe", **options)
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        dict(method="oe", horizon=25),
+        dict(method="oe", holdout=0.0),
+        dict(method="spiral", max_nfev=300, n_points=10),
+    ],
+)
+def test_every_method_and_split_trains_on_subsequences(options):
+    data = _record(300, seed=6, noise=0.02)
+    model = identify(
+        data, NARX(2, 2, 1, hidden=(3,)), training="subsequences", rng=0, **options
+    )
+    res = model.result
+    assert res.fun <= res.linear_cost
+    assert res.fun < 0.5 * res.linear_cost
