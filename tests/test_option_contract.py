@@ -87,6 +87,8 @@ NON_DEFAULT = {
     "safe_start": True,
     "holdout": 0.1,
     "decay": 0.01,
+    "training": "subsequences",
+    "horizon": 50,
 }
 EVERY_OPTION = sorted(
     {

@@ -105,6 +105,8 @@ def test_the_budget_counts_trainings_not_search_calls(second_order, chosen):
         (dict(holdback=0.0), "holdback"),
         (dict(holdback=0.7), "holdback"),
         (dict(nk=-1), "nk"),
+        (dict(horizons=()), "horizons"),
+        (dict(horizons=(20, 1)), "horizons[1]"),
     ],
 )
 def test_bad_arguments_are_refused_by_name(second_order, kwargs, name):
@@ -115,3 +117,21 @@ def test_bad_arguments_are_refused_by_name(second_order, kwargs, name):
 def test_data_must_be_a_record():
     with pytest.raises(TypeError, match="`data` must be an IOData"):
         choose_narx(np.zeros(10))
+
+
+def test_the_horizon_is_searched_with_training_on_subsequences(second_order):
+    from spiralid.sysid.estimation.narx.choice import _held_back_fit
+
+    res = choose_narx(
+        second_order, **BOX, horizons=(10, 40), budget=4, n_points=3, rng=0
+    )
+    assert res.horizon in (10, 40) and res.x[3] == res.horizon
+    assert all(len(t) == 5 and t[3] in (10, 40) for t in res.trials)
+    # The best trial is the choice, refitted on the whole record, where it
+    # is never above its linear start.
+    assert res.fit == max(t[4] for t in res.trials)
+    assert res.model.structure == res.structure
+    assert res.model.result.linear_cost >= res.model.result.fun
+    assert np.isfinite(
+        _held_back_fit(second_order.y, res.model.simulate(second_order.u))
+    )

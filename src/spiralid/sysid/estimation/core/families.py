@@ -118,7 +118,7 @@ def arx_estimator(method: str) -> Estimator:
 
 # -- NARX and polynomial NARX ---------------------------------------------------
 
-_NARX_OWN = ("rng", "predictor", "initial", "holdout", "decay")
+_NARX_OWN = ("rng", "predictor", "initial", "holdout", "decay", "training", "horizon")
 
 
 def _default_arx(data: IOData, arx, integrator: int, rng):

@@ -209,7 +209,7 @@ def identify(
         :func:`~spiralid.sysid.estimation.spiral.recommended._estimate_recommended`).
         A budget ``max_nfev`` without ``max_iter`` is the stop
         (:func:`~spiralid.sysid.estimation.spiral.population.search_options`).
-        For a NARX: ``holdout`` and ``decay``
+        For a NARX: ``holdout``, ``decay``, ``training`` and ``horizon``
         (:func:`~spiralid.sysid.estimation.narx.training.identify_narx`) and its
         estimator's. Any option that does not apply to the method and
         structure is refused in one line naming it, the method and the
@@ -282,7 +282,8 @@ def identify(
       ``restarts``.
 
     For a NARX structure every method takes ``rng``, ``predictor``,
-    ``initial``, ``holdout`` and ``decay``, and: ``"ls"`` and ``"oe"``
+    ``initial``, ``holdout``, ``decay``, ``training`` and ``horizon``, and:
+    ``"ls"`` and ``"oe"``
     ``max_rounds``, ``patience``, ``patience_share``; ``"spiral"``
     ``rule``, ``n_points``, ``max_nfev``, ``polish_every``,
     ``polish_nfev``, ``max_iter``, ``max_rounds``, ``patience``,

@@ -41,7 +41,8 @@ def identify_options(
     search with ``refine=True``; ``cancel`` for those with
     ``Method.cancel``; then
     :func:`~spiralid.sysid.estimation.core.estimators.method_options`.
-    For a NARX: ``predictor``, ``initial``, ``holdout``, ``decay`` and the
+    For a NARX: ``predictor``, ``initial``, ``holdout``, ``decay``,
+    ``training``, ``horizon`` and the
     method's NARX estimator's options; a PolynomialNARX (forward
     regression) takes ``predictor`` and ``initial`` only.
 
@@ -50,8 +51,8 @@ def identify_options(
     >>> identify_options("ls", ARX(2, 2, 1))
     ('rng', 'predictor', 'initial', 'gain', 'penalty', 'integrator')
     >>> identify_options("oe", NARX(2, 2, 1))  # doctest: +NORMALIZE_WHITESPACE
-    ('rng', 'predictor', 'initial', 'holdout', 'decay', 'max_rounds', 'patience',
-     'patience_share')
+    ('rng', 'predictor', 'initial', 'holdout', 'decay', 'training', 'horizon',
+     'max_rounds', 'patience', 'patience_share')
     """
     family = family_of(structure, n_outputs)
     return estimator(family, method, structure).options(refine)

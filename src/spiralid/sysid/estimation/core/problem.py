@@ -35,9 +35,11 @@ IDENTIFY_DEFAULTS = dict(
     bounds=None,
     refine=False,
     safe_start=None,
-    # A NARX's early stopping and weight decay (identify_narx's).
+    # A NARX's early stopping, weight decay and training (identify_narx's).
     holdout=0.2,
     decay=1e-3,
+    training="free-run",
+    horizon=None,
 )
 
 

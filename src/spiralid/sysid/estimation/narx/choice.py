@@ -1,5 +1,6 @@
 """A spiral search over the choices a NARX user struggles with: the lags,
-the hidden units and the weight decay.
+the hidden units and the weight decay, and with training on subsequences
+their length.
 
 :func:`choose_narx` runs :func:`spiralid.optim.minimize` over three
 integer-rounded coordinates (lags ``n``, hidden units ``h``, and the
@@ -35,6 +36,7 @@ from spiralid.optim.result import OptimiserResult
 from ...data import IOData
 from ...models.narx import NARX
 from ..core.identify import identify
+from .subsequences import check_horizon
 
 __all__ = ["choose_narx", "round_choice"]
 
@@ -105,6 +107,24 @@ def _decay_range(value) -> tuple[float, float]:
     return lo, hi
 
 
+def _horizons(value) -> tuple[int, ...] | None:
+    """`horizons` checked: None, or a non-empty sequence of integers >= 2."""
+    if value is None:
+        return None
+    try:
+        items = tuple(value)
+    except TypeError:
+        items = ()
+    if not items:
+        raise ValueError(
+            f"`horizons` must be None or a non-empty sequence of integers >= 2; "
+            f"got {value!r}"
+        )
+    for i, h in enumerate(items):
+        check_horizon(h, f"horizons[{i}]")
+    return tuple(int(h) for h in items)
+
+
 def _held_back_fit(y: np.ndarray, yhat: np.ndarray) -> float:
     """MATLAB's ``compare`` fit in percent (as ``validate``); -inf for a
     free run that diverged. `y` varies (choose_narx checks it)."""
@@ -142,16 +162,17 @@ def _search(cost, ranges, rule, n_points: int, budget: int, gen) -> str:
     """The spiral search of `cost` over the `ranges` (lags, hidden units,
     log10 decay) until `budget` trainings are spent; the message saying
     what ended it."""
-    lags, hidden, log_decay = ranges
+    lags, hidden, log_decay, horizons = ranges
     # Half a unit beyond each end, so the end values round in as often as
     # the inner ones.
-    box = np.array(
-        [
-            [lags[0] - 0.5, lags[1] + 0.5],
-            [hidden[0] - 0.5, hidden[1] + 0.5],
-            [math.ceil(2 * log_decay[0]) - 0.5, math.floor(2 * log_decay[1]) + 0.5],
-        ]
-    )
+    rows = [
+        [lags[0] - 0.5, lags[1] + 0.5],
+        [hidden[0] - 0.5, hidden[1] + 0.5],
+        [math.ceil(2 * log_decay[0]) - 0.5, math.floor(2 * log_decay[1]) + 0.5],
+    ]
+    if horizons is not None:
+        rows.append([-0.5, len(horizons) - 0.5])
+    box = np.array(rows)
     try:
         # Repeats cost no training, so the call cap only ends a search that
         # keeps landing on choices it has trained.
@@ -184,6 +205,7 @@ def choose_narx(
     rule: str = "learned-metric",
     n_points: int = 6,
     integrator: int = 0,
+    horizons: tuple[int, ...] | None = None,
     rng=None,
 ) -> OptimiserResult:
     """Choose a NARX's lags, hidden units and weight decay by a spiral
@@ -217,6 +239,11 @@ def choose_narx(
         are drawn, but never fewer than 2).
     integrator : int
         Integrators of every candidate (``NARX(..., integrator=...)``).
+    horizons : sequence of int, optional
+        Train every candidate on subsequences (``identify``'s
+        ``training="subsequences"``) and search their length among these
+        (each >= 2) as a fourth coordinate, an index into them rounded to
+        the nearest. None (default): free-run training, three coordinates.
     rng : int, Generator or None
         Randomness of the search and of the trainings.
 
@@ -224,10 +251,12 @@ def choose_narx(
     -------
     OptimiserResult
         ``model`` (the best choice trained on the whole record),
-        ``structure``, ``decay``, ``x`` (``[n, h, log10 decay]``), ``fun``
+        ``structure``, ``decay``, ``horizon`` (None without `horizons`),
+        ``x`` (``[n, h, log10 decay]``, then the horizon), ``fun``
         (the best held-back fit's shortfall, ``100 - fit``), ``fit``,
         ``trials`` (one ``(n, h, log10 decay, held-back fit %)`` per
-        training, in order), ``nfev`` (trainings, the final one excluded),
+        training, in order; with `horizons`, the horizon before the fit),
+        ``nfev`` (trainings, the final one excluded),
         ``n_calls`` (the search's evaluations, repeats included),
         ``elapsed``.
 
@@ -264,6 +293,7 @@ def choose_narx(
     share = real(holdback, "holdback")
     if not 0.0 < share <= 0.5:
         raise ValueError(f"`holdback` must be a number in (0, 0.5]; got {holdback!r}")
+    horizons = _horizons(horizons)
     gen = generator(rng)
     train, y_end = _held_back(data, share)
     split = train.n
@@ -285,29 +315,45 @@ def choose_narx(
     trials: dict[tuple, float] = {}
     calls = [0]
 
+    def key_of(x: np.ndarray) -> tuple:
+        key = round_choice(x, lags, hidden, log_decay)
+        if horizons is None:
+            return key
+        i = int(np.clip(np.rint(x[3]), 0, len(horizons) - 1))
+        return (*key, horizons[i])
+
+    def fit(record: IOData, key: tuple):
+        n, h, d = key[:3]
+        training = {} if horizons is None else {"training": "subsequences"}
+        if horizons is not None:
+            training["horizon"] = key[3]
+        return identify(
+            record, structure(n, h), method="oe", decay=10.0**d, rng=gen, **training
+        )
+
     def cost(x: np.ndarray) -> float:
         calls[0] += 1
-        key = round_choice(x, lags, hidden, log_decay)
+        key = key_of(x)
         if key not in trials:
             if len(trials) >= budget:
                 raise _BudgetSpent
-            n, h, d = key
-            model = identify(
-                train, structure(n, h), method="oe", decay=10.0**d, rng=gen
-            )
+            model = fit(train, key)
             trials[key] = _held_back_fit(y_end, model.simulate(data.u)[split:])
         return 100.0 - trials[key]
 
-    message = _search(cost, (lags, hidden, log_decay), rule, n_points, budget, gen)
-    (n, h, d), fit = max(trials.items(), key=lambda kv: kv[1])
-    model = identify(data, structure(n, h), method="oe", decay=10.0**d, rng=gen)
+    ranges = (lags, hidden, log_decay, horizons)
+    message = _search(cost, ranges, rule, n_points, budget, gen)
+    key, best = max(trials.items(), key=lambda kv: kv[1])
+    n, h, d = key[:3]
+    model = fit(data, key)
     return OptimiserResult(
-        x=np.array([n, h, d], dtype=float),
-        fun=100.0 - fit,
-        fit=fit,
+        x=np.array(key, dtype=float),
+        fun=100.0 - best,
+        fit=best,
         model=model,
         structure=structure(n, h),
         decay=10.0**d,
+        horizon=None if horizons is None else key[3],
         trials=[(*key, f) for key, f in trials.items()],
         nfev=len(trials),
         n_calls=calls[0],

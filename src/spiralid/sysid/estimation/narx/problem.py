@@ -5,6 +5,7 @@ estimators of :mod:`.narx` and :mod:`.frols` work on it."""
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 
@@ -15,6 +16,7 @@ from spiralid.optim.result import OptimiserResult
 
 from ...models.narx import Scaling
 from ..linear.levenberg import levenberg_marquardt
+from .subsequences import subsequence_residual
 
 __all__ = [
     "MAX_ROUNDS",
@@ -52,9 +54,15 @@ class NARXProblem:
     holdout : float
         Share of the record held back for early stopping, in [0, 0.5).
     rng : numpy.random.Generator
+    blocks : int
+        1: the held-back part is the record's end. More: the record after
+        its first full history is cut into `blocks` equal stretches and the
+        last `holdout` share of each is held back (training on
+        subsequences, :mod:`.subsequences`, whose early stopping must not
+        judge on an end the training part never resembles).
     """
 
-    def __init__(self, data, structure, predictor, initial, holdout, rng):
+    def __init__(self, data, structure, predictor, initial, holdout, rng, blocks=1):
         self.data = data
         self.structure = structure
         self.predictor = predictor
@@ -66,14 +74,25 @@ class NARXProblem:
         self.t0, self.hist, self.ystart = structure._history(data.y, s, initial)
         self.phi, self.target = structure.regressors(data.u, data.y, s)
         n = data.n
-        self.split = n - round(holdout * n) if holdout > 0 else n
         lo = max(self.t0, structure.max_lag if predictor == "one-step" else 0)
-        self.train = slice(lo, self.split)
-        self.hold = slice(self.split, n) if self.split < n else None
+        # Training on subsequences (.subsequences): the stretches' length
+        # while a polish runs on them (None: the free run), and the lengths
+        # a training runs through (identify_narx sets them).
+        self.horizon = None
+        self.stages = (None,)
+        if blocks > 1 and holdout > 0:
+            self.split = n
+            self.train, self.hold = _interleaved(lo, n, holdout, blocks)
+        else:
+            self.split = n - round(holdout * n) if holdout > 0 else n
+            self.train = slice(lo, self.split)
+            self.hold = slice(self.split, n) if self.split < n else None
         y = data.y
         self.rms_train = float(np.sqrt(np.mean(y[self.train] ** 2))) or 1.0
         self.rms_hold = (
-            float(np.sqrt(np.mean(y[self.hold] ** 2))) or 1.0 if self.hold else 1.0
+            float(np.sqrt(np.mean(y[self.hold] ** 2))) or 1.0
+            if self.hold is not None
+            else 1.0
         )
         self.rms_all = float(np.sqrt(np.mean(y[lo:] ** 2))) or 1.0
         self.lo = lo
@@ -125,13 +144,18 @@ class NARXProblem:
         """Scaled training residual and its exact Jacobian (callables), with
         the weight decay's rows ``sqrt(decay M) w`` on the network's weights
         (not the bypass) appended when `decay` > 0."""
-        fun, jac = self._residual_and_jacobian(predictor)
+        if predictor == "simulation" and self.horizon is not None:
+            fun, jac, m = subsequence_residual(self, self.horizon)
+        else:
+            fun, jac = self._residual_and_jacobian(predictor)
+            m = np.arange(self.data.n)[self.train].size
         decay = getattr(self, "decay", 0.0)
         st = self.structure
         if decay <= 0.0 or st.family != "narx" or st.h == 0:
             return fun, jac
         net = np.arange(st.h * (st.n_regressors + 2))
-        m = self.train.stop - self.train.start
+        # The decay weighs against the mean squared residual: M is the
+        # residuals' count (the training samples, or the stretches' samples).
         w = math.sqrt(decay * m)
 
         def fun_decay(p):
@@ -203,7 +227,7 @@ class NARXProblem:
         other.__dict__.update(self.__dict__)
         n = self.data.n
         other.split, other.hold = n, None
-        other.train = slice(self.train.start, n)
+        other.train = slice(self.lo, n)
         other.rms_train = self.rms_all
         other.nfev = 0
         return other
@@ -270,6 +294,17 @@ class NARXProblem:
         other.__dict__.update(self.__dict__)
         other.predictor = predictor
         return float(other.costs(p)[pick][0])
+
+
+def _interleaved(lo: int, n: int, holdout: float, blocks: int):
+    """Training and held-back indices: ``[lo, n)`` cut into `blocks` equal
+    stretches, the last `holdout` share of each held back."""
+    edges = np.linspace(lo, n, blocks + 1).round().astype(int)
+    hold = np.zeros(n, dtype=bool)
+    for a, b in itertools.pairwise(edges):
+        hold[b - round(holdout * (b - a)) : b] = True
+    idx = np.arange(n)
+    return idx[lo:][~hold[lo:]], idx[hold]
 
 
 def stopping_options(max_rounds, patience, patience_share) -> dict:

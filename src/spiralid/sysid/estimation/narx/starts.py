@@ -74,7 +74,10 @@ def _linear_starts(problem: NARXProblem, method: str = "default"):
     the generator as a user's `identify` call would find it).
     """
     whole, what = _linear_start(problem, method)
-    if whole is None or problem.hold is None:
+    if whole is None or problem.hold is None or problem.split >= problem.data.n:
+        # Held-back blocks inside the record (training on subsequences): the
+        # start is the whole record's, in sample on them, so training must
+        # beat it there to move (conservative).
         return whole, whole, what
     train, _ = _linear_start(problem, method, n=problem.split)
     return train, whole, what

@@ -48,6 +48,10 @@ so the held-back cost decides the training length; ``"ls"`` and ``"oe"``
 keep a fixed patience and 50 rounds. Searches minimise the training
 cost only. The Levenberg-Marquardt fits add a weight decay on the
 network's weights (``decay``, default 1e-3; see :func:`identify_narx`).
+With ``training="subsequences"`` each Levenberg-Marquardt polish runs on
+the error of short stretches started from measured samples, through a
+curriculum of lengths, and the held-back share is spread over the record
+in blocks (:mod:`.subsequences`).
 The reported ``cost`` is the paper's (eq. (2) with the gain
 ``100 sqrt(K) / rms(y)``, the error's RMS in percent of the output's) over
 the whole estimation record.
@@ -79,6 +83,14 @@ from .problem import (
     stopping_options,
 )
 from .starts import _starts
+from .subsequences import (
+    HOLD_BLOCKS,
+    TRAININGS,
+    check_horizon,
+    curriculum,
+    replay_stages,
+    train_stages,
+)
 
 __all__ = ["NARXProblem", "identify_narx"]
 
@@ -101,18 +113,20 @@ def _fit(
     nothing held back the rounds run until `max_rounds` or convergence.
     """
     best = None
+    stages = problem.stages if predictor == "simulation" else (None,)
     for name, p0 in starts.items():
-        p, rounds = problem.polish(p0, predictor, **options)
+        p, schedule = train_stages(problem, p0, predictor, stages, options)
         pick = 1 if problem.hold is not None else 0
         score = problem._score(p, predictor, pick)
         if best is None or score < best[0]:
-            best = (score, name, p, rounds)
-    _, name, p, rounds = best
+            best = (score, name, p, schedule)
+    _, name, p, schedule = best
+    rounds = sum(r for _, r in schedule)
     if problem.hold is None:
         return p, name, rounds
     whole = problem.whole()
     p0 = (refit or {}).get(name, starts[name])
-    p, _ = whole.polish(p0, predictor, rounds, rounds + 1, 0.0)
+    p = replay_stages(whole, p0, predictor, schedule)
     problem.nfev += whole.nfev
     return p, name, rounds
 
@@ -431,6 +445,7 @@ def identify_narx(
     rng=None,
     holdout: float = 0.2,
     decay: float = 1e-3,
+    training: str = "free-run",
     linear_estimator=None,
     **options,
 ) -> NARXModel:
@@ -463,6 +478,21 @@ def identify_narx(
         seeds 0-4 of ``benchmarks/nonparametric.py``'s nonlinear
         acceleration record (median validation fit 58.7 % without, 62.2 %
         with; 1e-4 gave 61.1 %, 1e-2 62.2 %).
+    training : {"free-run", "subsequences"}
+        What the Levenberg-Marquardt fits of the simulation error minimise
+        (a key of :data:`~.subsequences.TRAININGS`): ``"free-run"`` the
+        free run's error over the training part; ``"subsequences"`` the
+        error of overlapping stretches of `horizon` samples, each run from
+        the measured samples before it (:mod:`.subsequences`), with the
+        held-back part in 10 blocks spread over the record instead of its
+        end. The early stopping scores the free run either way; the
+        searches (and ``"spiral"``'s memetic polish) still move on the
+        free run's cost, and every final Levenberg-Marquardt polish runs
+        through the stretches' lengths. The
+        option ``horizon`` (in `options`) is the stretches' length
+        (>= 2), or None (default) for the curriculum
+        :data:`~.subsequences.HORIZONS` (each stage starting where the one
+        before stopped, up to the training part's length).
     linear_estimator : callable or None
         ``linear_estimator(data, arx, integrator, rng) -> theta``: the
         default method's ARX, the linear start of a free run from rest.
@@ -470,7 +500,8 @@ def identify_narx(
         imports neither it nor the estimators' table (no import circle,
         tests/test_layout.py). None: the least-squares ARX.
     **options
-        The estimator's own options (a search's ``max_nfev``...).
+        The estimator's own options (a search's ``max_nfev``...), and
+        ``horizon`` (see `training`).
 
     Returns
     -------
@@ -495,10 +526,24 @@ def identify_narx(
         ok = False
     if not ok or isinstance(decay, bool):
         raise ValueError(f"`decay` must be a finite number >= 0; got {decay!r}")
+    if training not in TRAININGS:
+        raise ValueError(f"`training` must be one of {TRAININGS}; got {training!r}")
+    horizon = check_horizon(options.pop("horizon", None))
+    if training == "subsequences" and predictor != "simulation":
+        raise ValueError(
+            "`training` 'subsequences' trains the simulation error; got "
+            f"predictor={predictor!r}"
+        )
+    if horizon is not None and training != "subsequences":
+        raise ValueError("`horizon` needs `training='subsequences'`")
     structure.check_length(data)
+    blocks = HOLD_BLOCKS if training == "subsequences" else 1
     problem = NARXProblem(
-        data, structure, predictor, initial, float(holdout), generator(rng)
+        data, structure, predictor, initial, float(holdout), generator(rng), blocks
     )
+    problem.stages = (None,)
+    if training == "subsequences":
+        problem.stages = curriculum(horizon, structure.max_lag, data.n)
     problem.decay = float(decay)
     problem.linear_estimator = linear_estimator
     res = estimate(problem, **options)
