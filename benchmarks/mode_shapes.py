@@ -10,8 +10,7 @@ with the shaker alone instead (``force_at`` ``--force-at``, default 0.6;
 no torque): the same shapes must come out of either input. ``--input
 both``: the torque and the shaker together, a record of two inputs fitted
 with one denominator over every pair; the shapes are the torque's
-(``model.input_shapes("torque")``; a fit of several inputs has no shape
-intervals yet: their coverage prints as nan).
+(``model.input_shapes("torque")``).
 
 Structure: ARX(14, 14, 1), every accelerometer's true order (five modes
 below Nyquist, 10 poles, and the 4th-order anti-aliasing filter every

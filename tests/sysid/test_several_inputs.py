@@ -281,3 +281,36 @@ def test_each_input_s_shapes_are_scipys_residues_of_its_pairs():
             np.abs(mac(got.shapes, want).diagonal()), 1.0, rtol=1e-9
         )
         np.testing.assert_allclose(got.shapes, normalise_shapes(want), atol=1e-7)
+
+
+def test_the_covariance_of_two_inputs_is_the_finite_difference_one():
+    """The shapes' factor of a fit of two inputs: ``R' R`` equals ``s^2
+    (J' J)^-1`` of the weighted simulation error of every output, ``J`` by
+    finite differences of SciPy's ``lfilter`` runs of every pair."""
+    data = _record(600, noise=0.05, seed=4)
+    fit = identify(data, ARX(4, 2, 1), method="oe")
+    na, nb = 4, 2
+
+    def residual(theta):
+        a, b = theta[:na], theta[na:].reshape(2, 2 * nb)
+        den = np.r_[1.0, a]
+        out = []
+        for i, w in enumerate(np.sqrt(fit.weights)):
+            sim = sum(
+                lfilter([0.0, *b[i, j * nb : (j + 1) * nb]], den, data.u[:, j])
+                for j in range(2)
+            )
+            out.append(w * (sim - data.y[:, i]))
+        return np.concatenate(out)
+
+    theta = np.r_[fit.a, fit.b.ravel()]
+    r0, h = residual(theta), 1e-7
+    jac = np.column_stack(
+        [(residual(theta + h * e) - r0) / h for e in np.eye(theta.size)]
+    )
+    s2 = r0 @ r0 / (r0.size - theta.size)
+    want = s2 * np.linalg.inv(jac.T @ jac)
+    got = fit.shape_factor.T @ fit.shape_factor
+    np.testing.assert_allclose(got, want, rtol=1e-3, atol=1e-12)
+    shapes = fit.input_shapes("f2")
+    assert np.all(np.isfinite(shapes.real_interval))

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...data import IOData
 from ...models.polynomials import is_stable_polynomial
 from ..linear.outputerror import error_functions
 
@@ -36,12 +37,13 @@ def parameter_factor(cost, a, b) -> np.ndarray | None:
         inputs summed for their integrators, and its weights).
     a : array_like, shape (na,)
         The shared denominator at the optimum.
-    b : array_like, shape (p, nb)
-        Each output's numerator there.
+    b : array_like, shape (p, m nb)
+        Each output's numerators there (``[b_i1, .., b_im]`` with several
+        inputs).
 
     Returns
     -------
-    ndarray, shape (na + p nb, na + p nb), or None
+    ndarray, shape (na + p m nb, na + p m nb), or None
         None where `a` is unstable, the record too short for the
         parameters, or a direction undetermined (a singular value of ``J``
         below 1e-12 of the largest).
@@ -50,19 +52,11 @@ def parameter_factor(cost, a, b) -> np.ndarray | None:
     b = np.atleast_2d(np.asarray(b, dtype=float))
     if not is_stable_polynomial(a):
         return None
-    arx = cost.arx
-    p, nb = b.shape
-    na = a.size
     blocks, residual = [], []
     for i, (w, part) in enumerate(zip(np.sqrt(cost.weights), cost.parts, strict=True)):
-        res, jac = error_functions(arx, part.data, "simulation", "rest")
-        theta = np.r_[a, b[i]]
-        j_i = np.asarray(jac(theta), dtype=float)
-        block = np.zeros((j_i.shape[0], na + p * nb))
-        block[:, :na] = j_i[:, :na]
-        block[:, na + i * nb : na + (i + 1) * nb] = j_i[:, na:]
+        block, res = _output_block(cost.arx, part.data, a, b, i)
         blocks.append(w * block)
-        residual.append(w * res(theta))
+        residual.append(w * res)
     jac = np.vstack(blocks)
     r = np.concatenate(residual)
     dof = jac.shape[0] - jac.shape[1]
@@ -75,3 +69,29 @@ def parameter_factor(cost, a, b) -> np.ndarray | None:
     if not sv[-1] > 1e-12 * sv[0]:
         return None
     return np.sqrt(float(r @ r) / dof) * vt / sv[:, None]
+
+
+def _output_block(arx, data, a, b, i: int) -> tuple[np.ndarray, np.ndarray]:
+    """Output `i`'s rows of the Jacobian in ``[a, b_1, .., b_p]`` and its
+    simulation error from rest. With several inputs the output is the sum
+    of each input's ``B_ij / A`` response (superposition): each pair's
+    Jacobian from :func:`error_functions` on that input (the measured
+    output given to the first pair only, zeros to the others, so the
+    residuals add up to the output's), its ``a`` columns summed."""
+    u = np.asarray(data.u, dtype=float).reshape(data.n, -1)
+    m, na = u.shape[1], a.size
+    nb = b.shape[1] // m
+    block = np.zeros((data.n, na + b.size))
+    total = 0.0
+    for j in range(m):
+        y = data.y if j == 0 else np.zeros(data.n)
+        res, jac = error_functions(
+            arx, IOData(u[:, j], y, ts=data.ts), "simulation", "rest"
+        )
+        theta = np.r_[a, b[i, j * nb : (j + 1) * nb]]
+        j_ij = np.asarray(jac(theta), dtype=float)
+        block[:, :na] += j_ij[:, :na]
+        first = na + (i * m + j) * nb
+        block[:, first : first + nb] = j_ij[:, na:]
+        total = total + res(theta)
+    return block, total

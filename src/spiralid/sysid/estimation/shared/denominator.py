@@ -427,10 +427,7 @@ def _model(data, arx, method, cost, a, b, covariance, result, t0):
         covariance_factor=root,
         integrators=cost.integrators,
         result=result,
-        # The shapes' factor is of one input's parameters (several: none yet).
-        shape_factor=None
-        if covariance is None or data.n_inputs > 1
-        else parameter_factor(cost, a, b),
+        shape_factor=None if covariance is None else parameter_factor(cost, a, b),
         timings={"total": time.perf_counter() - t0},
     )
 
