@@ -29,6 +29,11 @@ def _kernel_modules() -> list[str]:
     return found
 
 
+# Kernels compiled for a caller's own functions: a cached copy would name
+# the caller's module, which the next process may not import.
+NOT_CACHED = {"spiralid.sysid.models.greybox_run.rk4_compiled"}
+
+
 def test_every_kernel_is_cached_on_disk():
     modules = _kernel_modules()
     assert "spiralid.optim._kernels" in modules
@@ -38,7 +43,7 @@ def test_every_kernel_is_cached_on_disk():
             # A dispatcher without cache=True holds a NullCache.
             if isinstance(value, Dispatcher) and isinstance(value._cache, NullCache):
                 uncached.append(f"{name}.{attr}")
-    assert uncached == []
+    assert sorted(uncached) == sorted(NOT_CACHED)
 
 
 _CALL = """

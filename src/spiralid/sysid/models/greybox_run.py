@@ -69,7 +69,10 @@ def _first(value):  # pragma: no cover - compiled
     return np.asarray(value).ravel()[0]
 
 
-@numba.njit(cache=True)
+# Not cached on disk: a cached copy names the module of the f and g it was
+# compiled for, and a later process that cannot import that module (a test
+# module, a script's __main__) fails loading it instead of compiling.
+@numba.njit(cache=False)
 def rk4_compiled(f, g, p, x0, u, ts, n_sub):  # pragma: no cover - compiled
     """:func:`rk4_python` compiled, `f` and `g` Numba functions (each pair
     compiles once per process)."""
