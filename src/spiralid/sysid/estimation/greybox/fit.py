@@ -107,8 +107,8 @@ def _horizon_lengths(value, n: int, n_free: int) -> list[int]:
         raise ValueError(
             f"`horizons` must be increasing shares in (0, 1); got {value!r}"
         )
-    lengths = {int(round(f * n)) for f in shares}
-    return sorted(k for k in lengths if 2 * n_free < k < n) + [n]
+    lengths = {round(float(f) * n) for f in shares}
+    return [*sorted(k for k in lengths if 2 * n_free < k < n), n]
 
 
 def _chain(
