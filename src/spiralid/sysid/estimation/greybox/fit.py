@@ -7,6 +7,9 @@
   log scale), seeded with the initial values, then Levenberg-Marquardt on
   the simulation error from the best point, projected into the box;
 - ``"oe"``: that Levenberg-Marquardt alone, from the initial values;
+- both beside a second fit over growing horizons (``horizons``, shares of
+  the record): the search on the first share, the polish on each longer
+  one in turn; the fit of lower cost on the whole record is kept;
 - ``"sda"``, ``"ebsda"``: the paper's spiral searches over the same box and
   cost, as printed (no polish).
 
@@ -44,8 +47,11 @@ GREYBOX_METHODS: dict[str, tuple[str, ...]] = {
 _N_POINTS = 20
 _MAX_NFEV = 1000
 _POLISH_NFEV = 200
+# IPOP restarts of spiral's search: off, as the learned-metric poll does
+# not collapse within the default budget, so none would start.
 _RESTARTS = False
-# The growing horizons (shares of the record) of spiral's and oe's fit.
+# The growing horizons (shares of the record) of spiral's and oe's second
+# fit: over a tenth of the rig's record, its friction plane is smooth.
 _HORIZONS = (0.1, 0.25, 0.5)
 _RULES = {"spiral": "learned-metric", "sda": "sda", "ebsda": "ebsda"}
 
