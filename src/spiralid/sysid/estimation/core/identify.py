@@ -295,9 +295,9 @@ def identify(
     (:data:`~spiralid.sysid.estimation.greybox.fit.GREYBOX_METHODS`) takes
     ``rng``, ``gain``, ``penalty`` and ``workers`` (its simulations on
     several processes, :mod:`~spiralid.sysid.estimation.greybox.parallel`),
-    and: ``"spiral"`` ``n_points``, ``max_nfev``, ``polish_nfev``;
-    ``"oe"`` ``polish_nfev``; ``"sda"`` and ``"ebsda"`` ``n_points``,
-    ``max_nfev``.
+    and: ``"spiral"`` ``n_points``, ``max_nfev``, ``polish_nfev``,
+    ``horizons``, ``restarts``; ``"oe"`` ``polish_nfev``, ``horizons``;
+    ``"sda"`` and ``"ebsda"`` ``n_points``, ``max_nfev``.
     ``tests/test_option_contract.py`` checks this table against
     :func:`identify_options` and the command line.
 

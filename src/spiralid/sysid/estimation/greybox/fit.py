@@ -7,6 +7,9 @@
   log scale), seeded with the initial values, then Levenberg-Marquardt on
   the simulation error from the best point, projected into the box;
 - ``"oe"``: that Levenberg-Marquardt alone, from the initial values;
+- both beside a second fit over growing horizons (``horizons``, shares of
+  the record): the search on the first share, the polish on each longer
+  one in turn; the fit of lower cost on the whole record is kept;
 - ``"sda"``, ``"ebsda"``: the paper's spiral searches over the same box and
   cost, as printed (no polish).
 
@@ -32,10 +35,11 @@ from .problem import GreyBoxProblem
 __all__ = ["GREYBOX_METHODS", "fit_greybox"]
 
 _COMMON = ("rng", "gain", "penalty", "workers")
+_LOCAL = ("polish_nfev", "horizons")
 #: method -> the options it takes beside identify's common ones.
 GREYBOX_METHODS: dict[str, tuple[str, ...]] = {
-    "spiral": (*_COMMON, "n_points", "max_nfev", "polish_nfev"),
-    "oe": (*_COMMON, "polish_nfev"),
+    "spiral": (*_COMMON, "n_points", "max_nfev", *_LOCAL, "restarts"),
+    "oe": (*_COMMON, *_LOCAL),
     "sda": (*_COMMON, "n_points", "max_nfev"),
     "ebsda": (*_COMMON, "n_points", "max_nfev"),
 }
@@ -43,6 +47,12 @@ GREYBOX_METHODS: dict[str, tuple[str, ...]] = {
 _N_POINTS = 20
 _MAX_NFEV = 1000
 _POLISH_NFEV = 200
+# IPOP restarts of spiral's search: off, as the learned-metric poll does
+# not collapse within the default budget, so none would start.
+_RESTARTS = False
+# The growing horizons (shares of the record) of spiral's and oe's second
+# fit: over a tenth of the rig's record, its friction plane is smooth.
+_HORIZONS = (0.1, 0.25, 0.5)
 _RULES = {"spiral": "learned-metric", "sda": "sda", "ebsda": "ebsda"}
 
 
@@ -80,6 +90,7 @@ def _search(
         rng=given.get("rng"),
         vectorized=parallel,
         x0=problem.z0,
+        restarts=given.get("restarts", _RESTARTS) if method == "spiral" else False,
         # The spiral's trial points outside the box are clipped onto it
         # (the paper's searches stay as printed: the problem clips what
         # they evaluate): a parameter's bounds are physical, and a point
@@ -89,30 +100,87 @@ def _search(
     return np.clip(np.asarray(found.x, dtype=float), 0.0, 1.0)
 
 
+def _horizon_lengths(value, n: int, n_free: int) -> list[int]:
+    """The sample counts of `value`'s horizons (increasing shares of the
+    record in (0, 1)), those too short for a fit left out, then `n`."""
+    try:
+        shares = np.asarray(value, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise TypeError(
+            f"`horizons` must be a sequence of shares in (0, 1); got {value!r}"
+        ) from None
+    if np.any(~(shares > 0.0) | ~(shares < 1.0)) or np.any(np.diff(shares) <= 0):
+        raise ValueError(
+            f"`horizons` must be increasing shares in (0, 1); got {value!r}"
+        )
+    lengths = {round(float(f) * n) for f in shares}
+    return [*sorted(k for k in lengths if 2 * n_free < k < n), n]
+
+
+def _chain(
+    stages: list[GreyBoxProblem],
+    method: str,
+    given: dict,
+    polish_nfev: int,
+    pool: ParallelEvaluator,
+) -> np.ndarray:
+    """The search on the first stage's record, then (``"spiral"``,
+    ``"oe"``) the polish on each stage's in turn from the last result."""
+    pool.problem = stages[0]
+    z = _search(stages[0], method, given, pool)
+    for stage in stages if method in ("spiral", "oe") else ():
+        pool.problem = stage
+        polished = _polish(stage, z, polish_nfev, pool)
+        if stage(polished) <= stage(z):
+            z = polished
+    return z
+
+
+def _problem(data: IOData, structure: GreyBox, given: dict) -> GreyBoxProblem:
+    return GreyBoxProblem(
+        data,
+        structure,
+        gain=given.get("gain", "auto"),
+        penalty=given.get("penalty", 1e6),
+    )
+
+
 def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
     """The grey box `structure` fitted to `data` by `method` (a key of
     :data:`GREYBOX_METHODS`), `given` identify's arguments by name.
+
+    With ``horizons`` (``"spiral"`` and ``"oe"``), a second fit beside the
+    one on the whole record: its search runs on the record's first share
+    only and its polish on each longer share in turn, then on the whole
+    record, each from the last one's result; the fit of lower cost on the
+    whole record is the result. The error of a free run accumulates along
+    the record (a hub that comes to rest elsewhere after each pulse), so
+    over the whole record the cost can be rugged where over its start it is
+    smooth, and the start's minimum lies in the whole record's basin.
 
     Returns
     -------
     GreyBoxModel or LinearGreyBoxModel
         As the structure's kind.
     """
-    problem = GreyBoxProblem(
-        data,
-        structure,
-        gain=given.get("gain", "auto"),
-        penalty=given.get("penalty", 1e6),
-    )
+    problem = _problem(data, structure, given)
     polish_nfev = integer(given.get("polish_nfev", _POLISH_NFEV), "polish_nfev", 1)
+    chains = [[problem]]
+    if method in ("spiral", "oe"):
+        horizons = given.get("horizons", _HORIZONS)
+        lengths = _horizon_lengths(horizons, problem.y.size, problem.n_free)
+        if len(lengths) > 1:
+            shorter = [_problem(data[:k], structure, given) for k in lengths[:-1]]
+            chains.append([*shorter, problem])
     with ParallelEvaluator(problem, given.get("workers")) as pool:
-        z = _search(problem, method, given, pool)
-        if method in ("spiral", "oe"):
-            polished = _polish(problem, z, polish_nfev, pool)
-            if problem(polished) <= problem(z):
-                z = polished
+        z = min(
+            (_chain(chain, method, given, polish_nfev, pool) for chain in chains),
+            key=problem,
+        )
+        pool.problem = problem
         residual = problem.residual(z)
         jac = problem.jacobian(z, pool.residuals)
+    problem.nfev += sum(stage.nfev for chain in chains[1:] for stage in chain[:-1])
     intervals, notes = parameter_intervals(problem, z, residual, jac)
     kind = LinearGreyBoxModel if structure.kind == "linear" else GreyBoxModel
     return kind(
