@@ -26,6 +26,15 @@ that games one end does not game them all. The score of a candidate is
 fold; the lowest score is chosen (ties: the order above). Measured in
 docs/results/identification.md ("Drift: margin, folds, noise model").
 
+With ``folds="auto"`` (the default) the folds run only where the
+default's model had a pole its modes table flags as probably spurious
+(:func:`wanted`): the test is on the model before the flagged-pole removal
+(``Diagnosis.flagged``), since a removal the likelihood-ratio test allowed
+is itself the sign of a drift (its tolerance widens with the error's
+correlation) and the reduced model is still the held-back choice's basin;
+where nothing is flagged the model and its cost are exactly the default's
+without the folds.
+
 The reported cost stays the paper's, over the whole estimation record;
 a model chosen over the default carries no cancellation of its own (its
 covariance is the full structure's).
@@ -46,7 +55,22 @@ from ..linear.outputerror import local_polish
 from ..linear.parametrizations import make_parametrization
 from . import heldback
 
-__all__ = ["CANDIDATES", "FOLD_ENDS", "FoldChoice", "choose"]
+__all__ = [
+    "AUTO",
+    "CANDIDATES",
+    "FOLDS",
+    "FOLD_ENDS",
+    "FoldChoice",
+    "check",
+    "choose",
+    "wanted",
+]
+
+#: ``folds="auto"``: the folds run where the modes table flagged a pole.
+AUTO = "auto"
+
+#: The values of ``"spiral"``'s ``folds``, the default last.
+FOLDS = (True, False, AUTO)
 
 #: The folds' ends as shares of the estimation record: folds 0.4-0.6,
 #: 0.6-0.8 and 0.8-1.0, each refitted on what comes before it.
@@ -83,6 +107,50 @@ class FoldChoice:
             f"{self.chosen} (scores, the sum of log RMS against each fold's best: "
             f"{scores})"
         )
+
+
+def check(folds) -> bool | str:
+    """`folds` checked: True, False or ``"auto"``."""
+    if isinstance(folds, bool | np.bool_):
+        return bool(folds)
+    if not isinstance(folds, str):
+        raise TypeError(
+            f"`folds` of method 'spiral' must be True, False or {AUTO!r}; "
+            f"got {folds!r}"
+        )
+    if folds != AUTO:
+        raise ValueError(
+            f"`folds` of method 'spiral' must be True, False or {AUTO!r}; "
+            f"got {folds!r}"
+        )
+    return folds
+
+
+def n_flagged(problem: Problem, result: EstimatorResult) -> int:
+    """The poles the modes table flagged on `result`'s model before the
+    flagged-pole removal: the diagnosis's count where the method acted on
+    it, else (``cancel=False``) the flags of its model."""
+    diagnosis = result.get("diagnosis")
+    if diagnosis is not None:
+        return int(diagnosis.flagged)
+    from .cancellation import effective
+    from .spurious import flagged_poles
+
+    arx = problem.arx
+    order = result.get("effective_order") or (arx.na, arx.nb)
+    theta, reduced = effective(result.x, arx, order)
+    flags = flagged_poles(theta, reduced, problem.data, problem.initial)
+    return sum(f.size for f in flags)
+
+
+def wanted(folds, problem: Problem, result: EstimatorResult) -> bool:
+    """Whether the folds run: `folds` itself if True or False; with
+    ``"auto"`` where the modes table flagged a pole of the default's model
+    (:func:`n_flagged`)."""
+    folds = check(folds)
+    if folds != AUTO:
+        return folds
+    return n_flagged(problem, result) > 0
 
 
 def _differenced(data: IOData) -> IOData:
