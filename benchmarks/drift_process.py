@@ -106,6 +106,7 @@ def run_one(task) -> dict:
     model = identify(est, ARX(order, order, 0), rng=seed, **EVERY[name])
     elapsed = time.perf_counter() - t0
     diagnosis = getattr(model, "diagnosis", None) or {}
+    selection = getattr(model, "selection", None) or {}
     return dict(
         seed=seed,
         order=order,
@@ -114,6 +115,8 @@ def run_one(task) -> dict:
         cost=float(model.cost),
         effective=model.effective_order,
         removed=len(diagnosis.get("removed", [])),
+        # What the folds chose, "-" where they did not run.
+        chosen=selection.get("chosen", "-") if "fold_ends" in selection else "-",
         kept=len(diagnosis.get("kept", [])),
         flagged=int(np.sum(model.modes.spurious))
         if model.covariance is not None
@@ -129,8 +132,8 @@ def table(rows: list[dict], order: int) -> str:
         f"\n### ARX({order}, {order}, 0): validation fit % on the last third\n",
         "| seed | default | OE | LS | default - OE | default's effective order "
         "| flagged poles removed / kept | modes flagged in its table "
-        "| default s | OE s |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| folds chose | default s | OE s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for s in seeds:
         d, o, ls = cell[(s, "default")], cell[(s, "OE")], cell[(s, "LS")]
@@ -138,7 +141,8 @@ def table(rows: list[dict], order: int) -> str:
         lines.append(
             f"| {s} | {d['fit']:.1f} | {o['fit']:.1f} | {ls['fit']:.1f} | "
             f"{d['fit'] - o['fit']:+.1f} | {na}, {nb} | {d['removed']} / "
-            f"{d['kept']} | {d['flagged']} | {d['time']:.2f} | {o['time']:.2f} |"
+            f"{d['kept']} | {d['flagged']} | {d['chosen']} | {d['time']:.2f} | "
+            f"{o['time']:.2f} |"
         )
     names = [m for m in EVERY if (seeds[0], m) in cell]
     med = {m: np.median([cell[(s, m)]["fit"] for s in seeds]) for m in names}
