@@ -73,8 +73,8 @@ def test_folds_is_checked_and_only_the_recommended_method_s():
         sid.identify(data, ARX, rng=0, folds=1.5)
     with pytest.raises(ValueError, match="`folds=True` already weighs"):
         sid.identify(data, ARX, rng=0, folds=True, noise="integrated")
-    # "auto" (the default) leaves the chosen noise model alone.
-    integrated = sid.identify(data, ARX, rng=0, noise="integrated")
+    # "auto" leaves the chosen noise model alone.
+    integrated = sid.identify(data, ARX, rng=0, noise="integrated", folds=AUTO)
     assert "fold_ends" not in (integrated.selection or {})
     with pytest.raises(ValueError, match="`folds` does not apply to method 'oe'"):
         sid.identify(data, ARX, method="oe", folds=True)
@@ -93,7 +93,7 @@ def test_auto_leaves_a_model_with_no_flagged_pole_exactly_as_it_was():
     off = sid.identify(data, ARX, rng=0, folds=False)
     # Independently of the method: its model's table flags nothing.
     assert flagged_poles(off.theta, ARX, data, "rest") == []
-    auto = sid.identify(data, ARX, rng=0)
+    auto = sid.identify(data, ARX, rng=0, folds=AUTO)
     assert "fold_ends" not in (auto.selection or {})
     np.testing.assert_array_equal(auto.theta, off.theta)
     assert auto.cost == off.cost

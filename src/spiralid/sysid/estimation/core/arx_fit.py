@@ -100,10 +100,10 @@ def fit_arx(data: IOData, arx: ARX, method: str, given: dict) -> IdentifiedModel
     if (
         method == DEFAULT_METHOD
         and arx.na
-        and folds.wanted(options.get("folds", folds.AUTO), problem, res)
+        and folds.wanted(options.get("folds", folds.DEFAULT), problem, res)
     ):
         # Then the folds across the record choose among it, output error
-        # and output error with integrated noise (by default only where the
+        # and output error with integrated noise (with "auto" only where the
         # modes table flagged a pole: elsewhere the model is untouched).
         folds.choose(problem, res)
     return _packaged(method, problem, res, t_start, margin)
@@ -310,7 +310,8 @@ def _identify_integrated_noise(
             "give it with noise='white'"
         )
     if method == DEFAULT_METHOD:
-        # The noise model is chosen: no folds ("auto") on the differenced record.
+        # The noise model is chosen: no folds ("auto") on the differenced
+        # record.
         given = {**given, "folds": False}
     diff = replace(data, u=np.diff(data.u), y=np.diff(data.y))
     inner = fit_arx(diff, arx, method, given)

@@ -166,7 +166,7 @@ def _estimate_recommended(
     restarts: bool | Restarts = SPIRAL_RESTARTS,
     frequency_seeds: int = 0,
     holdback: float | None = HOLDBACK,
-    folds: bool | str = fold_choice.AUTO,
+    folds: bool | str = fold_choice.DEFAULT,
     stop: str = "work",
     x0=None,
     max_iter: int | None = None,
@@ -216,9 +216,9 @@ def _estimate_recommended(
     (:mod:`~spiralid.sysid.estimation.spiral.folds`; applied after the
     modes-table step, by the ARX fit, ``model.selection`` says which and
     why), a choice a continuing drift cannot win as it wins the held-back
-    end. ``folds="auto"`` (the default) runs them only where the modes
-    table flagged a pole of the method's model before the flagged-pole
-    removal; elsewhere the model and its cost are the method's own.
+    end. ``folds="auto"`` runs them only where the modes table flagged a
+    pole of the method's model before the flagged-pole removal; elsewhere
+    the model and its cost are the method's own. Default False.
 
     `stop` says when the search ends: ``"converged"`` as soon as a fresh
     population (a restart) stalls without lowering the best cost by more
