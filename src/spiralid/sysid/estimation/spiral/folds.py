@@ -59,19 +59,17 @@ __all__ = [
     "AUTO",
     "CANDIDATES",
     "DEFAULT",
-    "FOLDS",
     "FOLD_ENDS",
     "FoldChoice",
     "check",
     "choose",
+    "n_flagged",
     "wanted",
 ]
 
-#: ``folds="auto"``: the folds run where the modes table flagged a pole.
+#: ``folds="auto"`` (beside True and False): the folds run where the modes
+#: table flagged a pole.
 AUTO = "auto"
-
-#: The values of ``"spiral"``'s ``folds``.
-FOLDS = (True, False, AUTO)
 
 #: ``"spiral"``'s default ``folds``: off. ``"auto"`` met the failing drift
 #: record's goal (9 of 10 seeds) but, where a record that does not drift
