@@ -106,6 +106,9 @@ def fit_arx(data: IOData, arx: ARX, method: str, given: dict) -> IdentifiedModel
         # and output error with integrated noise (with "auto" only where the
         # modes table flagged a pole: elsewhere the model is untouched).
         folds.choose(problem, res)
+    # Output error's polish kept for the folds (with its problem): not part
+    # of the model.
+    res.pop("oe_fit", None)
     return _packaged(method, problem, res, t_start, margin)
 
 

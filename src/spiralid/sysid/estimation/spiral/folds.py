@@ -42,6 +42,7 @@ covariance is the full structure's).
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field, replace
 from itertools import pairwise
 
@@ -50,7 +51,7 @@ import numpy as np
 from ...data import IOData
 from ..core.cost import PaperCost
 from ..core.problem import EstimatorResult, Problem
-from ..linear.local_estimators import _estimate_oe
+from ..linear.local_estimators import _cancel, _estimate_oe
 from ..linear.outputerror import local_polish
 from ..linear.parametrizations import make_parametrization
 from . import heldback
@@ -157,6 +158,20 @@ def wanted(folds, problem: Problem, result: EstimatorResult) -> bool:
     return n_flagged(problem, result) > 0
 
 
+def _oe_model(problem: Problem, result: EstimatorResult) -> np.ndarray:
+    """Output error's model (``method="oe"``): the method's own polish of
+    output error's starts where it ran on `problem` (the same polish
+    ``"oe"`` makes, uncapped: ``result.oe_fit``), then its cancellation;
+    else output error run afresh."""
+    stored = result.get("oe_fit")
+    if stored is None or stored[0] is not problem:
+        return _estimate_oe(problem).x
+    fit = copy.copy(stored[1])
+    if problem.cancel:
+        _cancel(problem, fit, problem.simulation_cost())
+    return fit.x
+
+
 def _differenced(data: IOData) -> IOData:
     return replace(data, u=np.diff(data.u), y=np.diff(data.y))
 
@@ -216,7 +231,7 @@ def choose(problem: Problem, result: EstimatorResult) -> FoldChoice | None:
     # chose worse on the failing drift record (7/10 against 9/10 in one run).
     candidates = {
         "default": result.x,
-        "oe": _estimate_oe(problem).x,
+        "oe": _oe_model(problem, result),
         "integrated": _integrated_fit(problem),
     }
     choice = FoldChoice(FOLD_ENDS)

@@ -505,4 +505,9 @@ def _spiral_search(
         if oe is None and standard is not None:
             oe = _polish(problem, standard, problem.predictor, problem.cost)
         _refine(problem, result, oe, caps.get("polish"))
+        if oe is not None and problem.predictor == "simulation":
+            # Output error's own polish of its own starts, uncapped: the
+            # folds' "oe" candidate before its cancellation (popped by the
+            # ARX fit, with the problem it is of).
+            result.oe_fit = (problem, oe)
     return result
