@@ -111,3 +111,24 @@ def test_auto_runs_the_folds_where_the_table_flags_a_pole():
         assert auto.selection["fold_ends"] == list(FOLD_ENDS)
         assert auto.selection == always.selection
         np.testing.assert_array_equal(auto.theta, always.theta)
+
+
+def test_the_oe_candidate_is_output_error_s_model_without_a_second_fit():
+    from spiralid.sysid.estimation.core.arx_fit import _problem
+    from spiralid.sysid.estimation.core.estimators import METHODS
+    from spiralid.sysid.estimation.linear.local_estimators import _estimate_oe
+    from spiralid.sysid.estimation.spiral import folds
+
+    data = _drifting(0)
+    problem, options = _problem("spiral", data, ARX, {"rng": 0})
+    result = METHODS["spiral"].estimate(problem, **options)
+    assert result.oe_fit[0] is problem
+    # The same model as output error run afresh on the same problem.
+    np.testing.assert_array_equal(
+        folds._oe_model(problem, result), _estimate_oe(problem).x
+    )
+    # And as identify's method="oe" (its margin and cancellation).
+    oe = sid.identify(data, ARX, method="oe")
+    np.testing.assert_allclose(folds._oe_model(problem, result), oe.theta, atol=1e-8)
+    # Not kept in the model.
+    assert "oe_fit" not in sid.identify(data, ARX, rng=0).result
