@@ -226,9 +226,10 @@ def choose(problem: Problem, result: EstimatorResult) -> FoldChoice | None:
     least = problem.arx.max_lag + 2 * problem.arx.n_params
     if round(FOLD_ENDS[0] * problem.data.n) < least:
         return None
-    # Output error's own model, run in full: the method's polishes from the
-    # same starts are capped by its pace and skip the cancellation, and
-    # chose worse on the failing drift record (7/10 against 9/10 in one run).
+    # Output error's own model with its cancellation: the method's choice
+    # among its paced polishes chose worse on the failing drift record (7/10
+    # against 9/10 in one run). Its uncapped polish of OE's starts is OE's
+    # own and is reused, not run again (`_oe_model`).
     candidates = {
         "default": result.x,
         "oe": _oe_model(problem, result),
