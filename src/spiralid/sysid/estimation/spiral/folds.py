@@ -75,7 +75,7 @@ AUTO = "auto"
 #: ``"spiral"``'s default ``folds``: off. ``"auto"`` met the failing drift
 #: record's goal (9 of 10 seeds) but, where a record that does not drift
 #: has a flagged pole (the arm, the cascaded tanks at ARX(8, 8, 0)), it
-#: ran the folds at 6-8x output error's time for the same fit or 0.1
+#: ran the folds at 3.6-5x output error's time for the same fit or 0.1
 #: point less (docs/results/identification.md).
 DEFAULT = False
 
