@@ -30,13 +30,15 @@ and on how many it is 5 points or more below OE. Speed is printed, never
 asserted.
 
 With ``--folds`` it also runs the default with ``folds=True`` (the model
-chosen by folds across the record, ``folds``). With ``--integrated`` it
+chosen by folds across the record, ``folds``), with ``--auto`` with
+``folds="auto"`` (``auto``: the folds only where the default's modes table
+flagged a pole). With ``--integrated`` it
 also runs the default and output error with integrated noise
 (``noise="integrated"``: ``spiral-I``, ``OE-I``). Each prints its fits and
 counts against OE.
 
 Run: ``python benchmarks/drift_process.py [--seeds 10] [--orders 8]
-[--workers 2] [--integrated] [--folds]``. To measure the code before a
+[--workers 2] [--integrated] [--folds] [--auto]``. To measure the code before a
 change, put its source first on ``PYTHONPATH``.
 """
 
@@ -96,7 +98,10 @@ INTEGRATED = {
 # With --folds: the default with folds=True (the model chosen by folds
 # across the record among its own, OE's and OE with integrated noise).
 FOLDS = {"folds": {"folds": True}}
-EVERY = {**METHODS, **INTEGRATED, **FOLDS}
+# With --auto: the default with folds="auto" (the folds only where its
+# modes table flagged a pole).
+AUTO = {"auto": {"folds": "auto"}}
+EVERY = {**METHODS, **INTEGRATED, **FOLDS, **AUTO}
 
 
 def run_one(task) -> dict:
@@ -106,6 +111,7 @@ def run_one(task) -> dict:
     model = identify(est, ARX(order, order, 0), rng=seed, **EVERY[name])
     elapsed = time.perf_counter() - t0
     diagnosis = getattr(model, "diagnosis", None) or {}
+    selection = getattr(model, "selection", None) or {}
     return dict(
         seed=seed,
         order=order,
@@ -114,6 +120,8 @@ def run_one(task) -> dict:
         cost=float(model.cost),
         effective=model.effective_order,
         removed=len(diagnosis.get("removed", [])),
+        # What the folds chose, "-" where they did not run.
+        chosen=selection.get("chosen", "-") if "fold_ends" in selection else "-",
         kept=len(diagnosis.get("kept", [])),
         flagged=int(np.sum(model.modes.spurious))
         if model.covariance is not None
@@ -129,8 +137,8 @@ def table(rows: list[dict], order: int) -> str:
         f"\n### ARX({order}, {order}, 0): validation fit % on the last third\n",
         "| seed | default | OE | LS | default - OE | default's effective order "
         "| flagged poles removed / kept | modes flagged in its table "
-        "| default s | OE s |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| folds chose | default s | OE s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for s in seeds:
         d, o, ls = cell[(s, "default")], cell[(s, "OE")], cell[(s, "LS")]
@@ -138,7 +146,8 @@ def table(rows: list[dict], order: int) -> str:
         lines.append(
             f"| {s} | {d['fit']:.1f} | {o['fit']:.1f} | {ls['fit']:.1f} | "
             f"{d['fit'] - o['fit']:+.1f} | {na}, {nb} | {d['removed']} / "
-            f"{d['kept']} | {d['flagged']} | {d['time']:.2f} | {o['time']:.2f} |"
+            f"{d['kept']} | {d['flagged']} | {d['chosen']} | {d['time']:.2f} | "
+            f"{o['time']:.2f} |"
         )
     names = [m for m in EVERY if (seeds[0], m) in cell]
     med = {m: np.median([cell[(s, m)]["fit"] for s in seeds]) for m in names}
@@ -181,12 +190,16 @@ def main(argv=None) -> None:
         help="also both output-error methods with noise='integrated'",
     )
     ap.add_argument("--folds", action="store_true", help="also the default, folds=True")
+    ap.add_argument(
+        "--auto", action="store_true", help="also the default, folds='auto'"
+    )
     args = ap.parse_args(argv)
     orders = [int(v) for v in args.orders.split(",")]
     methods = {
         **METHODS,
         **(INTEGRATED if args.integrated else {}),
         **(FOLDS if args.folds else {}),
+        **(AUTO if args.auto else {}),
     }
     tasks = [(s, n, m) for n in orders for s in range(args.seeds) for m in methods]
     t0 = time.perf_counter()

@@ -97,10 +97,18 @@ def fit_arx(data: IOData, arx: ARX, method: str, given: dict) -> IdentifiedModel
         # The recommended method acts on its own modes table's diagnosis:
         # a flagged pole is removed where the cost allows.
         _act_on_modes(problem, res, (res.get("caps") or {}).get("cancel"))
-    if method == DEFAULT_METHOD and options.get("folds") and arx.na:
+    if (
+        method == DEFAULT_METHOD
+        and arx.na
+        and folds.wanted(options.get("folds", folds.DEFAULT), problem, res)
+    ):
         # Then the folds across the record choose among it, output error
-        # and output error with integrated noise.
+        # and output error with integrated noise (with "auto" only where the
+        # modes table flagged a pole: elsewhere the model is untouched).
         folds.choose(problem, res)
+    # Output error's polish kept for the folds (with its problem): not part
+    # of the model.
+    res.pop("oe_fit", None)
     return _packaged(method, problem, res, t_start, margin)
 
 
@@ -298,12 +306,16 @@ def _identify_integrated_noise(
         raise ValueError(
             f"`noise='integrated'` needs a record of at least 3 samples; got {data.n}"
         )
-    if given.get("folds"):
+    if "folds" in given and folds.check(given["folds"]) is True:
         # The folds choose between white and integrated noise themselves.
         raise ValueError(
             "`folds=True` already weighs output error with integrated noise; "
             "give it with noise='white'"
         )
+    if method == DEFAULT_METHOD:
+        # The noise model is chosen: no folds ("auto") on the differenced
+        # record.
+        given = {**given, "folds": False}
     diff = replace(data, u=np.diff(data.u), y=np.diff(data.y))
     inner = fit_arx(diff, arx, method, given)
     inner.result.noise = INTEGRATED

@@ -22,6 +22,7 @@ from ..linear.local_estimators import (
     _refine,
     _standard_starts,
 )
+from . import folds as fold_choice
 from . import heldback
 from .heldback import HOLDBACK
 
@@ -165,7 +166,7 @@ def _estimate_recommended(
     restarts: bool | Restarts = SPIRAL_RESTARTS,
     frequency_seeds: int = 0,
     holdback: float | None = HOLDBACK,
-    folds: bool = False,
+    folds: bool | str = fold_choice.DEFAULT,
     stop: str = "work",
     x0=None,
     max_iter: int | None = None,
@@ -215,7 +216,9 @@ def _estimate_recommended(
     (:mod:`~spiralid.sysid.estimation.spiral.folds`; applied after the
     modes-table step, by the ARX fit, ``model.selection`` says which and
     why), a choice a continuing drift cannot win as it wins the held-back
-    end. Default False.
+    end. ``folds="auto"`` runs them only where the modes table flagged a
+    pole of the method's model before the flagged-pole removal; elsewhere
+    the model and its cost are the method's own. Default False.
 
     `stop` says when the search ends: ``"converged"`` as soon as a fresh
     population (a restart) stalls without lowering the best cost by more
@@ -259,10 +262,7 @@ def _estimate_recommended(
             f"{problem.parametrization.name!r}"
         )
     holdback = _holdback_share(holdback)
-    if not isinstance(folds, bool | np.bool_):
-        raise TypeError(
-            f"`folds` of method 'spiral' must be True or False; got {folds!r}"
-        )
+    fold_choice.check(folds)
     restarts = _spiral_restarts(restarts)
     if stop not in SPIRAL_STOPS:
         raise ValueError(
@@ -505,4 +505,9 @@ def _spiral_search(
         if oe is None and standard is not None:
             oe = _polish(problem, standard, problem.predictor, problem.cost)
         _refine(problem, result, oe, caps.get("polish"))
+        if oe is not None and problem.predictor == "simulation":
+            # Output error's own polish of its own starts, uncapped: the
+            # folds' "oe" candidate before its cancellation (popped by the
+            # ARX fit, with the problem it is of).
+            result.oe_fit = (problem, oe)
     return result

@@ -97,10 +97,12 @@ class Diagnosis:
     the poles removed and the flagged poles kept, with the test's
     tolerance, the effective samples it used and the cost each kept pole's
     removal would have taken; ``untried`` counts the flagged poles left
-    when the polishes' budget was spent."""
+    when the polishes' budget was spent; ``flagged`` counts the poles the
+    table flagged on the estimate before any removal."""
 
     n_samples: int
     n_effective: float
+    flagged: int = 0
     removed: list[dict] = field(default_factory=list)
     kept: list[dict] = field(default_factory=list)
     untried: int = 0
@@ -112,6 +114,7 @@ class Diagnosis:
             "removed": [dict(r) for r in self.removed],
             "kept": [dict(k) for k in self.kept],
             "untried": int(self.untried),
+            "flagged": int(self.flagged),
             "note": self.sentence(),
         }
 
@@ -323,7 +326,11 @@ def remove_flagged(
         # first removal the test allows starts the next pass at the reduced
         # order. A pass without one ends: its refusals are what was kept.
         kept, acted, untried = [], False, 0
-        for flag in flagged_poles(current, structure, data, initial):
+        flags = flagged_poles(current, structure, data, initial)
+        if not fixed:
+            # The estimate as it came, before any removal.
+            diagnosis.flagged = sum(f.size for f in flags)
+        for flag in flags:
             zero = _partner(flag, current[structure.na :])
             if zero is None:
                 continue
