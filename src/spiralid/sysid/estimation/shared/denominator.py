@@ -53,7 +53,13 @@ from ...models.shared import SharedDenominatorModel
 from ..linear.margin import AUTO, is_auto, max_radius
 from ..linear.modal import ModalParametrization
 from ..linear.varpro import ProjectedCost, gauss_newton_polish
-from .inputs import SharedInputsCost, equation_regressors, shared_integrators, summed
+from .inputs import (
+    SharedInputsCost,
+    WeightedOutputs,
+    equation_regressors,
+    shared_integrators,
+    summed,
+)
 
 __all__ = [
     "SHARED_METHODS",
@@ -75,7 +81,7 @@ def shared_options(method: str) -> tuple[str, ...]:
     return ("rng", "predictor", "initial", "integrator", *SHARED_METHODS[method])
 
 
-class SharedProjectedCost:
+class SharedProjectedCost(WeightedOutputs):
     """``J(A)`` over denominators, every output's numerator projected out.
 
     Parameters
@@ -106,34 +112,7 @@ class SharedProjectedCost:
             ProjectedCost(arx, summed(data.output(i), k))
             for i, k in enumerate(self.integrators)
         ]
-        energy = np.array([float(np.sum(part.data.y**2)) for part in self.parts])
-        if weights is None:
-            weights = data.n / np.maximum(energy, np.finfo(float).tiny)
-        weights = np.asarray(weights, dtype=float).ravel()
-        if weights.shape != (len(self.parts),) or not np.all(
-            np.isfinite(weights) & (weights > 0)
-        ):
-            raise ValueError(
-                f"`weights` must be {len(self.parts)} finite numbers > 0 (one per "
-                f"output); got {weights!r}"
-            )
-        self.weights = weights
-        self._norm = float(weights @ energy)
-
-    def reweighted(self, weights) -> SharedProjectedCost:
-        """The same cost with other weights."""
-        return SharedProjectedCost(self.arx, self.data, weights, self.integrators)
-
-    def fun_of_sse(self, sse: float) -> float:
-        return 100.0 * float(np.sqrt(max(sse, 0.0) / self._norm))
-
-    def sse(self, a) -> float:
-        return float(
-            sum(
-                w * part.sse(a)
-                for w, part in zip(self.weights, self.parts, strict=True)
-            )
-        )
+        self._weigh(weights)
 
     def normal_equations(self, a):
         total_s, total_g, total_h = 0.0, 0.0, 0.0

@@ -38,7 +38,7 @@ from ...models.polynomials import is_stable_polynomial
 from ...models.shared import MOST_INTEGRATORS
 from ..core.cost import auto_gain
 
-__all__ = ["SharedInputsCost", "equation_regressors"]
+__all__ = ["SharedInputsCost", "WeightedOutputs", "equation_regressors"]
 
 
 def shared_integrators(integrators, p: int) -> tuple[int, ...]:
@@ -230,7 +230,48 @@ class _Part:
         return self.group.residual(a, self.column)
 
 
-class SharedInputsCost:
+class WeightedOutputs:
+    """What the shared costs of one and of several inputs have in common:
+    each output's part (``parts``, each with its ``data`` and ``sse``)
+    weighted by ``lambda_i`` (``weights``), and the percent RMS error the
+    cost reports."""
+
+    def _weigh(self, weights) -> None:
+        """Set ``weights`` (default ``1 / mean(y_i^2)``), checked, and the
+        norm the reported percent divides by."""
+        energy = np.array([float(np.sum(part.data.y**2)) for part in self.parts])
+        if weights is None:
+            weights = self.data.n / np.maximum(energy, np.finfo(float).tiny)
+        weights = np.asarray(weights, dtype=float).ravel()
+        if weights.shape != (len(self.parts),) or not np.all(
+            np.isfinite(weights) & (weights > 0)
+        ):
+            raise ValueError(
+                f"`weights` must be {len(self.parts)} finite numbers > 0 (one per "
+                f"output); got {weights!r}"
+            )
+        self.weights = weights
+        self._norm = float(weights @ energy)
+
+    def reweighted(self, weights):
+        """The same cost with other weights."""
+        return type(self)(self.arx, self.data, weights, self.integrators)
+
+    def fun_of_sse(self, sse: float) -> float:
+        """The reported percent RMS error of the weighted sum `sse`."""
+        return 100.0 * float(np.sqrt(max(sse, 0.0) / self._norm))
+
+    def sse(self, a) -> float:
+        """The weighted sum of the outputs' squared errors at `a`."""
+        return float(
+            sum(
+                w * part.sse(a)
+                for w, part in zip(self.weights, self.parts, strict=True)
+            )
+        )
+
+
+class SharedInputsCost(WeightedOutputs):
     """``J(A)`` over denominators for a record of several inputs, every
     input-output numerator projected out (module docstring): the interface
     of :class:`~spiralid.sysid.estimation.shared.denominator.SharedProjectedCost`.
@@ -276,34 +317,7 @@ class SharedInputsCost:
             one = summed(data.output(i), k)
             column = [j for j, c in enumerate(self.integrators) if c == k].index(i)
             self.parts.append(_Part(groups[k], column, one))
-        energy = np.array([float(np.sum(part.data.y**2)) for part in self.parts])
-        if weights is None:
-            weights = data.n / np.maximum(energy, np.finfo(float).tiny)
-        weights = np.asarray(weights, dtype=float).ravel()
-        if weights.shape != (len(self.parts),) or not np.all(
-            np.isfinite(weights) & (weights > 0)
-        ):
-            raise ValueError(
-                f"`weights` must be {len(self.parts)} finite numbers > 0 (one per "
-                f"output); got {weights!r}"
-            )
-        self.weights = weights
-        self._norm = float(weights @ energy)
-
-    def reweighted(self, weights) -> SharedInputsCost:
-        """The same cost with other weights."""
-        return SharedInputsCost(self.arx, self.data, weights, self.integrators)
-
-    def fun_of_sse(self, sse: float) -> float:
-        return 100.0 * float(np.sqrt(max(sse, 0.0) / self._norm))
-
-    def sse(self, a) -> float:
-        return float(
-            sum(
-                w * part.sse(a)
-                for w, part in zip(self.weights, self.parts, strict=True)
-            )
-        )
+        self._weigh(weights)
 
     def normal_equations(self, a):
         total_s, total_g, total_h = 0.0, 0.0, 0.0
