@@ -64,6 +64,15 @@ def _time_constant(text: str) -> float | str | None:
     return v
 
 
+def _folds(text: str) -> bool | str:
+    """--folds: on, off or auto (identify's True, False or "auto")."""
+    words = {"on": True, "off": False, "auto": "auto"}
+    word = text.strip().lower()
+    if word not in words:
+        raise argparse.ArgumentTypeError(f"must be on, off or auto; got {text!r}")
+    return words[word]
+
+
 def _integrator_count(text: str) -> int | tuple[int, ...]:
     """--integrator K: a count of known integrators, 0 or more; or one per
     output separated by commas (2,1,0,0) with several --output columns."""
@@ -434,7 +443,24 @@ _OPTION_FLAGS = {
     "--iterations": "max_iter",
     "--budget": "max_nfev",
     "--holdout": "holdout",
+    "--noise": "noise",
+    "--folds": "folds",
+    "--training": "training",
+    "--horizon": "horizon",
+    "--workers": "workers",
 }
+# Flags whose None stands for "not typed": identify() then applies its own
+# default (one place decides it, and a changed default reaches the CLI).
+_LIBRARY_DEFAULTS = (
+    "max_iter",
+    "max_nfev",
+    "parametrization",
+    "noise",
+    "folds",
+    "training",
+    "horizon",
+    "workers",
+)
 _DESTS = {flag: flag.removeprefix("--").replace("-", "_") for flag in _OPTION_FLAGS}
 
 # The structure options of one kind of --model: the models they apply to.
@@ -478,8 +504,7 @@ def _identify_options(args, structure) -> dict:
     return {
         name: value
         for name, value in _option_values(args).items()
-        if name in takes
-        and not (value is None and name in ("max_iter", "max_nfev", "parametrization"))
+        if name in takes and not (value is None and name in _LIBRARY_DEFAULTS)
     }
 
 
@@ -689,6 +714,21 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
         "(0: train to convergence)",
     )
     p.add_argument(
+        "--training",
+        choices=["free-run", "subsequences"],
+        default=None,
+        help="NARX: train on the free run of the whole record or on short "
+        "stretches each started from measured samples (default: free-run)",
+    )
+    p.add_argument(
+        "--horizon",
+        type=_positive_int,
+        default=None,
+        metavar="SAMPLES",
+        help="NARX --training subsequences: the stretches' length (default: a "
+        "growing curriculum, kept by the held-back fit)",
+    )
+    p.add_argument(
         "--degree", type=_positive_int, default=2, help="polynomial NARX degree"
     )
     p.add_argument(
@@ -737,6 +777,23 @@ def _add_method_options(p: argparse.ArgumentParser) -> None:
         "part's length, for --method spiral and oe and --refine's polish",
     )
     p.add_argument(
+        "--noise",
+        choices=["white", "integrated"],
+        default=None,
+        help="--method spiral and oe: the output's disturbance, white or "
+        "integrated (a drifting output: the fit runs on the differenced record, "
+        "as MATLAB's IntegrateNoise; default: white)",
+    )
+    p.add_argument(
+        "--folds",
+        type=_folds,
+        default=None,
+        metavar="{on,off,auto}",
+        help="--method spiral: choose among the search's model, output error and "
+        "the integrated-noise fit by blocked folds of the estimation part; auto "
+        "only where the modes table flags a mode (default: the library's, off)",
+    )
+    p.add_argument(
         "--integrator",
         nargs="?",
         type=_integrator_count,
@@ -767,5 +824,13 @@ def _add_search_options(p: argparse.ArgumentParser) -> None:
         help="max cost evaluations (default: the method's own: 10,000 "
         "evaluations for spiral and every NARX search; the others stop at "
         "--iterations)",
+    )
+    p.add_argument(
+        "--workers",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="--model rig: run the search's simulations on N processes, the "
+        "same result bit for bit (default: 1, this process)",
     )
     _add_seed_option(p)
