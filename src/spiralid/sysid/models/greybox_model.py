@@ -19,7 +19,11 @@ from .greybox import GreyBox, _import
 from .modes import ModeTable, mode_table
 from .polynomials import is_stable_polynomial
 
-__all__ = ["GreyBoxModel", "LinearGreyBoxModel"]
+__all__ = ["INTEGRATOR_TOLERANCE", "GreyBoxModel", "LinearGreyBoxModel"]
+
+#: How close to ``z = 1`` a linear grey box's pole counts as an integrator
+#: of its physics (:attr:`LinearGreyBoxModel.integrator`).
+INTEGRATOR_TOLERANCE = 1e-6
 
 
 # What the model keeps of its record (IOData's fields of the same names).
@@ -255,9 +259,23 @@ class LinearGreyBoxModel(GreyBoxModel):
         return np.asarray(num[0], dtype=float), np.asarray(den, dtype=float)
 
     @property
+    def integrator(self) -> int:
+        """The poles at ``z = 1`` the physics has by design: a rigid-body
+        rotation, an integrating output (the hub angle from torque). An
+        eigenvalue of the continuous ``A`` at 0 holds to exactly 1; a double
+        one (a Jordan block) lands ``sqrt(eps)`` away, hence the tolerance
+        :data:`INTEGRATOR_TOLERANCE` (a time constant above 2,000 s at
+        0.002 s). The stability verdict is judged without them, as for an
+        ARX fit's known integrators."""
+        return int(np.sum(np.abs(self.poles - 1.0) < INTEGRATOR_TOLERANCE))
+
+    @property
     def free_denominator(self) -> np.ndarray:
-        """The denominator's ``a_1..a_n`` (every pole is the parameters')."""
-        return self.polynomials[1][1:]
+        """The denominator's ``a_1..a_n`` of the poles other than the
+        :attr:`integrator`'s."""
+        poles = self.poles
+        free = poles[np.abs(poles - 1.0) >= INTEGRATOR_TOLERANCE]
+        return np.real(np.poly(free))[1:]
 
     @property
     def poles(self) -> np.ndarray:
