@@ -42,8 +42,8 @@ the validation fit also scores how a model's free run happens to meet the
 drift, this one what the plant model got right.
 
 Run: ``python benchmarks/drift_process.py [--seeds 10] [--orders 8]
-[--workers 2] [--integrated] [--folds] [--auto] [--plant]``. To measure the code before a
-change, put its source first on ``PYTHONPATH``.
+[--workers 2] [--integrated] [--folds] [--auto] [--plant]``. To measure the
+code before a change, put its source first on ``PYTHONPATH``.
 """
 
 import os
