@@ -110,9 +110,9 @@ def main() -> None:
             print(f"| rig, {label} start, {method} | {_fit(model, est, val):.2f} | "
                   f"{secs:.0f} |", flush=True)  # fmt: skip
             fitted[label, method] = model
+    pairs = zip(table.frequency[keep], table.damping[keep], strict=True)
     print("\nARX(8, 8, 0)'s modes (Hz, damping):",
-          ", ".join(f"{f:.3f} ({z:.4f})" for f, z in
-                    zip(table.frequency[keep], table.damping[keep], strict=True)))  # fmt: skip
+          ", ".join(f"{f:.3f} ({z:.4f})" for f, z in pairs))  # fmt: skip
     best = max(fitted.values(), key=lambda m: _fit(m, est, val))
     print("\nBest rig fit:")
     print(best.summary())

@@ -182,7 +182,10 @@ def _started(p: Parameter, value: float, scale: float) -> Parameter:
 def _rebuilt(box: RigGreyBox, values: np.ndarray) -> RigGreyBox:
     """`box` with every parameter started at `values`."""
     params = list(box.parameters[: box._n_fields])
-    params = [dataclasses.replace(p, value=float(v)) for p, v in zip(params, values)]
+    params = [
+        dataclasses.replace(p, value=float(v))
+        for p, v in zip(params, values[: len(params)], strict=True)
+    ]
     gain = box.output_gain
     if isinstance(gain, Parameter):
         k = values[box._n_fields]
