@@ -25,7 +25,8 @@ invisible in the record). Rows:
   state and even each mode's damping free: the residues and the state by
   least squares, the modes by Levenberg-Marquardt from the ARX's.
 
-``--bound-only`` prints the black boxes and that bound, without the rig.
+``--bound-only`` prints the black boxes and that bound, without the rig;
+``--starts modes`` only the rig's start from the ARX's modes.
 
 Times are wall-clock seconds on the machine that runs this (a shared
 machine: compare, do not quote as absolute).
@@ -122,6 +123,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--bound-only", action="store_true")
+    ap.add_argument(
+        "--starts", default="preset,modes", help="the rig's starts, comma-separated"
+    )
     args = ap.parse_args()
     seed = args.seed
     data = robot_arm().detrend()
@@ -143,9 +147,10 @@ def main() -> None:
         return
     box = _box()
     keep = ~table.spurious
+    modes = {"preset": box.rig.modes(MODES), "modes": arx}
     starts = {
-        "preset": rig_start_from_modes(box, box.rig.modes(MODES), est),
-        "modes": rig_start_from_modes(box, arx, est, rng=seed),
+        label: rig_start_from_modes(box, modes[label], est, rng=seed)
+        for label in args.starts.split(",")
     }
     fitted = {}
     for label, start in starts.items():

@@ -92,9 +92,10 @@ def _box_map(params: list[Parameter]):
     return values, point
 
 
-def _match(box: RigGreyBox, freq: np.ndarray, starts: int, rng) -> np.ndarray:
-    """Every parameter's values with the modal fields set to match `freq`
-    (the best of `starts` local fits plus one from the initial values)."""
+def _match(box: RigGreyBox, freq: np.ndarray, starts: int, rng) -> list[np.ndarray]:
+    """Every parameter's values with the modal fields set to match `freq`:
+    one vector per local fit (from the initial values and `starts` random
+    points) that matches, the closest match first."""
     values = box.initial_values
     rows = [
         i
@@ -120,19 +121,33 @@ def _match(box: RigGreyBox, freq: np.ndarray, starts: int, rng) -> np.ndarray:
         return np.log(f) - np.log(freq)
 
     points = [to_point(values[rows]), *rng.uniform(0.0, 1.0, (starts, len(rows)))]
-    best = None
-    for z0 in points:
-        fit = least_squares(residual, np.clip(z0, 0.0, 1.0), bounds=(0.0, 1.0))
-        if best is None or fit.cost < best.cost:
-            best = fit
-    if np.sqrt(2.0 * best.cost / m) > _MATCHED:
+    fits = [
+        least_squares(residual, np.clip(z0, 0.0, 1.0), bounds=(0.0, 1.0))
+        for z0 in points
+    ]
+    fits.sort(key=lambda fit: fit.cost)
+    matched = [fit for fit in fits if np.sqrt(2.0 * fit.cost / m) <= _MATCHED]
+    if not matched:
         found = box.rig_at(values).modes(m)
         raise ValueError(
             f"`modes`: no rig within the bounds has the modes {np.round(freq, 3)} Hz; "
             f"the nearest found at this start {np.round(found, 3)}"
         )
-    values[rows] = to_values(best.x)
-    return values
+    out = []
+    for fit in matched:
+        v = values.copy()
+        v[rows] = to_values(fit.x)
+        out.append(v)
+    return out
+
+
+def _error(box: RigGreyBox, values: np.ndarray, data) -> float:
+    """The simulation error's norm at `values` on `data` (inf for a run
+    that blew up)."""
+    e = np.asarray(data.y, dtype=float).ravel() - box.simulate(
+        values, data.u, float(data.ts)
+    )
+    return float(np.linalg.norm(e)) if np.all(np.isfinite(e)) else np.inf
 
 
 def _state_and_gain(box: RigGreyBox, values: np.ndarray, data) -> np.ndarray:
@@ -218,9 +233,11 @@ def rig_start_from_modes(
     bounds, so that the finite-element model's first flexible modes are
     `modes`' frequencies: a bounded least squares on the log frequencies
     from the box's initial values and `starts` random points, the best
-    kept. A free damping ratio starts at the modes' mean damping. With
-    `data` (the linear kind), the output gain and the initial state, where
-    estimated, start at their least-squares values on the record, the
+    kept (with `data`, of the fits that match, the one whose simulation
+    is closest to the record: the modes fix the frequencies, not the
+    residues). A free damping ratio starts at the modes' mean damping.
+    With `data` (the linear kind), the output gain and the initial state,
+    where estimated, start at their least-squares values on the record, the
     simulation being linear in both, and their bounds become 4 times the
     value's size either side of it (the record's units are not known
     before; an initial state's entry near zero takes a quarter of the
@@ -263,15 +280,16 @@ def rig_start_from_modes(
             f"`modes` gives {freq.size} modes; the box keeps {limit} flexible modes"
         )
     starts = integer(starts, "starts", 0)
-    values = _match(box, freq, starts, generator(rng))
+    if data is not None and box.kind != "linear":
+        raise ValueError("`data`: the gain and state start need the linear rig")
+    candidates = _match(box, freq, starts, generator(rng))
     names = box.names
     if damping is not None and "damping_ratio" in names:
         i = names.index("damping_ratio")
         p = box.all_parameters[i]
-        if p.free:
+        for values in candidates if p.free else ():
             values[i] = np.clip(np.mean(damping), *p.bounds)
-    if data is not None:
-        if box.kind != "linear":
-            raise ValueError("`data`: the gain and state start need the linear rig")
-        values = _state_and_gain(box, values, data)
-    return _rebuilt(box, values)
+    if data is None:
+        return _rebuilt(box, candidates[0])
+    candidates = [_state_and_gain(box, v, data) for v in candidates]
+    return _rebuilt(box, min(candidates, key=lambda v: _error(box, v, data)))
