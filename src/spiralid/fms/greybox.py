@@ -381,8 +381,10 @@ class RigGreyBox(GreyBox):
 
     def simulate(self, values, u, ts: float) -> np.ndarray:
         """The output, shape (N,), over the torque `u` from rest, by the
-        rig's own sampled simulation; NaN when the values make no rig or
-        the run leaves the floating-point range (the fit's penalty)."""
+        rig's own sampled simulation (from another initial state, by the
+        exact zero-order hold of the same matrices), times the output
+        gain; NaN when the values make no rig or the run leaves the
+        floating-point range (the fit's penalty)."""
         uu = np.asarray(u, dtype=float).reshape(len(u), -1)
         if uu.shape[1] != 1:
             raise ValueError(f"`u` must have 1 input column; got {uu.shape[1]}")
