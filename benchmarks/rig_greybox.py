@@ -20,8 +20,9 @@ Parts (``--part``, default all):
   rig with its geometry free (bounds a factor 100 either side of the
   preset: the arm is not the Sheffield rig), run from rest, against
   ARX(8, 8, 0) by ``oe``; with the acceleration as recorded and with its
-  sign flipped (the record states no sign convention, and the rig has no
-  gain of its own).
+  sign flipped, the rig without gain or initial state (the record
+  states no sign convention); ``benchmarks/daisy_greybox.py`` adds both
+  and a start from the record's modes.
 
 Times are wall-clock seconds on the machine that runs this.
 
