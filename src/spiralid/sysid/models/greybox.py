@@ -182,7 +182,8 @@ class GreyBox:
     """
 
     family = "greybox"
-    outputs_family = None
+    # Several outputs are the structure's own (``g``'s values, ``C``'s rows).
+    outputs_family = "greybox"
     # A grey box reads no past outputs: it runs from its own state.
     max_lag = 0
 
