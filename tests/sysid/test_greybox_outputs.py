@@ -89,7 +89,7 @@ def _position(p):
 
 
 def test_the_weights_are_the_noise_variances_added(fits):
-    rec, sd, both, _ = fits
+    _, sd, both, _ = fits
     assert both.output_names == NAMES
     np.testing.assert_allclose(both.weights, 1.0 / sd**2, rtol=0.15)
     assert "noise sd" in both.summary()
