@@ -158,6 +158,9 @@ class RigGreyBox(GreyBox):
 
     Attributes
     ----------
+    outputs : tuple of str
+        The sensors, in the record's order (`output` given as one name or
+        several).
     kind : str
         ``"nonlinear"`` when friction or a torque limit is on or free, else
         ``"linear"`` (the fit then has poles and modes).
