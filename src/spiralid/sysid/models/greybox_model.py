@@ -314,6 +314,8 @@ class LinearGreyBoxModel(GreyBoxModel):
         As :class:`GreyBoxModel`'s attributes.
     input_name, input_unit, output_unit, u_offset, y_offset
         As :class:`GreyBoxModel`'s attributes.
+    output_fits, weights, column
+        As :class:`GreyBoxModel`'s attributes.
     """
 
     @property
