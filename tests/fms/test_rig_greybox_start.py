@@ -163,6 +163,17 @@ def test_gain_and_state_read_back(tmp_path):
             ValueError,
             "starts",
         ),
+        (
+            lambda: rig_start_from_modes(
+                RigGreyBox(
+                    ["hub_inertia"], SMALL, output=("hub_angle", "end_acceleration")
+                ),
+                [10.0],
+                sid.sysid.IOData(np.zeros(50), np.zeros((50, 2)), ts=0.002),
+            ),
+            ValueError,
+            "one sensor",
+        ),
     ],
 )
 def test_bad_input_is_one_line(call, error, words):

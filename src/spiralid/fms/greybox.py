@@ -1,6 +1,6 @@
 """The rig as a ready grey box: :class:`RigGreyBox`, any subset of
 :class:`~spiralid.fms.rig.FlexibleManipulator`'s physical fields free,
-fitted by :func:`spiralid.sysid.identify` to a record of one of its
+fitted by :func:`spiralid.sysid.identify` to a record of one or several of its
 sensors.
 
 Every evaluation builds the rig at the parameter values and runs the rig's
@@ -121,6 +121,24 @@ def default_parameter(rig: FlexibleManipulator, name: str) -> Parameter:
     return Parameter(name, 0.0, (0.0, _zero_preset_high(rig, name)), unit)
 
 
+def _outputs_of(output, sensors: Sensors) -> tuple[str | tuple, tuple[str, ...]]:
+    """`output` checked (one sensor or several, each once): as given (a
+    tuple for several) and as a tuple."""
+    known = _OUTPUTS + sensors.positional_names
+    if isinstance(output, str):
+        return one_of(output, "output", known), (output,)
+    names = tuple(output) if isinstance(output, Sequence) else ()
+    if not names or not all(isinstance(n, str) for n in names):
+        raise TypeError(
+            f"`output` must be a sensor's name or a sequence of them; got {output!r}"
+        )
+    for name in names:
+        one_of(name, "output", known)
+    if len(set(names)) != len(names):
+        raise ValueError(f"`output` must name each sensor once; got {names}")
+    return (names[0] if len(names) == 1 else names), names
+
+
 class RigGreyBox(GreyBox):
     """The flexible manipulator as a grey box: the fields named in `free`
     estimated, the others held at `rig`'s values.
@@ -135,10 +153,12 @@ class RigGreyBox(GreyBox):
     rig : FlexibleManipulator, optional
         The rig whose other fields are held and whose values start the
         free ones; default ``FlexibleManipulator()``.
-    output : str, default "hub_angle"
+    output : str or sequence of str, default "hub_angle"
         The sensor the record holds: ``"hub_angle"``, ``"hub_velocity"``,
         ``"end_acceleration"``, ``"tip_deflection"``, or one of `sensors`'
-        positional outputs (``deflection_<x>``, ``acceleration_<x>``).
+        positional outputs (``deflection_<x>``, ``acceleration_<x>``); or
+        several of them, the record's outputs in that order (each weighted
+        by its noise variance in the fit).
     n_modes : int, optional
         Keep the rigid mode and this many flexible modes (default all
         ``2 n_elements``).
@@ -163,6 +183,9 @@ class RigGreyBox(GreyBox):
 
     Attributes
     ----------
+    outputs : tuple of str
+        The sensors, in the record's order (`output` given as one name or
+        several).
     kind : str
         ``"nonlinear"`` when friction or a torque limit is on or free, else
         ``"linear"`` (the fit then has poles and modes).
@@ -179,7 +202,7 @@ class RigGreyBox(GreyBox):
         free: Sequence[str | Parameter],
         rig: FlexibleManipulator | None = None,
         *,
-        output: str = "hub_angle",
+        output: str | Sequence[str] = "hub_angle",
         n_modes: int | None = None,
         sensors: Sensors | None = None,
         output_gain: float | Parameter = 1.0,
@@ -216,8 +239,9 @@ class RigGreyBox(GreyBox):
                     "one or the other"
                 )
         self.rig, self.sensors = rig, sensors
-        self.output = one_of(output, "output", _OUTPUTS + sensors.positional_names)
-        self._row = (_OUTPUTS + sensors.positional_names).index(self.output)
+        self.output, self.outputs = _outputs_of(output, sensors)
+        known = _OUTPUTS + sensors.positional_names
+        self._rows = [known.index(name) for name in self.outputs]
         if n_modes is not None:
             n_modes = integer(n_modes, "n_modes", 1)
             if n_modes > 2 * rig.n_elements:
@@ -228,7 +252,7 @@ class RigGreyBox(GreyBox):
         self.n_modes = n_modes
         # The encoder and the deflections pass no filter: the model runs
         # without the other channels' filter states.
-        unfiltered = self.output in _UNFILTERED or self.output.startswith("defl")
+        unfiltered = all(n in _UNFILTERED or n.startswith("defl") for n in self.outputs)
         self._sim_sensors = (
             dataclasses.replace(sensors, antialias_order=0) if unfiltered else sensors
         )
@@ -238,7 +262,7 @@ class RigGreyBox(GreyBox):
         )
         self.functions = {}
         self.substeps = rig.friction_substeps
-        self.n_inputs, self.n_outputs = 1, 1
+        self.n_inputs, self.n_outputs = 1, len(self.outputs)
         self.state_parameters = ()
         a = self.matrices(self.initial_values, 1.0)[0]
         self.n_states = a.shape[0]
@@ -353,9 +377,9 @@ class RigGreyBox(GreyBox):
             s.acceleration_at,
             self.n_modes,
         )
-        row = slice(self._row, self._row + 1)
+        rows = self._rows
         k = self.gain_at(values)
-        return a, b[:, None], k * c[row], k * d[row][:, None]
+        return a, b[:, None], k * c[rows], k * d[rows][:, None]
 
     def discretise(self, values, ts: float) -> tuple[np.ndarray, ...]:
         """The linear rig's exact zero-order hold ``(Ad, Bd, C, D)`` at
@@ -370,25 +394,26 @@ class RigGreyBox(GreyBox):
             s.acceleration_at,
             self.n_modes,
         )
-        row = slice(self._row, self._row + 1)
+        rows = self._rows
         k = self.gain_at(values)
         return (
             np.array(ad),
             np.array(bd)[:, None],
-            k * np.array(c[row]),
-            k * np.array(d[row])[:, None],
+            k * np.array(c[rows]),
+            k * np.array(d[rows])[:, None],
         )
 
     def simulate(self, values, u, ts: float) -> np.ndarray:
-        """The output, shape (N,), over the torque `u` from rest, by the
-        rig's own sampled simulation (from another initial state, by the
-        exact zero-order hold of the same matrices), times the output
-        gain; NaN when the values make no rig or the run leaves the
-        floating-point range (the fit's penalty)."""
+        """The output, shape (N,) (one sensor) or (N, p), over the torque
+        `u` from rest, by the rig's own sampled simulation (from another
+        initial state, by the exact zero-order hold of the same matrices),
+        times the output gain; NaN when the values make no rig or the run
+        leaves the floating-point range (the fit's penalty)."""
         uu = np.asarray(u, dtype=float).reshape(len(u), -1)
         if uu.shape[1] != 1:
             raise ValueError(f"`u` must have 1 input column; got {uu.shape[1]}")
-        nan = np.full(uu.shape[0], np.nan)
+        shape = (uu.shape[0],) if self.n_outputs == 1 else (uu.shape[0], self.n_outputs)
+        nan = np.full(shape, np.nan)
         try:
             rig = self.rig_at(values)
         except (TypeError, ValueError):
@@ -407,7 +432,8 @@ class RigGreyBox(GreyBox):
                 )
             except (ValueError, np.linalg.LinAlgError):
                 return nan
-        return self.gain_at(values) * np.asarray(y[:, self._row], dtype=float)
+        y = self.gain_at(values) * np.asarray(y[:, self._rows], dtype=float)
+        return y[:, 0] if self.n_outputs == 1 else y
 
     def _from_state(self, values, uu, ts: float, nan) -> np.ndarray:
         """The linear rig's run from the initial state at `values`: its
@@ -418,8 +444,8 @@ class RigGreyBox(GreyBox):
             except (ValueError, np.linalg.LinAlgError):
                 return nan
             x0 = self.initial_state(values)
-            y = lti_run(ad, bd, c, d, x0, np.ascontiguousarray(uu))[:, 0]
-        return y
+            y = lti_run(ad, bd, c, d, x0, np.ascontiguousarray(uu))
+        return y[:, 0] if self.n_outputs == 1 else y
 
     # -- the modes beside the FEM's ----------------------------------------------
 
@@ -450,6 +476,10 @@ class RigGreyBox(GreyBox):
 
     # -- text and JSON ----------------------------------------------------------
 
+    def output_source(self) -> str:
+        """What gives the outputs, for messages: the sensors named."""
+        return f"`output` {self.output!r}"
+
     def function_paths(self) -> dict[str, str]:
         """None: the rig's simulation is this class's own (model.json names
         the class)."""
@@ -469,7 +499,9 @@ class RigGreyBox(GreyBox):
                 else self.output_gain
             ),
             "x0": self._x0_entries(),
-            "output": self.output,
+            "output": self.output
+            if isinstance(self.output, str)
+            else list(self.output),
             "n_modes": self.n_modes,
             "sensors": dataclasses.asdict(self.sensors),
         }
@@ -487,7 +519,7 @@ class RigGreyBox(GreyBox):
         return cls(
             [Parameter(**p) for p in d["parameters"]],
             FlexibleManipulator(**d["rig"]),
-            output=d["output"],
+            output=d["output"] if isinstance(d["output"], str) else tuple(d["output"]),
             n_modes=d.get("n_modes"),
             sensors=Sensors(**sensors),
             output_gain=Parameter(**gain) if isinstance(gain, dict) else gain,
@@ -497,7 +529,7 @@ class RigGreyBox(GreyBox):
     def __repr__(self) -> str:
         modes = "all" if self.n_modes is None else self.n_modes
         return (
-            f"RigGreyBox({self.kind}, {self.output}, modes {modes}; "
+            f"RigGreyBox({self.kind}, {', '.join(self.outputs)}, modes {modes}; "
             f"{', '.join(self.names)})"
         )
 

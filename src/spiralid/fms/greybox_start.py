@@ -282,6 +282,11 @@ def rig_start_from_modes(
     starts = integer(starts, "starts", 0)
     if data is not None and box.kind != "linear":
         raise ValueError("`data`: the gain and state start need the linear rig")
+    if data is not None and box.n_outputs != 1:
+        raise ValueError(
+            f"`data`: the gain and state start fit one sensor; the box reads "
+            f"{box.n_outputs} ({', '.join(box.outputs)})"
+        )
     candidates = _match(box, freq, starts, generator(rng))
     names = box.names
     if damping is not None and "damping_ratio" in names:
