@@ -6,7 +6,7 @@ cancels the same poles with zeros."""
 
 import numpy as np
 import pytest
-from test_rig_greybox import VARIANT, record
+from test_rig_greybox import FS, VARIANT, record, torque
 
 import spiralid as sid
 from spiralid.fms import FlexibleManipulator, Sensors
@@ -62,3 +62,25 @@ def test_the_end_acceleration_cancels_them_with_zeros():
     np.testing.assert_allclose(
         model.free_denominator, np.real(np.poly(free))[1:], atol=1e-12
     )
+
+
+def test_two_sensors_list_the_flexible_modes_once():
+    """The modes of a two-sensor fit: the finite elements' flexible modes
+    (not the rotation at z = 1), each with its larger share of the two
+    sensors' tables, flagged only where both flag it."""
+    truth = FlexibleManipulator(**VARIANT)
+    rec = truth.simulate(torque(), fs=FS, sensors=Sensors.ideal())
+    data = rec.iodata(["hub_angle", "end_acceleration"])
+    box = RigGreyBox(
+        ["hub_inertia"], FlexibleManipulator(**VARIANT),
+        output=("hub_angle", "end_acceleration"), sensors=Sensors.ideal(),
+    )  # fmt: skip
+    model = sid.identify(data, box, method="oe")
+    table = model.modes
+    fem = truth.modes(4)
+    for f in fem:
+        assert np.min(np.abs(table.frequency - f)) < 1e-6 * f
+    assert table.frequency.min() > 0.5 * fem[0]
+    each = [model.output_model(name).modes for name in data.output_name]
+    np.testing.assert_array_equal(table.share, np.maximum(*(t.share for t in each)))
+    np.testing.assert_array_equal(table.spurious, each[0].spurious & each[1].spurious)

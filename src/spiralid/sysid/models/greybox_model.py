@@ -383,5 +383,15 @@ class LinearGreyBoxModel(GreyBoxModel):
     def modes(self) -> ModeTable:
         """The complex pole pairs as modes (no intervals on them: the
         intervals are the parameters')."""
-        num, den = self.polynomials
-        return mode_table(den[1:], num, self.ts)
+        several = self.column is None and (self.structure.n_outputs or 1) > 1
+        if not several:
+            return mode_table(self.free_denominator, self.polynomials[0], self.ts)
+        # One set of poles, a share in each sensor: a mode is the model's
+        # where any sensor shows it, flagged only where every sensor flags it.
+        tables = [self.output_model(k).modes for k in range(self.structure.n_outputs)]
+        return dataclasses.replace(
+            tables[0],
+            share=np.max([t.share for t in tables], axis=0),
+            cancelled=np.all([t.cancelled for t in tables], axis=0),
+            spurious=np.all([t.spurious for t in tables], axis=0),
+        )
