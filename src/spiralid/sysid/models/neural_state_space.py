@@ -127,6 +127,22 @@ class NeuralStateSpace:
         """Length of the parameter vector (the encoder's ``E`` included)."""
         return self.n_theta + self.order * 2 * self.window
 
+    def check_length(self, data, name: str = "data") -> None:
+        """A one-line ValueError naming `name` when the record is too short
+        for this structure (four encoder windows and ten samples).
+
+        Parameters
+        ----------
+        data : IOData
+        name : str
+            The record's name in the message.
+        """
+        need = 4 * self.window + 10
+        if data.n < need:
+            raise ValueError(
+                f"`{name}` must have at least {need} samples for {self}; got {data.n}"
+            )
+
     def _params(self, params, name: str = "params") -> np.ndarray:
         arr = np.asarray(params, dtype=float)
         if arr.shape != (self.n_params,):

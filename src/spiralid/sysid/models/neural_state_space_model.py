@@ -80,6 +80,13 @@ class NeuralStateSpaceModel:
                 self.linear_params, "linear_params"
             )
 
+    @property
+    def timings(self) -> dict:
+        """Wall time of the fit in seconds (``"total"``; empty after a
+        model file, which keeps none)."""
+        seconds = self.result.get("seconds")
+        return {} if seconds is None else {"total": float(seconds)}
+
     # -- the protocol -----------------------------------------------------------
 
     @property

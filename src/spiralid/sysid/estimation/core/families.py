@@ -15,7 +15,7 @@ family                    methods
 ``"polynomial-narx"``     ``"ls"`` and ``"spiral"`` (forward regression)
 ``"shared-denominator"``  :data:`~.denominator.SHARED_METHODS`
 ``"greybox"``             :data:`~.greybox.fit.GREYBOX_METHODS`
-``"neural-state-space"``  ``"spiral"`` and ``"oe"`` (the linear start's method)
+``"neural-state-space"``  ``"spiral"``, ``"oe"``, ``"ls"`` (the linear start's)
 ========================  ======================================================
 
 Adding a family
@@ -171,7 +171,7 @@ _POLYNOMIAL = ("rng", "predictor", "initial")
 # -- neural state space -----------------------------------------------------------
 
 #: The neural state-space family's methods: the linear start's.
-NSS_METHODS = ("spiral", "oe")
+NSS_METHODS = ("spiral", "oe", "ls")
 
 
 def _nss_linear(data: IOData, order: int, method: str, rng):

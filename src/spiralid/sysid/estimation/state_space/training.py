@@ -41,7 +41,6 @@ import math
 import time
 
 import numpy as np
-from scipy.optimize import minimize
 
 from spiralid._checks import generator
 
@@ -55,7 +54,7 @@ __all__ = ["HORIZONS", "NSS_OPTIONS", "identify_neural_state_space"]
 
 #: The stages' subsequence lengths of ``horizon=None`` (those shorter than
 #: the record's training part), each starting from the best point so far.
-HORIZONS = (20, 50, 120)
+HORIZONS = (50, 100, 200)
 
 #: The family's options beside identify's ``rng``.
 NSS_OPTIONS = ("holdout", "decay", "horizon", "max_iter")
@@ -63,9 +62,15 @@ NSS_OPTIONS = ("holdout", "decay", "horizon", "max_iter")
 # L-BFGS iterations between two held-back scores, and chunks without a
 # better score before a stage stops.
 _CHUNK = 25
-_PATIENCE = 4
+_PATIENCE = 10
+# Curvature pairs L-BFGS keeps.
+_MEMORY = 10
 # Iterations a stage may take at most (the default of `max_iter`).
-_MAX_ITER = 600
+_MAX_ITER = 1000
+# Starts from the linear model, each with its own random input weights:
+# the held-back samples keep the best (seeds 0-2 on the cascaded tanks
+# spread from 0.38 to 0.60 V on one start).
+_STARTS = 3
 # Glorot-uniform scale of the networks' input weights at the start.
 _INIT = 1.0
 
@@ -145,26 +150,66 @@ class _Problem:
         return rms if math.isfinite(rms) else math.inf
 
 
+def _lbfgs(fun, p, iters: int, memory: list) -> tuple[np.ndarray, int, bool]:
+    """`iters` iterations of L-BFGS (two-loop recursion, backtracking to
+    Armijo's condition) on ``fun(p) -> (f, grad)`` from `p`, continuing
+    the curvature pairs in `memory` (updated in place); returns the point,
+    the iterations run and whether it converged. Our own, not SciPy's: its
+    L-BFGS-B spends its time in threaded BLAS calls on vectors this small
+    (most of a fit on a shared machine)."""
+    f, g = fun(p)
+    for it in range(iters):
+        q = g.copy()
+        alphas = []
+        for s_k, y_k, rho in reversed(memory):
+            a = rho * (s_k @ q)
+            alphas.append(a)
+            q -= a * y_k
+        if memory:
+            s_k, y_k, _ = memory[-1]
+            q *= (s_k @ y_k) / (y_k @ y_k)
+        for (s_k, y_k, rho), a in zip(memory, reversed(alphas), strict=True):
+            q += s_k * (a - rho * (y_k @ q))
+        d = -q
+        slope = float(g @ d)
+        if slope >= 0.0:  # not a descent direction: restart from the gradient
+            memory.clear()
+            d, slope = -g, -float(g @ g)
+        step = 1.0 if memory else min(1.0, 1e-2 / max(np.abs(g).max(), 1e-12))
+        for _ in range(30):
+            p_new = p + step * d
+            f_new, g_new = fun(p_new)
+            if f_new <= f + 1e-4 * step * slope:
+                break
+            step *= 0.3
+        else:
+            return p, it, True
+        s_k, y_k = p_new - p, g_new - g
+        if s_k @ y_k > 1e-12:
+            memory.append((s_k, y_k, 1.0 / (s_k @ y_k)))
+            del memory[:-_MEMORY]
+        converged = f - f_new <= 1e-10 * max(abs(f), 1e-12)
+        p, f, g = p_new, f_new, g_new
+        if converged:
+            return p, it + 1, True
+    return p, iters, False
+
+
 def _stage(problem: _Problem, p0, best, max_iter: int):
     """L-BFGS from `p0` in chunks, the held-back RMS after each; returns
     the best ``(rms, p)`` (`best` unless beaten) and the iterations run."""
-    p, used, stale = p0, 0, 0
+    p, used, stale, memory = p0, 0, 0, []
     while used < max_iter and stale < _PATIENCE:
-        res = minimize(
-            problem.loss,
-            p,
-            jac=True,
-            method="L-BFGS-B",
-            options={"maxiter": min(_CHUNK, max_iter - used)},
+        p, nit, converged = _lbfgs(
+            problem.loss, p, min(_CHUNK, max_iter - used), memory
         )
-        used += max(int(res.nit), 1)
-        p = res.x
+        used += max(nit, 1)
         rms = problem.held_rms(p)
         if rms < best[0]:
             best, stale = (rms, p.copy()), 0
         else:
             stale += 1
-        if res.nit < _CHUNK and res.success:  # converged
+        if converged:
             break
     return best, used
 
@@ -243,7 +288,7 @@ def identify_neural_state_space(
     horizon : int or None
         Subsequence length (>= 2); None grows it through :data:`HORIZONS`.
     max_iter : int or None
-        L-BFGS iterations per stage at most (default 600).
+        L-BFGS iterations per stage at most (default 1000).
 
     Returns
     -------
@@ -255,11 +300,7 @@ def identify_neural_state_space(
         raise TypeError(
             f"`structure` must be a NeuralStateSpace; got {type(structure).__name__}"
         )
-    if data.n < 4 * structure.window + 10:
-        raise ValueError(
-            f"`data` must have at least {4 * structure.window + 10} samples for "
-            f"{structure}; got {data.n}"
-        )
+    structure.check_length(data)
     gen = generator(rng)
     problem = _Problem(structure, data, holdout, decay)
     theta, text = linear_estimator(data, structure.order, method, gen)
@@ -270,15 +311,20 @@ def identify_neural_state_space(
     horizons = (horizon,) if horizon is not None else HORIZONS
     room = data.n - structure.window
     horizons = tuple(h for h in horizons if h < room) or (room,)
-    start = p0
-    if structure.h:
+    for run in range(_STARTS if structure.h else 0):
+        if run:
+            p0 = _linear_start(structure, problem, theta, gen)[1]
+        ours = (linear_cost, p_lin)
+        start = p0
         for h in horizons:
             problem.batch(h)
-            best, used = _stage(problem, start, best, max_iter)
-            schedule.append([int(h), int(used), float(best[0])])
-            # The next (longer) stage starts from the best point so far;
+            ours, used = _stage(problem, start, ours, max_iter)
+            schedule.append([int(h), int(used), float(ours[0])])
+            # The next (longer) stage starts from this start's best point;
             # from the random input weights while that is the linear start.
-            start = start if best[1] is p_lin else best[1]
+            start = start if ours[1] is p_lin else ours[1]
+        if ours[0] < best[0]:
+            best = ours
     kept = best[1] is p_lin
     return NeuralStateSpaceModel(
         structure=structure,
