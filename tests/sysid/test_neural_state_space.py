@@ -48,7 +48,7 @@ def test_the_gradient_is_exact():
     p = st.from_linear([-1.4, 0.6], [0.3, 0.15]) + 0.2 * rng.standard_normal(
         st.n_params
     )
-    f, g = problem.loss(p)
+    _, g = problem.loss(p)
     eps = 1e-6
     numeric = np.array(
         [
@@ -105,7 +105,7 @@ def test_a_linear_record_keeps_or_matches_its_linear_start():
 
 
 def test_the_model_file_reads_back(fitted, tmp_path):
-    model, est, val = fitted
+    model, _, val = fitted
     path = tmp_path / "model.json"
     path.write_text(json.dumps(model.to_dict()))
     back = sid.sysid.load_model(path)

@@ -82,9 +82,7 @@ def nss_free_run(theta, u, x0, nx, h, y):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def nss_batch_loss(
-    theta, U, Y, W, X0, nx, h, grad, gx0
-):  # pragma: no cover - compiled
+def nss_batch_loss(theta, U, Y, W, X0, nx, h, grad, gx0):  # pragma: no cover - compiled
     """Weighted squared simulation error of the subsequences ``U[k]``,
     ``Y[k]`` each run from ``X0[k]``: ``sum W (y - Y)^2``; ``grad`` (the
     gradient in ``theta``) and ``gx0`` (in each ``X0[k]``) filled by

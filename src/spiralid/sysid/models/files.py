@@ -51,8 +51,9 @@ def load_model(d: dict | str | os.PathLike) -> FittedModelProtocol:
 
     Returns
     -------
-    IdentifiedModel, NARXModel, SharedDenominatorModel, GreyBoxModel or NeuralStateSpaceModel
-        As its field ``"model"`` says.
+    FittedModelProtocol
+        The kind its field ``"model"`` names: IdentifiedModel, NARXModel,
+        SharedDenominatorModel, GreyBoxModel or NeuralStateSpaceModel.
 
     Raises
     ------

@@ -44,13 +44,13 @@ import numpy as np
 from spiralid.optim import RULES
 
 from ...data import IOData
+from ...models.arx import ARX
 from ...models.protocol import FittedModelProtocol
 from ..greybox.fit import GREYBOX_METHODS, fit_greybox
 from ..narx import training as _narx
 from ..narx.frols import frols
 from ..shared.denominator import SHARED_METHODS, identify_shared, shared_options
 from ..state_space.training import NSS_OPTIONS, identify_neural_state_space
-from ...models.arx import ARX
 from .arx_fit import fit_arx
 from .estimators import (
     _MINIMIZE_OPTIONS,
@@ -184,7 +184,8 @@ def _nss_linear(data: IOData, order: int, method: str, rng):
 
 
 def _fit_nss(data, structure, method, given):
-    """A neural state space (:func:`~.state_space.training.identify_neural_state_space`)."""
+    """A neural state space
+    (:func:`~.state_space.training.identify_neural_state_space`)."""
     return identify_neural_state_space(
         data,
         structure,
@@ -251,9 +252,7 @@ ESTIMATORS: dict[tuple[str, str], Estimator] = {
         for name, options in GREYBOX_METHODS.items()
     },
     **{
-        ("neural-state-space", name): Estimator(
-            _fit_nss, _fixed(("rng", *NSS_OPTIONS))
-        )
+        ("neural-state-space", name): Estimator(_fit_nss, _fixed(("rng", *NSS_OPTIONS)))
         for name in NSS_METHODS
     },
 }

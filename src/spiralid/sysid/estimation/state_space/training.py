@@ -79,7 +79,7 @@ def _hold_mask(n: int, holdout: float) -> np.ndarray:
     """True at the held-back samples: `holdout` of `n` in HOLD_BLOCKS equal
     blocks evenly spread over the record."""
     held = np.zeros(n, dtype=bool)
-    size = int(round(holdout * n / HOLD_BLOCKS))
+    size = round(holdout * n / HOLD_BLOCKS)
     if size < 1:
         return held
     for i in range(HOLD_BLOCKS):
