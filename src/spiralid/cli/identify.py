@@ -683,7 +683,7 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
         "--order",
         type=_positive_int,
         default=3,
-        help="--model nss: state dimension (default 3)",
+        help="--model nss: state dimension",
     )
     add_rig_options(p)
     p.add_argument(
@@ -691,7 +691,7 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
         type=_orders,
         default=[10],
         help="NARX hidden units; several (4,8,16 or 4:8) for --by-fit to choose "
-        "among; --model nss: each network's units (default 10)",
+        "among; --model nss: each network's units",
     )
     p.add_argument(
         "--lags",
