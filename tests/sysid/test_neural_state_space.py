@@ -162,3 +162,19 @@ def test_bad_options_are_refused_in_one_line(options, error, name):
         sid.identify(_wiener(200), NeuralStateSpace(2, hidden=(2,)), **options)
     message = str(refused.value)
     assert "\n" not in message and f"`{name}`" in message
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--na", "2"], "not to --model nss"),
+        (["--method", "sda"], "does not fit --model nss: spiral, oe, ls"),
+        (["--activation", "logistic"], "not to --model nss"),
+    ],
+)
+def test_the_command_line_refuses_what_nss_does_not_take(tmp_path, argv, message):
+    from clitools import run
+
+    proc = run("identify", "rec.npz", "--model", "nss", *argv, "--out", "m",
+               cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 2 and message in proc.stderr, proc.stderr
