@@ -146,6 +146,16 @@ def _one_narx(args, na: int, nb: int, hidden: int | None):
     )
 
 
+def _nss_structure(args):
+    """--model nss: a neural state space of --order states and --hidden
+    units in each network."""
+    from spiralid.sysid import NeuralStateSpace
+
+    if len(args.hidden) > 1:
+        raise UsageError("--model nss takes one --hidden size")
+    return NeuralStateSpace(args.order, hidden=(args.hidden[0],))
+
+
 def _load_parts(args, progress, make_structure):
     """DATA loaded (detrended when asked), the structure built from the
     options, and the record split: the structure must fit the estimation
@@ -165,7 +175,8 @@ def _run_narx(args) -> int:
     from spiralid.sysid import identify
 
     with _progress(args) as progress:
-        structure, est, val = _load_parts(args, progress, _narx_structure)
+        make = _nss_structure if args.model == "nss" else _narx_structure
+        structure, est, val = _load_parts(args, progress, make)
         options = _identify_options(args, structure)
         with _open_folder(args.out, args.force) as folder:
             steps = _search_steps(args, narx=True)
@@ -465,7 +476,8 @@ _DESTS = {flag: flag.removeprefix("--").replace("-", "_") for flag in _OPTION_FL
 
 # The structure options of one kind of --model: the models they apply to.
 _MODEL_FLAGS = {
-    "--hidden": ("narx",),
+    "--hidden": ("narx", "nss"),
+    "--order": ("nss",),
     "--lags": ("narx", "polynomial"),
     "--by-fit": ("narx", "polynomial"),
     "--activation": ("narx",),
@@ -483,6 +495,10 @@ def _example_structure(model: str):
         from spiralid.fms.greybox import RigGreyBox
 
         return RigGreyBox(["hub_inertia"])
+    if model == "nss":
+        from spiralid.sysid import NeuralStateSpace
+
+        return NeuralStateSpace(1)
     kinds = {"arx": ARX, "narx": NARX, "polynomial": PolynomialNARX}
     return kinds[model](1, 1, 0)
 
@@ -577,6 +593,14 @@ def _check_options(args) -> None:
         _refuse_unused(
             _given(args, "--na", "--nb", "--nk"),
             "to --model arx, narx and polynomial, not to --model rig",
+        )
+    elif model == "nss":
+        if ("neural-state-space", method) not in ESTIMATORS:
+            able = ", ".join(methods_of("neural-state-space"))
+            raise UsageError(f"--method {method} does not fit --model nss: {able}")
+        _refuse_unused(
+            _given(args, "--na", "--nb", "--nk"),
+            "to --model arx, narx and polynomial, not to --model nss (--order)",
         )
     elif model != "arx" and ("narx", method) not in ESTIMATORS:
         able = ", ".join(methods_of("narx"))
@@ -673,18 +697,26 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
     """--model, and the options of the NARX families."""
     p.add_argument(
         "--model",
-        choices=["arx", "narx", "polynomial", "rig"],
+        choices=["arx", "narx", "polynomial", "nss", "rig"],
         default="arx",
         help="ARX, NARX with a one-hidden-layer perceptron (--na past outputs, "
-        "--nb past inputs), polynomial NARX by forward-regression OLS, or the "
-        "flexible manipulator's physical parameters (--free)",
+        "--nb past inputs), polynomial NARX by forward-regression OLS, a neural "
+        "state space (--order states, --hidden units; --method names its linear "
+        "start's), or the flexible manipulator's physical parameters (--free)",
+    )
+    p.add_argument(
+        "--order",
+        type=_positive_int,
+        default=3,
+        help="--model nss: state dimension",
     )
     add_rig_options(p)
     p.add_argument(
         "--hidden",
         type=_orders,
         default=[10],
-        help="NARX hidden units; several (4,8,16 or 4:8) for --by-fit to choose among",
+        help="NARX hidden units; several (4,8,16 or 4:8) for --by-fit to choose "
+        "among; --model nss: each network's units",
     )
     p.add_argument(
         "--lags",
