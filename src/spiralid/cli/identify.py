@@ -757,8 +757,8 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
         type=_positive_int,
         default=None,
         metavar="SAMPLES",
-        help="NARX --training subsequences: the stretches' length (default: a "
-        "growing curriculum, kept by the held-back fit)",
+        help="NARX --training subsequences, and --model nss: the stretches' "
+        "length (default: a growing curriculum, kept by the held-back fit)",
     )
     p.add_argument(
         "--degree", type=_positive_int, default=2, help="polynomial NARX degree"
