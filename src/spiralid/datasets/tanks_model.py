@@ -109,7 +109,8 @@ def tanks_f_inflow(t, x, u, p):  # pragma: no cover - compiled
 
 #: overflow name -> the ``f`` that models it (:func:`tanks_greybox`'s
 #: `overflow`).
-OVERFLOWS = {"surplus": tanks_f, "inflow": tanks_f_inflow}
+#: The first is :func:`tanks_greybox`'s default.
+OVERFLOWS = {"inflow": tanks_f_inflow, "surplus": tanks_f}
 
 
 @numba.njit(cache=True)
@@ -121,7 +122,7 @@ def tanks_g(x, u, p):  # pragma: no cover - compiled
 def tanks_greybox(
     *,
     exponents: bool = False,
-    overflow: str = "surplus",
+    overflow: str = "inflow",
     x0="estimated",
     substeps: int = 4,
 ) -> GreyBox:
@@ -132,10 +133,11 @@ def tanks_greybox(
     ----------
     exponents : bool, default False
         Estimate the outflow exponents too (else fixed at Torricelli's 0.5).
-    overflow : {"surplus", "inflow"}, default "surplus"
+    overflow : {"inflow", "surplus"}, default "inflow"
         What reaches the lower tank while the upper one is full (a key of
-        :data:`OVERFLOWS`): ``overflow_share`` times the upper tank's
-        surplus inflow, or times the pump's whole inflow.
+        :data:`OVERFLOWS`): ``overflow_share`` times the pump's whole
+        inflow, or times the upper tank's surplus inflow (the model's form
+        before the inflow one predicted held-back data better).
     x0 : "estimated" or sequence of float, default "estimated"
         The initial levels: estimated within ``[0, 10]`` V (the records
         start from an unknown state), or given.
