@@ -35,11 +35,15 @@ chosen by folds across the record, ``folds``), with ``--auto`` with
 flagged a pole). With ``--integrated`` it
 also runs the default and output error with integrated noise
 (``noise="integrated"``: ``spiral-I``, ``OE-I``). Each prints its fits and
-counts against OE.
+counts against OE. Each method's median fit against the process
+linearised (``plant_fit``: no drift, no noise, no gain variation, over
+the validation third) is printed too, and with ``--plant`` each seed's:
+the validation fit also scores how a model's free run happens to meet the
+drift, this one what the plant model got right.
 
 Run: ``python benchmarks/drift_process.py [--seeds 10] [--orders 8]
-[--workers 2] [--integrated] [--folds] [--auto]``. To measure the code before a
-change, put its source first on ``PYTHONPATH``.
+[--workers 2] [--integrated] [--folds] [--auto] [--plant]``. To measure the
+code before a change, put its source first on ``PYTHONPATH``.
 """
 
 import os
@@ -88,6 +92,21 @@ def record(seed: int, n: int = N, drift: float = DRIFT) -> IOData:
     return IOData(u, y - y[: int(FRACTION * n)].mean(), ts=TS)
 
 
+def plant_fit(model, data: IOData) -> float:
+    """Fit % of `model`'s free run from rest against the process
+    linearised (no drift, no noise, no gain variation) over `data`'s last
+    third: ``d(v + 0.5 v^2)/du = 0.5 (1 + v)`` at ``v``'s mean 1/2, a gain of
+    0.75, into the two real poles. What the plant model got right, apart
+    from how its free run happens to meet the drift."""
+    a = np.poly([np.exp(-TS / tc) for tc in TIME_CONSTANTS])
+    dv = 0.5 * (1.0 + 0.5)
+    truth = signal.lfilter([0.0, dv * a.sum()], a, data.u)
+    start = int(FRACTION * data.n)
+    error = truth[start:] - model.simulate(data.u)[start:]
+    spread = truth[start:] - truth[start:].mean()
+    return float(100.0 * (1.0 - np.linalg.norm(error) / np.linalg.norm(spread)))
+
+
 METHODS = {"default": {}, "OE": {"method": "oe"}, "LS": {"method": "ls"}}
 # With --integrated: both output-error methods with integrated noise
 # (identify's noise="integrated", the plant fitted on the differenced record).
@@ -106,7 +125,8 @@ EVERY = {**METHODS, **INTEGRATED, **FOLDS, **AUTO}
 
 def run_one(task) -> dict:
     seed, order, name = task
-    est, val = record(seed).split(FRACTION)
+    data = record(seed)
+    est, val = data.split(FRACTION)
     t0 = time.perf_counter()
     model = identify(est, ARX(order, order, 0), rng=seed, **EVERY[name])
     elapsed = time.perf_counter() - t0
@@ -117,6 +137,7 @@ def run_one(task) -> dict:
         order=order,
         method=name,
         fit=float(validate(model, val, warmup=est).fit_percent),
+        plant=plant_fit(model, data),
         cost=float(model.cost),
         effective=model.effective_order,
         removed=len(diagnosis.get("removed", [])),
@@ -130,7 +151,7 @@ def run_one(task) -> dict:
     )
 
 
-def table(rows: list[dict], order: int) -> str:
+def table(rows: list[dict], order: int, plant: bool = False) -> str:
     cell = {(r["seed"], r["method"]): r for r in rows if r["order"] == order}
     seeds = sorted({s for s, _ in cell})
     lines = [
@@ -166,6 +187,22 @@ def table(rows: list[dict], order: int) -> str:
             f"{m} >= OE - 1 on {sum(x >= -1 for x in diff)}/{len(seeds)}; "
             f"{m} <= OE - 5 on {sum(x <= -5 for x in diff)}/{len(seeds)}"
         )
+    lines.append(
+        "\nfit % against the linearised process (plant_fit), median: "
+        + ", ".join(
+            f"{m} {np.median([cell[(s, m)]['plant'] for s in seeds]):.1f}"
+            for m in names
+        )
+    )
+    if plant:
+        lines.append("\n| seed | " + " | ".join(names) + " |")
+        lines.append("|---|" + "---|" * len(names))
+        for s in seeds:
+            lines.append(
+                f"| {s} | "
+                + " | ".join(f"{cell[(s, m)]['plant']:.1f}" for m in names)
+                + " |"
+            )
     extra = [m for m in names if m not in METHODS]
     if extra:
         lines.append("\n| seed | " + " | ".join(extra) + " |")
@@ -193,6 +230,11 @@ def main(argv=None) -> None:
     ap.add_argument(
         "--auto", action="store_true", help="also the default, folds='auto'"
     )
+    ap.add_argument(
+        "--plant",
+        action="store_true",
+        help="also each seed's fit against the linearised process",
+    )
     args = ap.parse_args(argv)
     orders = [int(v) for v in args.orders.split(",")]
     methods = {
@@ -209,7 +251,7 @@ def main(argv=None) -> None:
     else:
         rows = [run_one(task) for task in tasks]
     for n in orders:
-        print(table(rows, n))
+        print(table(rows, n, args.plant))
     print(
         f"\n{len(tasks)} identifications in {time.perf_counter() - t0:.0f} s; "
         f"load average {os.getloadavg()[0]:.2f}"

@@ -188,6 +188,11 @@ def _cli_args(method: str, kind: str, flag: str | None):
             "--iterations": "7",
             "--budget": "700",
             "--holdout": "0.1",
+            "--noise": "integrated",
+            "--folds": "on",
+            "--training": "subsequences",
+            "--horizon": "12",
+            "--workers": "2",
         }.get(flag)
         argv += [flag] if value is None else [flag, value]
     return build_parser().parse_args(argv)

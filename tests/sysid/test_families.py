@@ -70,8 +70,13 @@ CASES = {
         ["--na", "2", "--nb", "2", "--nk", "1", "--output", "near,far"],
     ),
     "greybox": (GREYBOX, 1, None),
+    "neural-state-space": (
+        sid.sysid.NeuralStateSpace(2, hidden=(3,)),
+        1,
+        ["--model", "nss", "--order", "2", "--hidden", "3"],
+    ),
 }
-QUICKEST = {"greybox": "oe"}
+QUICKEST = {"greybox": "oe", "neural-state-space": "oe"}
 FAMILIES = sorted(CASES)
 
 

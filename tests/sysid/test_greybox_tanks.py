@@ -10,10 +10,12 @@ import numpy as np
 import pytest
 
 import spiralid as sid
-from spiralid.datasets import cascaded_tanks
+from spiralid.datasets import cascaded_tanks, tanks_model
 from spiralid.datasets.tanks_model import (
+    OVERFLOWS,
     TANKS_PARAMETERS,
     tanks_f,
+    tanks_f_inflow,
     tanks_g,
     tanks_greybox,
 )
@@ -52,14 +54,46 @@ def test_the_equations_by_hand():
     assert tanks_g(np.array([0.0, 9.9]), u, P) == 10.0
 
 
-def test_the_compiled_model_runs_as_its_python_original():
+def test_the_inflow_overflow_by_hand():
+    strong = np.array([5.0])
+    pump = 0.05 * (5.0 - 0.6)
+    # Below the top both overflows are the same equations.
+    below = np.array([4.0, 2.25])
+    np.testing.assert_array_equal(
+        tanks_f_inflow(0.0, below, strong, P), tanks_f(0.0, below, strong, P)
+    )
+    # At the top, half (the share) of the pump's whole inflow reaches the
+    # lower tank, not half of the surplus.
+    full = tanks_f_inflow(0.0, np.array([10.0, 2.25]), strong, P)
+    np.testing.assert_allclose(
+        full, [0.0, 0.04 * math.sqrt(10.0) - 0.05 * 1.5 + 0.5 * pump]
+    )
+    # A full upper tank that drains faster than the pump fills it spills
+    # nothing, in either form.
+    weak = np.array([0.7])
+    np.testing.assert_array_equal(
+        tanks_f_inflow(0.0, np.array([10.0, 2.25]), weak, P),
+        tanks_f(0.0, np.array([10.0, 2.25]), weak, P),
+    )
+
+
+@pytest.mark.parametrize("overflow", list(OVERFLOWS))
+def test_the_compiled_model_runs_as_its_python_original(overflow):
     est = cascaded_tanks()
-    box = tanks_greybox(x0=[6.0, 5.0])
+    box = tanks_greybox(x0=[6.0, 5.0], overflow=overflow)
+    # Every call interpreted: the shared body's original, not the Numba
+    # wrapper's (which calls the compiled body).
+    jet = overflow == "inflow"
+
+    def python_f(t, x, u, p):
+        return tanks_model._rates.py_func(x, u, p, jet)
+
     python = GreyBox(
-        box.parameters, f=tanks_f.py_func, g=tanks_g.py_func, n_states=2,
+        box.parameters, f=python_f, g=tanks_g.py_func, n_states=2,
         x0=[6.0, 5.0], substeps=box.substeps,
     )  # fmt: skip
     values = box.initial_values
+    values[3] = 0.2  # a strong pump: the upper tank reaches its top and spills
     y = box.simulate(values, est.u[:300], est.ts)
     np.testing.assert_allclose(
         y, python.simulate(values, est.u[:300], est.ts), rtol=1e-12, atol=1e-12
@@ -74,11 +108,19 @@ def test_the_builder_and_a_saved_fit(tmp_path):
     assert box.free.sum() == 10 and tanks_greybox(exponents=True).free.all()
     with pytest.raises(ValueError, match="`x0`"):
         tanks_greybox(x0="rest")
+    # The default is the first of the one table, the inflow form.
+    assert box.functions["f"] is tanks_f_inflow is next(iter(OVERFLOWS.values()))
+    assert tanks_greybox(overflow="surplus").functions["f"] is tanks_f
+    assert set(OVERFLOWS) == {"surplus", "inflow"}
+    with pytest.raises(ValueError, match="`overflow`"):
+        tanks_greybox(overflow="jet")
+    with pytest.raises(TypeError, match="`overflow`"):
+        tanks_greybox(overflow=["inflow"])
     est = cascaded_tanks()
     model = sid.identify(est, box, method="oe", polish_nfev=3)
     path = tmp_path / "model.json"
     path.write_text(json.dumps(model.to_dict()))
     text = path.read_text()
-    assert "spiralid.datasets.tanks_model:tanks_f" in text
+    assert "spiralid.datasets.tanks_model:tanks_f_inflow" in text
     back = sid.sysid.load_model(path)
     np.testing.assert_array_equal(back.simulate(est), model.simulate(est))

@@ -64,6 +64,15 @@ def _time_constant(text: str) -> float | str | None:
     return v
 
 
+def _folds(text: str) -> bool | str:
+    """--folds: on, off or auto (identify's True, False or "auto")."""
+    words = {"on": True, "off": False, "auto": "auto"}
+    word = text.strip().lower()
+    if word not in words:
+        raise argparse.ArgumentTypeError(f"must be on, off or auto; got {text!r}")
+    return words[word]
+
+
 def _integrator_count(text: str) -> int | tuple[int, ...]:
     """--integrator K: a count of known integrators, 0 or more; or one per
     output separated by commas (2,1,0,0) with several --output columns."""
@@ -137,6 +146,16 @@ def _one_narx(args, na: int, nb: int, hidden: int | None):
     )
 
 
+def _nss_structure(args):
+    """--model nss: a neural state space of --order states and --hidden
+    units in each network."""
+    from spiralid.sysid import NeuralStateSpace
+
+    if len(args.hidden) > 1:
+        raise UsageError("--model nss takes one --hidden size")
+    return NeuralStateSpace(args.order, hidden=(args.hidden[0],))
+
+
 def _load_parts(args, progress, make_structure):
     """DATA loaded (detrended when asked), the structure built from the
     options, and the record split: the structure must fit the estimation
@@ -156,7 +175,8 @@ def _run_narx(args) -> int:
     from spiralid.sysid import identify
 
     with _progress(args) as progress:
-        structure, est, val = _load_parts(args, progress, _narx_structure)
+        make = _nss_structure if args.model == "nss" else _narx_structure
+        structure, est, val = _load_parts(args, progress, make)
         options = _identify_options(args, structure)
         with _open_folder(args.out, args.force) as folder:
             steps = _search_steps(args, narx=True)
@@ -434,12 +454,30 @@ _OPTION_FLAGS = {
     "--iterations": "max_iter",
     "--budget": "max_nfev",
     "--holdout": "holdout",
+    "--noise": "noise",
+    "--folds": "folds",
+    "--training": "training",
+    "--horizon": "horizon",
+    "--workers": "workers",
 }
+# Flags whose None stands for "not typed": identify() then applies its own
+# default (one place decides it, and a changed default reaches the CLI).
+_LIBRARY_DEFAULTS = (
+    "max_iter",
+    "max_nfev",
+    "parametrization",
+    "noise",
+    "folds",
+    "training",
+    "horizon",
+    "workers",
+)
 _DESTS = {flag: flag.removeprefix("--").replace("-", "_") for flag in _OPTION_FLAGS}
 
 # The structure options of one kind of --model: the models they apply to.
 _MODEL_FLAGS = {
-    "--hidden": ("narx",),
+    "--hidden": ("narx", "nss"),
+    "--order": ("nss",),
     "--lags": ("narx", "polynomial"),
     "--by-fit": ("narx", "polynomial"),
     "--activation": ("narx",),
@@ -457,6 +495,10 @@ def _example_structure(model: str):
         from spiralid.fms.greybox import RigGreyBox
 
         return RigGreyBox(["hub_inertia"])
+    if model == "nss":
+        from spiralid.sysid import NeuralStateSpace
+
+        return NeuralStateSpace(1)
     kinds = {"arx": ARX, "narx": NARX, "polynomial": PolynomialNARX}
     return kinds[model](1, 1, 0)
 
@@ -478,8 +520,7 @@ def _identify_options(args, structure) -> dict:
     return {
         name: value
         for name, value in _option_values(args).items()
-        if name in takes
-        and not (value is None and name in ("max_iter", "max_nfev", "parametrization"))
+        if name in takes and not (value is None and name in _LIBRARY_DEFAULTS)
     }
 
 
@@ -552,6 +593,14 @@ def _check_options(args) -> None:
         _refuse_unused(
             _given(args, "--na", "--nb", "--nk"),
             "to --model arx, narx and polynomial, not to --model rig",
+        )
+    elif model == "nss":
+        if ("neural-state-space", method) not in ESTIMATORS:
+            able = ", ".join(methods_of("neural-state-space"))
+            raise UsageError(f"--method {method} does not fit --model nss: {able}")
+        _refuse_unused(
+            _given(args, "--na", "--nb", "--nk"),
+            "to --model arx, narx and polynomial, not to --model nss (--order)",
         )
     elif model != "arx" and ("narx", method) not in ESTIMATORS:
         able = ", ".join(methods_of("narx"))
@@ -648,18 +697,26 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
     """--model, and the options of the NARX families."""
     p.add_argument(
         "--model",
-        choices=["arx", "narx", "polynomial", "rig"],
+        choices=["arx", "narx", "polynomial", "nss", "rig"],
         default="arx",
         help="ARX, NARX with a one-hidden-layer perceptron (--na past outputs, "
-        "--nb past inputs), polynomial NARX by forward-regression OLS, or the "
-        "flexible manipulator's physical parameters (--free)",
+        "--nb past inputs), polynomial NARX by forward-regression OLS, a neural "
+        "state space (--order states, --hidden units; --method names its linear "
+        "start's), or the flexible manipulator's physical parameters (--free)",
+    )
+    p.add_argument(
+        "--order",
+        type=_positive_int,
+        default=3,
+        help="--model nss: state dimension",
     )
     add_rig_options(p)
     p.add_argument(
         "--hidden",
         type=_orders,
         default=[10],
-        help="NARX hidden units; several (4,8,16 or 4:8) for --by-fit to choose among",
+        help="NARX hidden units; several (4,8,16 or 4:8) for --by-fit to choose "
+        "among; --model nss: each network's units",
     )
     p.add_argument(
         "--lags",
@@ -687,6 +744,21 @@ def _add_model_options(p: argparse.ArgumentParser) -> None:
         default=0.2,
         help="NARX: share of the estimation part held back for early stopping "
         "(0: train to convergence)",
+    )
+    p.add_argument(
+        "--training",
+        choices=["free-run", "subsequences"],
+        default=None,
+        help="NARX: train on the free run of the whole record or on short "
+        "stretches each started from measured samples (default: free-run)",
+    )
+    p.add_argument(
+        "--horizon",
+        type=_positive_int,
+        default=None,
+        metavar="SAMPLES",
+        help="NARX --training subsequences, and --model nss: the stretches' "
+        "length (default: a growing curriculum, kept by the held-back fit)",
     )
     p.add_argument(
         "--degree", type=_positive_int, default=2, help="polynomial NARX degree"
@@ -737,6 +809,23 @@ def _add_method_options(p: argparse.ArgumentParser) -> None:
         "part's length, for --method spiral and oe and --refine's polish",
     )
     p.add_argument(
+        "--noise",
+        choices=["white", "integrated"],
+        default=None,
+        help="--method spiral and oe: the output's disturbance, white or "
+        "integrated (a drifting output: the fit runs on the differenced record, "
+        "as MATLAB's IntegrateNoise; default: white)",
+    )
+    p.add_argument(
+        "--folds",
+        type=_folds,
+        default=None,
+        metavar="{on,off,auto}",
+        help="--method spiral: choose among the search's model, output error and "
+        "the integrated-noise fit by blocked folds of the estimation part; auto "
+        "only where the modes table flags a mode (default: the library's, off)",
+    )
+    p.add_argument(
         "--integrator",
         nargs="?",
         type=_integrator_count,
@@ -767,5 +856,13 @@ def _add_search_options(p: argparse.ArgumentParser) -> None:
         help="max cost evaluations (default: the method's own: 10,000 "
         "evaluations for spiral and every NARX search; the others stop at "
         "--iterations)",
+    )
+    p.add_argument(
+        "--workers",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="--model rig: run the search's simulations on N processes, the "
+        "same result bit for bit (default: 1, this process)",
     )
     _add_seed_option(p)

@@ -1,6 +1,6 @@
 """``spiralid identify --model rig``: the flexible manipulator's physical
 parameters (:class:`spiralid.fms.greybox.RigGreyBox`) fitted to a record of
-one of its sensors, validated on the rest of the record."""
+one or several of its sensors, validated on the rest of the record."""
 
 from __future__ import annotations
 
@@ -50,9 +50,11 @@ def add_rig_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--sensor",
         default=None,
-        help="--model rig: the rig's output the record holds (hub_angle, "
-        "hub_velocity, end_acceleration, tip_deflection; default the record's "
-        "output name)",
+        metavar="SENSORS",
+        help="--model rig: the rig's sensor the record's output holds "
+        "(hub_angle, hub_velocity, end_acceleration, tip_deflection), or several "
+        "separated by commas, one per --output column in its order (each "
+        "weighted by its noise variance); default the record's output names",
     )
     p.add_argument(
         "--modes",
@@ -78,7 +80,17 @@ def _structure(args, data):
     if args.free is None:
         raise UsageError("--model rig needs --free FIELDS (the fields to estimate)")
     rig = nonlinear_rig() if args.rig == "nonlinear" else FlexibleManipulator()
-    sensor = args.sensor or str(data.output_name)
+    if args.sensor is None:
+        sensors = list(data.output_names)
+    else:
+        sensors = [part.strip() for part in str(args.sensor).split(",")]
+    if len(sensors) != data.n_outputs:
+        raise UsageError(
+            f"--sensor names {len(sensors)} sensor(s) ({', '.join(sensors)}) but the "
+            f"record holds {data.n_outputs} output(s) "
+            f"({', '.join(data.output_names)}): one sensor per --output column"
+        )
+    sensor = sensors[0] if len(sensors) == 1 else tuple(sensors)
     try:
         return RigGreyBox(args.free, rig, output=sensor, n_modes=args.modes)
     except (TypeError, ValueError) as error:
@@ -87,6 +99,8 @@ def _structure(args, data):
         hint = ""
         if args.sensor is None and "`output`" in str(error):
             hint = " (the record's output name; set --sensor)"
+        elif "`output`" in str(error):
+            hint = " (from --sensor)"
         raise UsageError(f"--model rig: {error}{hint}") from None
 
 
@@ -99,8 +113,6 @@ def run_rig(args, options: dict, write_model, validated, write_timings) -> int:
     with _progress(args) as progress:
         progress.phase("load", "loading the data")
         data = _load_data(args)
-        if data.n_outputs != 1:
-            raise UsageError("--model rig fits a record of one output")
         if args.detrend:
             data = _detrended(data, args.fraction)
         structure = _structure(args, data)
@@ -117,6 +129,7 @@ def run_rig(args, options: dict, write_model, validated, write_timings) -> int:
                     f"{structure} by {args.method} on {args.data}",
                     *model.parameter_rows(),
                     *(f"  {note}" for note in model.undetermined),
+                    *model.output_rows(),
                     "",
                     structure.modes_beside(model.values),
                 ]

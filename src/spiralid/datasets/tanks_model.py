@@ -15,9 +15,15 @@ tank's level, ``x[1]`` the lower tank's. With ``p`` as
     y      = min(x1 + sensor_offset, 10)
 
 The upper tank spills once ``x0`` reaches :data:`UPPER_TOP` (it then stays
-there, its surplus inflow going partly into the lower tank and partly
-away), and the lower tank stops filling at ``lower_top`` (its own
-overflow). The upper level is never measured: its scale is the model's
+there), and the lower tank stops filling at ``lower_top`` (its own
+overflow). What the upper tank spills is one of :data:`OVERFLOWS`:
+``"surplus"`` (:func:`tanks_f`), its surplus inflow ``pump - q_up``, a
+share of it into the lower tank and the rest away; or ``"inflow"``
+(:func:`tanks_f_inflow`), a share of the pump's whole inflow ``pump``
+falling on into the lower tank while the upper one is full (the form of
+the published grey boxes of the benchmark, Rogers et al. 2017 and Worden
+et al. 2018: a term ``k5 u`` added to the lower tank above the upper
+one's top). The upper level is never measured: its scale is the model's
 choice, fixed by :data:`UPPER_TOP`, or the record could not tell the pump's
 gain from the upper tank's size.
 
@@ -36,7 +42,15 @@ import numpy as np
 
 from spiralid.sysid.models.greybox import GreyBox, Parameter
 
-__all__ = ["TANKS_PARAMETERS", "UPPER_TOP", "tanks_f", "tanks_g", "tanks_greybox"]
+__all__ = [
+    "OVERFLOWS",
+    "TANKS_PARAMETERS",
+    "UPPER_TOP",
+    "tanks_f",
+    "tanks_f_inflow",
+    "tanks_g",
+    "tanks_greybox",
+]
 
 #: The upper tank's overflow level, in the model's volts.
 UPPER_TOP = 10.0
@@ -60,19 +74,43 @@ TANKS_PARAMETERS: dict[str, tuple] = {
 
 
 @numba.njit(cache=True)
-def tanks_f(t, x, u, p):  # pragma: no cover - compiled
-    """``dx/dt`` of the two tanks (see the module docstring)."""
+def _rates(x, u, p, jet):  # pragma: no cover - compiled
+    # The two overflows share everything but what reaches the lower tank
+    # while the upper one is full: its surplus (jet False) or the pump's
+    # whole inflow (jet True), times the share.
     up = max(x[0], 0.0)
     low = max(x[1], 0.0)
     q_up = p[0] * up ** p[8]
-    dx0 = p[3] * max(u[0] - p[6], 0.0) - q_up
+    pump = p[3] * max(u[0] - p[6], 0.0)
+    dx0 = pump - q_up
     spill = 0.0
     if x[0] >= UPPER_TOP and dx0 > 0.0:
-        spill, dx0 = dx0, 0.0
+        spill, dx0 = (pump if jet else dx0), 0.0
     dx1 = p[1] * q_up - p[2] * low ** p[9] + p[4] * spill
     if x[1] >= p[7] and dx1 > 0.0:
         dx1 = 0.0
     return np.array([dx0, dx1])
+
+
+@numba.njit(cache=True)
+def tanks_f(t, x, u, p):  # pragma: no cover - compiled
+    """``dx/dt`` of the two tanks, the upper one's surplus spilling (see
+    the module docstring)."""
+    return _rates(x, u, p, False)
+
+
+@numba.njit(cache=True)
+def tanks_f_inflow(t, x, u, p):  # pragma: no cover - compiled
+    """``dx/dt`` of the two tanks, a share of the pump's inflow reaching
+    the lower tank while the upper one is full (see the module
+    docstring)."""
+    return _rates(x, u, p, True)
+
+
+#: overflow name -> the ``f`` that models it (:func:`tanks_greybox`'s
+#: `overflow`).
+#: The first is :func:`tanks_greybox`'s default.
+OVERFLOWS = {"inflow": tanks_f_inflow, "surplus": tanks_f}
 
 
 @numba.njit(cache=True)
@@ -82,7 +120,11 @@ def tanks_g(x, u, p):  # pragma: no cover - compiled
 
 
 def tanks_greybox(
-    *, exponents: bool = False, x0="estimated", substeps: int = 4
+    *,
+    exponents: bool = False,
+    overflow: str = "inflow",
+    x0="estimated",
+    substeps: int = 4,
 ) -> GreyBox:
     """The tanks model as a grey box ready for
     :func:`~spiralid.sysid.identify`.
@@ -91,6 +133,11 @@ def tanks_greybox(
     ----------
     exponents : bool, default False
         Estimate the outflow exponents too (else fixed at Torricelli's 0.5).
+    overflow : {"inflow", "surplus"}, default "inflow"
+        What reaches the lower tank while the upper one is full (a key of
+        :data:`OVERFLOWS`): ``overflow_share`` times the pump's whole
+        inflow, or times the upper tank's surplus inflow (the model's form
+        before the inflow one predicted held-back data better).
     x0 : "estimated" or sequence of float, default "estimated"
         The initial levels: estimated within ``[0, 10]`` V (the records
         start from an unknown state), or given.
@@ -101,6 +148,12 @@ def tanks_greybox(
     -------
     GreyBox
     """
+    if not isinstance(overflow, str):
+        raise TypeError(f"`overflow` must be a str; got {type(overflow).__name__}")
+    if overflow not in OVERFLOWS:
+        raise ValueError(
+            f"`overflow` must be one of {sorted(OVERFLOWS)}; got {overflow!r}"
+        )
     params = [
         Parameter(
             name,
@@ -119,4 +172,6 @@ def tanks_greybox(
             Parameter("upper_level_0", 5.0, (0.0, UPPER_TOP), "V"),
             Parameter("lower_level_0", 5.0, (0.0, SENSOR_MAX), "V"),
         ]
-    return GreyBox(params, f=tanks_f, g=tanks_g, n_states=2, x0=x0, substeps=substeps)
+    return GreyBox(
+        params, f=OVERFLOWS[overflow], g=tanks_g, n_states=2, x0=x0, substeps=substeps
+    )

@@ -4,7 +4,9 @@ The physical rig of the paper is not available, so :class:`FlexibleManipulator`
 simulates it from physics (hub + Euler-Bernoulli beam + payload, exact
 zero-order-hold sampling, encoder/tachometer/accelerometer models).
 :class:`RigGreyBox` (:mod:`spiralid.fms.greybox`) is the rig as a grey box
-whose physical parameters :func:`spiralid.sysid.identify` fits to a record.
+whose physical parameters :func:`spiralid.sysid.identify` fits to a record;
+:func:`rig_start_from_modes` (:mod:`spiralid.fms.greybox_start`) starts it
+where its modes are a black box's.
 """
 
 from spiralid.fms.experiment import Experiment, paper_experiment
@@ -24,6 +26,7 @@ __all__ = [
     "nonlinear_rig",
     "paper_experiment",
     "prbs",
+    "rig_start_from_modes",
 ]
 
 
@@ -34,4 +37,8 @@ def __getattr__(name: str):
         from spiralid.fms.greybox import RigGreyBox
 
         return RigGreyBox
+    if name == "rig_start_from_modes":
+        from spiralid.fms.greybox_start import rig_start_from_modes
+
+        return rig_start_from_modes
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

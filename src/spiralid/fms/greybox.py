@@ -1,6 +1,6 @@
 """The rig as a ready grey box: :class:`RigGreyBox`, any subset of
 :class:`~spiralid.fms.rig.FlexibleManipulator`'s physical fields free,
-fitted by :func:`spiralid.sysid.identify` to a record of one of its
+fitted by :func:`spiralid.sysid.identify` to a record of one or several of its
 sensors.
 
 Every evaluation builds the rig at the parameter values and runs the rig's
@@ -10,6 +10,13 @@ implicit stick-slip step of :mod:`spiralid.fms._friction` with hub
 friction on, the amplifier's clip with a torque limit. Nothing of the
 physics is restated here, so the grey box and the simulator that made a
 record cannot drift apart.
+
+Two options connect the rig to a record made elsewhere (a real arm):
+``output_gain``, a factor between the rig's output in SI units and the
+record's (a sensor's scale and sign), and ``x0``, the modal initial state,
+given or estimated (a record that starts in motion).
+:func:`spiralid.fms.greybox_start.rig_start_from_modes` picks a start whose
+finite-element modes are those of a black box fitted to the record.
 
 ``n_modes`` keeps the rigid mode and the first ``n_modes`` flexible ones
 (modal truncation): fewer states, so faster runs (the stick-slip step's
@@ -33,8 +40,12 @@ from spiralid.choices import RIG_PARAMETERS
 from spiralid.fms.rig import _OUTPUTS, FlexibleManipulator, _continuous, _discrete
 from spiralid.fms.sensors import Sensors
 from spiralid.sysid.models.greybox import GreyBox, Parameter
+from spiralid.sysid.models.greybox_run import lti_run
 
-__all__ = ["RIG_PARAMETERS", "RigGreyBox", "default_parameter"]
+__all__ = ["GAIN", "RIG_PARAMETERS", "RigGreyBox", "default_parameter"]
+
+#: The name of the output gain's parameter (not a field of the rig).
+GAIN = "output_gain"
 
 # The derived parameters and the fields they are computed from: freeing one
 # with any of its fields would leave a direction the model cannot see.
@@ -110,6 +121,24 @@ def default_parameter(rig: FlexibleManipulator, name: str) -> Parameter:
     return Parameter(name, 0.0, (0.0, _zero_preset_high(rig, name)), unit)
 
 
+def _outputs_of(output, sensors: Sensors) -> tuple[str | tuple, tuple[str, ...]]:
+    """`output` checked (one sensor or several, each once): as given (a
+    tuple for several) and as a tuple."""
+    known = _OUTPUTS + sensors.positional_names
+    if isinstance(output, str):
+        return one_of(output, "output", known), (output,)
+    names = tuple(output) if isinstance(output, Sequence) else ()
+    if not names or not all(isinstance(n, str) for n in names):
+        raise TypeError(
+            f"`output` must be a sensor's name or a sequence of them; got {output!r}"
+        )
+    for name in names:
+        one_of(name, "output", known)
+    if len(set(names)) != len(names):
+        raise ValueError(f"`output` must name each sensor once; got {names}")
+    return (names[0] if len(names) == 1 else names), names
+
+
 class RigGreyBox(GreyBox):
     """The flexible manipulator as a grey box: the fields named in `free`
     estimated, the others held at `rig`'s values.
@@ -124,10 +153,12 @@ class RigGreyBox(GreyBox):
     rig : FlexibleManipulator, optional
         The rig whose other fields are held and whose values start the
         free ones; default ``FlexibleManipulator()``.
-    output : str, default "hub_angle"
+    output : str or sequence of str, default "hub_angle"
         The sensor the record holds: ``"hub_angle"``, ``"hub_velocity"``,
         ``"end_acceleration"``, ``"tip_deflection"``, or one of `sensors`'
-        positional outputs (``deflection_<x>``, ``acceleration_<x>``).
+        positional outputs (``deflection_<x>``, ``acceleration_<x>``); or
+        several of them, the record's outputs in that order (each weighted
+        by its noise variance in the fit).
     n_modes : int, optional
         Keep the rigid mode and this many flexible modes (default all
         ``2 n_elements``).
@@ -135,9 +166,26 @@ class RigGreyBox(GreyBox):
         The instruments (their anti-aliasing filter is part of the model of
         a filtered channel; noise and quantisation are not); default
         ``Sensors()``, the rig's.
+    output_gain : float or Parameter, optional
+        The record's output per unit of the rig's (SI) output: a number
+        holds it, a :class:`~spiralid.sysid.Parameter` named
+        ``"output_gain"`` estimates it within its bounds (a negative range
+        for a sensor of the opposite sign). Default 1, no parameter. With
+        every mass and stiffness free it trades against their common scale
+        (the record cannot tell them apart): hold one of those.
+    x0 : sequence of float or Parameter, optional
+        The initial state in the model's coordinates, ``n_states`` entries
+        (modal displacements, then scaled modal velocities, then the
+        filter's states; see :meth:`modal_state`), each a number or an
+        estimated :class:`~spiralid.sysid.Parameter` as
+        :class:`~spiralid.sysid.GreyBox` takes them; default rest. The
+        linear kind only.
 
     Attributes
     ----------
+    outputs : tuple of str
+        The sensors, in the record's order (`output` given as one name or
+        several).
     kind : str
         ``"nonlinear"`` when friction or a torque limit is on or free, else
         ``"linear"`` (the fit then has poles and modes).
@@ -154,9 +202,11 @@ class RigGreyBox(GreyBox):
         free: Sequence[str | Parameter],
         rig: FlexibleManipulator | None = None,
         *,
-        output: str = "hub_angle",
+        output: str | Sequence[str] = "hub_angle",
         n_modes: int | None = None,
         sensors: Sensors | None = None,
+        output_gain: float | Parameter = 1.0,
+        x0=None,
     ) -> None:
         rig = FlexibleManipulator() if rig is None else rig
         if not isinstance(rig, FlexibleManipulator):
@@ -174,6 +224,10 @@ class RigGreyBox(GreyBox):
                 f"got {free!r}"
             )
         self.parameters = tuple(self._parameter(rig, p) for p in free)
+        self._n_fields = len(self.parameters)
+        self.output_gain = self._gain(output_gain)
+        if isinstance(self.output_gain, Parameter):
+            self.parameters += (self.output_gain,)
         names = [p.name for p in self.parameters]
         if len(set(names)) != len(names):
             raise ValueError(f"`free` names a field more than once: {names}")
@@ -185,8 +239,9 @@ class RigGreyBox(GreyBox):
                     "one or the other"
                 )
         self.rig, self.sensors = rig, sensors
-        self.output = one_of(output, "output", _OUTPUTS + sensors.positional_names)
-        self._row = (_OUTPUTS + sensors.positional_names).index(self.output)
+        self.output, self.outputs = _outputs_of(output, sensors)
+        known = _OUTPUTS + sensors.positional_names
+        self._rows = [known.index(name) for name in self.outputs]
         if n_modes is not None:
             n_modes = integer(n_modes, "n_modes", 1)
             if n_modes > 2 * rig.n_elements:
@@ -197,7 +252,7 @@ class RigGreyBox(GreyBox):
         self.n_modes = n_modes
         # The encoder and the deflections pass no filter: the model runs
         # without the other channels' filter states.
-        unfiltered = self.output in _UNFILTERED or self.output.startswith("defl")
+        unfiltered = all(n in _UNFILTERED or n.startswith("defl") for n in self.outputs)
         self._sim_sensors = (
             dataclasses.replace(sensors, antialias_order=0) if unfiltered else sensors
         )
@@ -207,12 +262,76 @@ class RigGreyBox(GreyBox):
         )
         self.functions = {}
         self.substeps = rig.friction_substeps
-        self.n_inputs, self.n_outputs = 1, 1
+        self.n_inputs, self.n_outputs = 1, len(self.outputs)
         self.state_parameters = ()
         a = self.matrices(self.initial_values, 1.0)[0]
         self.n_states = a.shape[0]
-        # The record starts at rest, as the rig's simulate does.
-        self._x0_given = self._initial_state(None)
+        # By default the record starts at rest, as the rig's simulate does.
+        self._x0_given = self._initial_state(x0)
+        if self.kind == "nonlinear" and (self.state_parameters or self._x0_given.any()):
+            raise ValueError(
+                "`x0`: an initial state other than rest needs the linear rig (no "
+                "friction, no torque limit)"
+            )
+        twice = sorted({n for n in self.names if self.names.count(n) > 1})
+        if twice:
+            raise ValueError(f"`x0` names {twice} as a parameter already has")
+
+    @staticmethod
+    def _gain(value) -> float | Parameter:
+        """`output_gain` checked: a finite nonzero number or a Parameter
+        named :data:`GAIN`."""
+        if isinstance(value, Parameter):
+            if value.name != GAIN:
+                raise ValueError(
+                    f"`output_gain` as a Parameter must be named {GAIN!r}; got "
+                    f"{value.name!r}"
+                )
+            return value
+        if isinstance(value, bool) or not isinstance(value, int | float | np.number):
+            raise TypeError(
+                f"`output_gain` must be a number or a Parameter; got "
+                f"{type(value).__name__}"
+            )
+        if not (np.isfinite(value) and value != 0.0):
+            raise ValueError(f"`output_gain` must be finite and nonzero; got {value}")
+        return float(value)
+
+    def gain_at(self, values) -> float:
+        """The output gain at `values` (every parameter, in order)."""
+        if isinstance(self.output_gain, Parameter):
+            return float(np.asarray(values, dtype=float)[self._n_fields])
+        return self.output_gain
+
+    def modal_state(self, x) -> np.ndarray:
+        """The model's state for the rig's generalised coordinates and
+        velocities `x` (``(q, q')``, shape ``(2 ndof,)``, as
+        :meth:`FlexibleManipulator.simulate` takes ``x0``), at the initial
+        values: modal displacements ``eta`` with ``q = Phi eta``, velocities
+        scaled by each flexible mode's frequency, the filter at rest.
+
+        Parameters
+        ----------
+        x : array_like, shape (2 ndof,)
+            The rig's state.
+
+        Returns
+        -------
+        ndarray, shape (n_states,)
+        """
+        rig = self.rig_at(self.initial_values)
+        x = np.asarray(x, dtype=float).ravel()
+        if x.size != 2 * rig.ndof:
+            raise ValueError(
+                f"`x` must have 2 ndof = {2 * rig.ndof} entries; got {x.size}"
+            )
+        _, _, _, _, scale = rig._plant(n_modes=self.n_modes)
+        n = scale.size
+        phi, m = rig._modal[1][:, :n], rig.mass_matrix
+        s = np.zeros(self.n_states)
+        s[:n] = phi.T @ (m @ x[: rig.ndof])
+        s[n : 2 * n] = (phi.T @ (m @ x[rig.ndof :])) / scale
+        return s
 
     @staticmethod
     def _parameter(rig: FlexibleManipulator, p) -> Parameter:
@@ -231,7 +350,9 @@ class RigGreyBox(GreyBox):
         """The rig with the parameters at `values` (every parameter of this
         structure, in order); a ValueError when they make no rig."""
         fields, derived = {}, {}
-        for p, v in zip(self.parameters, np.asarray(values, dtype=float), strict=True):
+        fields_of = self.parameters[: self._n_fields]
+        values = np.asarray(values, dtype=float)[: self._n_fields]
+        for p, v in zip(fields_of, values, strict=True):
             (derived if p.name in _DERIVED else fields)[p.name] = float(v)
         rig = dataclasses.replace(self.rig, **fields)
         if "flexural_rigidity" in derived:
@@ -256,8 +377,9 @@ class RigGreyBox(GreyBox):
             s.acceleration_at,
             self.n_modes,
         )
-        row = slice(self._row, self._row + 1)
-        return a, b[:, None], c[row], d[row][:, None]
+        rows = self._rows
+        k = self.gain_at(values)
+        return a, b[:, None], k * c[rows], k * d[rows][:, None]
 
     def discretise(self, values, ts: float) -> tuple[np.ndarray, ...]:
         """The linear rig's exact zero-order hold ``(Ad, Bd, C, D)`` at
@@ -272,26 +394,32 @@ class RigGreyBox(GreyBox):
             s.acceleration_at,
             self.n_modes,
         )
-        row = slice(self._row, self._row + 1)
+        rows = self._rows
+        k = self.gain_at(values)
         return (
             np.array(ad),
             np.array(bd)[:, None],
-            np.array(c[row]),
-            np.array(d[row])[:, None],
+            k * np.array(c[rows]),
+            k * np.array(d[rows])[:, None],
         )
 
     def simulate(self, values, u, ts: float) -> np.ndarray:
-        """The output, shape (N,), over the torque `u` from rest, by the
-        rig's own sampled simulation; NaN when the values make no rig or
-        the run leaves the floating-point range (the fit's penalty)."""
+        """The output, shape (N,) (one sensor) or (N, p), over the torque
+        `u` from rest, by the rig's own sampled simulation (from another
+        initial state, by the exact zero-order hold of the same matrices),
+        times the output gain; NaN when the values make no rig or the run
+        leaves the floating-point range (the fit's penalty)."""
         uu = np.asarray(u, dtype=float).reshape(len(u), -1)
         if uu.shape[1] != 1:
             raise ValueError(f"`u` must have 1 input column; got {uu.shape[1]}")
-        nan = np.full(uu.shape[0], np.nan)
+        shape = (uu.shape[0],) if self.n_outputs == 1 else (uu.shape[0], self.n_outputs)
+        nan = np.full(shape, np.nan)
         try:
             rig = self.rig_at(values)
         except (TypeError, ValueError):
             return nan
+        if self.state_parameters or self._x0_given.any():
+            return self._from_state(values, uu, float(ts), nan)
         with np.errstate(all="ignore"):
             try:
                 y, _, _ = rig._outputs(
@@ -304,7 +432,20 @@ class RigGreyBox(GreyBox):
                 )
             except (ValueError, np.linalg.LinAlgError):
                 return nan
-        return np.asarray(y[:, self._row], dtype=float)
+        y = self.gain_at(values) * np.asarray(y[:, self._rows], dtype=float)
+        return y[:, 0] if self.n_outputs == 1 else y
+
+    def _from_state(self, values, uu, ts: float, nan) -> np.ndarray:
+        """The linear rig's run from the initial state at `values`: its
+        exact zero-order hold (the matrices the rig's own run uses)."""
+        with np.errstate(all="ignore"):
+            try:
+                ad, bd, c, d = self.discretise(values, ts)
+            except (ValueError, np.linalg.LinAlgError):
+                return nan
+            x0 = self.initial_state(values)
+            y = lti_run(ad, bd, c, d, x0, np.ascontiguousarray(uu))
+        return y[:, 0] if self.n_outputs == 1 else y
 
     # -- the modes beside the FEM's ----------------------------------------------
 
@@ -335,6 +476,10 @@ class RigGreyBox(GreyBox):
 
     # -- text and JSON ----------------------------------------------------------
 
+    def output_source(self) -> str:
+        """What gives the outputs, for messages: the sensors named."""
+        return f"`output` {self.output!r}"
+
     def function_paths(self) -> dict[str, str]:
         """None: the rig's simulation is this class's own (model.json names
         the class)."""
@@ -347,8 +492,16 @@ class RigGreyBox(GreyBox):
             "class": f"{type(self).__module__}:{type(self).__qualname__}",
             "kind": self.kind,
             "rig": dataclasses.asdict(self.rig),
-            "parameters": [p.to_dict() for p in self.parameters],
-            "output": self.output,
+            "parameters": [p.to_dict() for p in self.parameters[: self._n_fields]],
+            "output_gain": (
+                self.output_gain.to_dict()
+                if isinstance(self.output_gain, Parameter)
+                else self.output_gain
+            ),
+            "x0": self._x0_entries(),
+            "output": self.output
+            if isinstance(self.output, str)
+            else list(self.output),
             "n_modes": self.n_modes,
             "sensors": dataclasses.asdict(self.sensors),
         }
@@ -359,18 +512,24 @@ class RigGreyBox(GreyBox):
         sensors = {
             k: tuple(v) if isinstance(v, list) else v for k, v in d["sensors"].items()
         }
+        gain = d.get("output_gain", 1.0)
+        x0 = d.get("x0")
+        if x0 is not None:
+            x0 = [Parameter(**e) if isinstance(e, dict) else e for e in x0]
         return cls(
             [Parameter(**p) for p in d["parameters"]],
             FlexibleManipulator(**d["rig"]),
-            output=d["output"],
+            output=d["output"] if isinstance(d["output"], str) else tuple(d["output"]),
             n_modes=d.get("n_modes"),
             sensors=Sensors(**sensors),
+            output_gain=Parameter(**gain) if isinstance(gain, dict) else gain,
+            x0=x0,
         )
 
     def __repr__(self) -> str:
         modes = "all" if self.n_modes is None else self.n_modes
         return (
-            f"RigGreyBox({self.kind}, {self.output}, modes {modes}; "
+            f"RigGreyBox({self.kind}, {', '.join(self.outputs)}, modes {modes}; "
             f"{', '.join(self.names)})"
         )
 

@@ -30,6 +30,10 @@ from .models.modes import ModeTable as ModeTable
 from .models.narx import NARX as NARX
 from .models.narx import NARXModel as NARXModel
 from .models.narx import PolynomialNARX as PolynomialNARX
+from .models.neural_state_space import NeuralStateSpace as NeuralStateSpace
+from .models.neural_state_space_model import (
+    NeuralStateSpaceModel as NeuralStateSpaceModel,
+)
 from .models.polynomials import fold_reflection as fold_reflection
 from .models.polynomials import format_pole_radius as format_pole_radius
 from .models.polynomials import is_stable_polynomial as is_stable_polynomial
@@ -88,6 +92,8 @@ __all__ = [
     "ModeShapes",
     "ModeTable",
     "NARXModel",
+    "NeuralStateSpace",
+    "NeuralStateSpaceModel",
     "NonlinearChecks",
     "PaperCost",
     "Parameter",

@@ -2,7 +2,8 @@
 
 A model file (``model.json``) names its kind in the field ``"model"``:
 ``"arx"`` (or absent, in files written before the field existed),
-``"narx"``, ``"shared-denominator"`` or ``"greybox"``; :data:`MODEL_KINDS`
+``"narx"``, ``"shared-denominator"``, ``"greybox"`` or
+``"neural-state-space"``; :data:`MODEL_KINDS`
 is the one table from that name to the class whose ``from_dict`` reads it.
 """
 
@@ -15,6 +16,7 @@ from pathlib import Path
 from .greybox_model import GreyBoxModel
 from .identified import IdentifiedModel
 from .narx import NARXModel
+from .neural_state_space_model import NeuralStateSpaceModel
 from .protocol import FittedModelProtocol
 from .shared import SharedDenominatorModel
 
@@ -25,6 +27,7 @@ MODEL_KINDS = {
     "narx": NARXModel,
     "shared-denominator": SharedDenominatorModel,
     "greybox": GreyBoxModel,
+    "neural-state-space": NeuralStateSpaceModel,
 }
 
 
@@ -48,8 +51,9 @@ def load_model(d: dict | str | os.PathLike) -> FittedModelProtocol:
 
     Returns
     -------
-    IdentifiedModel, NARXModel, SharedDenominatorModel or GreyBoxModel
-        As its field ``"model"`` says.
+    FittedModelProtocol
+        The kind its field ``"model"`` names: IdentifiedModel, NARXModel,
+        SharedDenominatorModel, GreyBoxModel or NeuralStateSpaceModel.
 
     Raises
     ------

@@ -13,7 +13,10 @@ Two kinds, as MATLAB's ``idgrey`` and ``idnlgrey``:
 
 ``p`` is every parameter's value in the declared order, free and fixed
 alike (``k, c, m = p`` unpacks it), ``x`` and ``u`` one-dimensional arrays
-(``u`` of length ``n_inputs``). A plain Python function works; with Numba
+(``u`` of length ``n_inputs``). Several outputs are ``C``'s rows, or the
+values ``g`` returns: a record of as many outputs, in that order, is fitted
+by all of them at once (each weighted by its noise variance, see
+:mod:`spiralid.sysid.estimation.greybox.fit`). A plain Python function works; with Numba
 functions (``numba.njit``) for both ``f`` and ``g`` the Runge-Kutta loop
 runs compiled (:mod:`.greybox_run`). Each function is called once at
 construction on the initial values, and a wrong shape or a NaN is refused
@@ -166,7 +169,7 @@ class GreyBox:
     kind : str
         ``"linear"`` or ``"nonlinear"``.
     n_outputs : int
-        The output dimension (one: the family fits records of one output).
+        The output dimension: ``C``'s rows, or the values ``g`` returns.
     parameters : tuple of Parameter
         The functions' parameters (``p``).
     state_parameters : tuple of Parameter
@@ -178,7 +181,8 @@ class GreyBox:
     """
 
     family = "greybox"
-    outputs_family = None
+    # Several outputs are the structure's own (``g``'s values, ``C``'s rows).
+    outputs_family = "greybox"
     # A grey box reads no past outputs: it runs from its own state.
     max_lag = 0
 
@@ -242,11 +246,6 @@ class GreyBox:
             u0 = np.zeros(self.n_inputs)
             self._derivative(0.0, self.x0, u0, values)
             self.n_outputs = self._output(self.x0, u0, values, size=None).size
-        if self.n_outputs != 1:
-            raise ValueError(
-                f"the grey-box family fits one output; `{self._output_function}` "
-                f"returns {self.n_outputs}"
-            )
 
     # -- the parameters -------------------------------------------------------
 
@@ -284,9 +283,11 @@ class GreyBox:
             x[self._x0_free_rows] = np.asarray(values, dtype=float)[n_p:]
         return x
 
-    @property
-    def _output_function(self) -> str:
-        return "ss" if self.kind == "linear" else "g"
+    def output_source(self) -> str:
+        """What gives the outputs, for messages: the function by role and
+        name."""
+        role = "ss" if self.kind == "linear" else "g"
+        return f"`{role}` ({_function_name(self.functions[role])})"
 
     def _initial_state(self, x0) -> np.ndarray:
         """The given initial state (a Parameter's entry at its value), the
@@ -375,11 +376,11 @@ class GreyBox:
         return ad, bd, np.ascontiguousarray(c), np.ascontiguousarray(d)
 
     def simulate(self, values, u, ts: float) -> np.ndarray:
-        """The output, shape (N,), over the input `u` (shape (N,) or (N,
-        m)) from the initial state at the parameter values `values` (every
-        parameter of :attr:`all_parameters`, in order, or only the
-        functions', the initial state then at its initial values);
-        non-finite from where the run blew up.
+        """The output, shape (N,) (one output) or (N, p), over the input
+        `u` (shape (N,) or (N, m)) from the initial state at the parameter
+        values `values` (every parameter of :attr:`all_parameters`, in
+        order, or only the functions', the initial state then at its
+        initial values); non-finite from where the run blew up.
 
         With Numba functions ``f`` and ``g`` the Runge-Kutta loop runs
         compiled (:mod:`.greybox_run`), otherwise in Python; the two agree
@@ -398,26 +399,32 @@ class GreyBox:
                 f"`u` must have {self.n_inputs} input column(s); got {uu.shape[1]}"
             )
         p, x0 = np.ascontiguousarray(values[:n_p]), self.initial_state(values)
+        y = self._run(p, x0, uu, float(ts))
+        return y[:, 0] if self.n_outputs == 1 else y
+
+    def _run(self, p, x0, uu, ts: float) -> np.ndarray:
+        """The outputs, shape (N, p), of :meth:`simulate`."""
         with np.errstate(all="ignore"):
             if self.kind == "linear":
                 try:
                     ad, bd, c, d = self.discretise(p, ts)
                 except ValueError:
                     # Parameters where ss itself fails: no run, the penalty.
-                    return np.full(uu.shape[0], np.nan)
-                return lti_run(ad, bd, c, d, x0, uu)[:, 0]
+                    return np.full((uu.shape[0], self.n_outputs), np.nan)
+                return lti_run(ad, bd, c, d, x0, uu)
             f, g = self.functions["f"], self.functions["g"]
+            n_out = self.n_outputs
             if not is_compiled(f, g):
-                return rk4_python(f, g, p, x0, uu, float(ts), self.substeps)
+                return rk4_python(f, g, p, x0, uu, ts, self.substeps, n_out)
             try:
-                return rk4_compiled(f, g, p, x0, uu, float(ts), self.substeps)
+                return rk4_compiled(f, g, p, x0, uu, ts, self.substeps, n_out)
             except numba.core.errors.TypingError as error:
                 first = str(error).strip().splitlines()[-1][:200]
                 raise ValueError(
                     f"the Numba functions `f` ({_function_name(f)}) and `g` "
                     f"({_function_name(g)}) do not compile in the Runge-Kutta "
                     f"loop (f must return a float array of the states, g a "
-                    f"number or a one-element array): {first}"
+                    f"number or an array of the outputs): {first}"
                 ) from None
 
     # -- text and JSON ------------------------------------------------------------

@@ -5,10 +5,15 @@
 Its parameters carry 95 % intervals in their own units, from the polish's
 Jacobian (see :mod:`spiralid.sysid.estimation.greybox`); a parameter the
 record cannot determine has no interval and is named in ``undetermined``.
+
+A model of several outputs simulates them all (shape (N, p)); its
+``output_model(name)`` is the same model reading one of them, which
+:func:`~spiralid.sysid.validate` validates output by output.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,7 +24,11 @@ from .greybox import GreyBox, _import
 from .modes import ModeTable, mode_table
 from .polynomials import is_stable_polynomial
 
-__all__ = ["GreyBoxModel", "LinearGreyBoxModel"]
+__all__ = ["INTEGRATOR_TOLERANCE", "GreyBoxModel", "LinearGreyBoxModel"]
+
+#: How close to ``z = 1`` a linear grey box's pole counts as an integrator
+#: of its physics (:attr:`LinearGreyBoxModel.integrator`).
+INTEGRATOR_TOLERANCE = 1e-6
 
 
 # What the model keeps of its record (IOData's fields of the same names).
@@ -28,6 +37,19 @@ _RECORD = ("input_name", "input_unit", "output_unit", "u_offset", "y_offset")
 
 def _inputs(u) -> np.ndarray:
     return np.asarray(u.u if isinstance(u, IOData) else u, dtype=float)
+
+
+def _nth(value, k: int):
+    """The `k`-th of a per-output tuple, or the one value for all."""
+    return value[k] if isinstance(value, tuple) else value
+
+
+def _plain(value):
+    """A field as JSON holds it (a tuple as a list, a NumPy number as a
+    float)."""
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return float(value) if isinstance(value, np.floating) else value
 
 
 def _structure_from_dict(d: dict) -> GreyBox:
@@ -64,16 +86,29 @@ class GreyBoxModel:
     undetermined : list of str
         The parameters and combinations the record cannot determine, one
         sentence each.
-    output_name : str
-        The output's name.
+    output_name : str or tuple of str
+        The output's name (a tuple for several outputs, as ``IOData``'s).
     nfev : int
         Simulations the fit ran.
-    input_name, input_unit, output_unit : str
-        The record's names and units, which the command line checks a
+    input_name, input_unit : str
+        The record's input name and unit, which the command line checks a
         validation record against.
-    u_offset, y_offset : float
-        The offsets removed from the record's signals before the fit (its
+    output_unit : str or tuple of str
+        The output's unit (one per output for several).
+    u_offset : float
+        The offset removed from the record's input before the fit.
+    y_offset : float or tuple of float
+        The offsets removed from the record's outputs before the fit (its
         ``IOData``'s); the parameters describe the signals without them.
+    output_fits : dict
+        Each output's fit % on the estimation record (free run from the
+        initial state), by name: what ``validate`` on that record reports.
+    weights : ndarray, optional
+        Each output's weight in the cost, one over its error variance at
+        the fit (several outputs; 1 for a single output).
+    column : int, optional
+        For the one-output view ``output_model`` returns: which of the
+        structure's outputs this model reads.
     """
 
     structure: GreyBox
@@ -89,7 +124,10 @@ class GreyBoxModel:
     input_unit: str = ""
     output_unit: str = ""
     u_offset: float = 0.0
-    y_offset: float = 0.0
+    y_offset: float | tuple = 0.0
+    output_fits: dict = field(default_factory=dict)
+    weights: np.ndarray | None = None
+    column: int | None = None
 
     def __post_init__(self) -> None:
         self.values = np.asarray(self.values, dtype=float)
@@ -97,6 +135,12 @@ class GreyBoxModel:
         if self.intervals is None:
             self.intervals = np.full((n, 2), np.nan)
         self.intervals = np.asarray(self.intervals, dtype=float).reshape(n, 2)
+        for name in ("output_name", "output_unit", "y_offset"):
+            value = getattr(self, name)
+            if isinstance(value, list | tuple):  # as JSON gives it back
+                setattr(self, name, tuple(value))
+        if self.weights is not None:
+            self.weights = np.asarray(self.weights, dtype=float).ravel()
 
     # -- the protocol -----------------------------------------------------------
 
@@ -118,22 +162,45 @@ class GreyBoxModel:
 
     @property
     def output_names(self) -> tuple[str, ...]:
-        return (self.output_name,)
+        """The outputs' names, in the structure's order."""
+        name = self.output_name
+        return tuple(name) if isinstance(name, tuple) else (name,)
 
     def output_model(self, which: int | str) -> GreyBoxModel:
-        """The model itself (one output)."""
-        if which not in (0, self.output_name):
+        """The model of the output `which` (index or name): the model
+        itself for one output, else the same fit reading that output."""
+        names = self.output_names
+        if which in names:
+            k = names.index(which)
+        elif isinstance(which, int) and not isinstance(which, bool):
+            k = which if 0 <= which < len(names) else -1
+        else:
+            k = -1
+        if k < 0:
             raise ValueError(
-                f"`which` must be 0 or {self.output_name!r}; got {which!r}"
+                f"`which` must be an output's index or name {names}; got {which!r}"
             )
-        return self
+        if len(names) == 1:
+            return self
+        pick = dict(
+            output_unit=_nth(self.output_unit, k), y_offset=_nth(self.y_offset, k)
+        )
+        return dataclasses.replace(
+            self,
+            output_name=names[k],
+            output_fits={names[k]: self.output_fits.get(names[k], float("nan"))},
+            weights=None if self.weights is None else self.weights[k : k + 1],
+            column=k,
+            **pick,
+        )
 
     def simulate(self, u, y0=None) -> np.ndarray:
         """The free run from the structure's initial state over `u` (an
-        ``IOData`` gives its ``u``), shape (N,). `y0` is accepted as every
-        model's ``simulate`` takes it, and unused: a grey box reads no past
-        outputs (``max_lag`` 0)."""
-        return self.structure.simulate(self.values, _inputs(u), self.ts)
+        ``IOData`` gives its ``u``), shape (N,) for one output, (N, p) for
+        several. `y0` is accepted as every model's ``simulate`` takes it,
+        and unused: a grey box reads no past outputs (``max_lag`` 0)."""
+        y = self.structure.simulate(self.values, _inputs(u), self.ts)
+        return y if self.column is None else y[:, self.column]
 
     def predict(self, data: IOData) -> np.ndarray:
         """The one-step prediction of an output-error model: its free run
@@ -168,8 +235,20 @@ class GreyBoxModel:
             f"ts = {self.ts:g} s",
             *self.parameter_rows(),
             *(f"  {note}" for note in self.undetermined),
+            *self.output_rows(),
         ]
         return "\n".join(lines)
+
+    def output_rows(self) -> list[str]:
+        """One line per output of several: its fit % on the estimation
+        record and its weight in the cost (none for one output)."""
+        if len(self.output_names) == 1 or self.weights is None:
+            return []
+        return [
+            f"  output {name}: fit {self.output_fits.get(name, np.nan):.2f} % on "
+            f"the estimation record, noise sd {1 / np.sqrt(w):.4g}"
+            for name, w in zip(self.output_names, self.weights, strict=True)
+        ]
 
     def to_dict(self, *, timings: bool = True) -> dict:
         """The ``model.json`` form: the structure (functions by import
@@ -184,9 +263,12 @@ class GreyBoxModel:
             ts=float(self.ts),
             method=str(self.method),
             cost=float(self.cost),
-            output_name=self.output_name,
+            output_name=_plain(self.output_name),
             nfev=int(self.nfev),
-            **{name: getattr(self, name) for name in _RECORD},
+            output_fits={str(k): float(v) for k, v in self.output_fits.items()},
+            weights=None if self.weights is None else self.weights.tolist(),
+            column=self.column,
+            **{name: _plain(getattr(self, name)) for name in _RECORD},
         )
 
     @classmethod
@@ -205,8 +287,11 @@ class GreyBoxModel:
                 cost=float(d["cost"]),
                 intervals=np.asarray(d["intervals"], dtype=float),
                 undetermined=list(d.get("undetermined", [])),
-                output_name=str(d.get("output_name", "y")),
+                output_name=d.get("output_name", "y"),
                 nfev=int(d.get("nfev", 0)),
+                output_fits=dict(d.get("output_fits", {})),
+                weights=d.get("weights"),
+                column=d.get("column"),
                 **{name: d[name] for name in _RECORD if name in d},
             )
         except KeyError as missing:
@@ -233,6 +318,8 @@ class LinearGreyBoxModel(GreyBoxModel):
         As :class:`GreyBoxModel`'s attributes.
     input_name, input_unit, output_unit, u_offset, y_offset
         As :class:`GreyBoxModel`'s attributes.
+    output_fits, weights, column
+        As :class:`GreyBoxModel`'s attributes.
     """
 
     @property
@@ -245,7 +332,10 @@ class LinearGreyBoxModel(GreyBoxModel):
         return self
 
     def _discrete(self):
-        return self.structure.discretise(self.values, self.ts)
+        ad, bd, c, d = self.structure.discretise(self.values, self.ts)
+        if self.column is not None:
+            c, d = c[self.column : self.column + 1], d[self.column : self.column + 1]
+        return ad, bd, c, d
 
     @property
     def polynomials(self) -> tuple[np.ndarray, np.ndarray]:
@@ -255,9 +345,23 @@ class LinearGreyBoxModel(GreyBoxModel):
         return np.asarray(num[0], dtype=float), np.asarray(den, dtype=float)
 
     @property
+    def integrator(self) -> int:
+        """The poles at ``z = 1`` the physics has by design: a rigid-body
+        rotation, an integrating output (the hub angle from torque). An
+        eigenvalue of the continuous ``A`` at 0 holds to exactly 1; a double
+        one (a Jordan block) lands ``sqrt(eps)`` away, hence the tolerance
+        :data:`INTEGRATOR_TOLERANCE` (a time constant above 2,000 s at
+        0.002 s). The stability verdict is judged without them, as for an
+        ARX fit's known integrators."""
+        return int(np.sum(np.abs(self.poles - 1.0) < INTEGRATOR_TOLERANCE))
+
+    @property
     def free_denominator(self) -> np.ndarray:
-        """The denominator's ``a_1..a_n`` (every pole is the parameters')."""
-        return self.polynomials[1][1:]
+        """The denominator's ``a_1..a_n`` of the poles other than the
+        :attr:`integrator`'s."""
+        poles = self.poles
+        free = poles[np.abs(poles - 1.0) >= INTEGRATOR_TOLERANCE]
+        return np.real(np.poly(free))[1:]
 
     @property
     def poles(self) -> np.ndarray:
@@ -279,5 +383,15 @@ class LinearGreyBoxModel(GreyBoxModel):
     def modes(self) -> ModeTable:
         """The complex pole pairs as modes (no intervals on them: the
         intervals are the parameters')."""
-        num, den = self.polynomials
-        return mode_table(den[1:], num, self.ts)
+        several = self.column is None and (self.structure.n_outputs or 1) > 1
+        if not several:
+            return mode_table(self.free_denominator, self.polynomials[0], self.ts)
+        # One set of poles, a share in each sensor: a mode is the model's
+        # where any sensor shows it, flagged only where every sensor flags it.
+        tables = [self.output_model(k).modes for k in range(self.structure.n_outputs)]
+        return dataclasses.replace(
+            tables[0],
+            share=np.max([t.share for t in tables], axis=0),
+            cancelled=np.all([t.cancelled for t in tables], axis=0),
+            spurious=np.all([t.spurious for t in tables], axis=0),
+        )

@@ -36,18 +36,25 @@ def is_compiled(*functions: Callable) -> bool:
 
 
 def rk4_python(
-    f: Callable, g: Callable, p: np.ndarray, x0: np.ndarray, u: np.ndarray, ts, n_sub
+    f: Callable,
+    g: Callable,
+    p: np.ndarray,
+    x0: np.ndarray,
+    u: np.ndarray,
+    ts,
+    n_sub,
+    n_out=1,
 ) -> np.ndarray:
-    """The output, shape (N,), of ``dx/dt = f(t, x, u, p)``, ``y = g(x, u,
-    p)`` from `x0` over the held input `u` (shape (N, m)), `n_sub` steps per
-    sample of `ts`."""
+    """The `n_out` outputs, shape (N, n_out), of ``dx/dt = f(t, x, u, p)``,
+    ``y = g(x, u, p)`` from `x0` over the held input `u` (shape (N, m)),
+    `n_sub` steps per sample of `ts`."""
     h = ts / n_sub
     x = x0.copy()
-    y = np.full(u.shape[0], np.nan)
+    y = np.full((u.shape[0], n_out), np.nan)
     try:
         for k in range(u.shape[0]):
             uk = u[k]
-            y[k] = np.asarray(g(x, uk, p), dtype=float).ravel()[0]
+            y[k] = np.asarray(g(x, uk, p), dtype=float).ravel()
             t = k * ts
             for _ in range(n_sub):
                 k1 = np.asarray(f(t, x, uk, p), dtype=float)
@@ -64,24 +71,24 @@ def rk4_python(
 
 
 @numba.njit(cache=True)
-def _first(value):  # pragma: no cover - compiled
-    # g may return a number or a one-element array.
-    return np.asarray(value).ravel()[0]
+def _flat(value):  # pragma: no cover - compiled
+    # g may return a number or an array of the outputs.
+    return np.asarray(value, dtype=np.float64).ravel()
 
 
 # Not cached on disk: a cached copy names the module of the f and g it was
 # compiled for, and a later process that cannot import that module (a test
 # module, a script's __main__) fails loading it instead of compiling.
 @numba.njit(cache=False)
-def rk4_compiled(f, g, p, x0, u, ts, n_sub):  # pragma: no cover - compiled
+def rk4_compiled(f, g, p, x0, u, ts, n_sub, n_out=1):  # pragma: no cover
     """:func:`rk4_python` compiled, `f` and `g` Numba functions (each pair
     compiles once per process)."""
     h = ts / n_sub
     x = x0.copy()
-    y = np.full(u.shape[0], np.nan)
+    y = np.full((u.shape[0], n_out), np.nan)
     for k in range(u.shape[0]):
         uk = u[k]
-        y[k] = _first(g(x, uk, p))
+        y[k, :] = _flat(g(x, uk, p))
         t = k * ts
         for _ in range(n_sub):
             k1 = np.asarray(f(t, x, uk, p), dtype=np.float64)

@@ -15,6 +15,7 @@ family                    methods
 ``"polynomial-narx"``     ``"ls"`` and ``"spiral"`` (forward regression)
 ``"shared-denominator"``  :data:`~.denominator.SHARED_METHODS`
 ``"greybox"``             :data:`~.greybox.fit.GREYBOX_METHODS`
+``"neural-state-space"``  ``"spiral"``, ``"oe"``, ``"ls"`` (the linear start's)
 ========================  ======================================================
 
 Adding a family
@@ -43,11 +44,13 @@ import numpy as np
 from spiralid.optim import RULES
 
 from ...data import IOData
+from ...models.arx import ARX
 from ...models.protocol import FittedModelProtocol
 from ..greybox.fit import GREYBOX_METHODS, fit_greybox
 from ..narx import training as _narx
 from ..narx.frols import frols
 from ..shared.denominator import SHARED_METHODS, identify_shared, shared_options
+from ..state_space.training import NSS_OPTIONS, identify_neural_state_space
 from .arx_fit import fit_arx
 from .estimators import (
     _MINIMIZE_OPTIONS,
@@ -165,6 +168,33 @@ def _by_frols(problem, **options):
 _POLYNOMIAL = ("rng", "predictor", "initial")
 
 
+# -- neural state space -----------------------------------------------------------
+
+#: The neural state-space family's methods: the linear start's.
+NSS_METHODS = ("spiral", "oe", "ls")
+
+
+def _nss_linear(data: IOData, order: int, method: str, rng):
+    """The neural state space's linear start: ``ARX(order, order, 1)`` by
+    `method` with identify's other arguments at their defaults."""
+    given = {k: IDENTIFY_DEFAULTS[k] for k in _IDENTIFY_ARGUMENTS}
+    given["rng"] = rng
+    arx = ARX(order, order, 1)
+    return fit_arx(data, arx, method, given).theta, f"{arx} by {method}"
+
+
+def _fit_nss(data, structure, method, given):
+    """A neural state space
+    (:func:`~.state_space.training.identify_neural_state_space`)."""
+    return identify_neural_state_space(
+        data,
+        structure,
+        method=method,
+        linear_estimator=_nss_linear,
+        **{k: v for k, v in given.items() if k in ("rng", *NSS_OPTIONS)},
+    )
+
+
 # -- several outputs, one denominator ------------------------------------------
 
 
@@ -220,6 +250,10 @@ ESTIMATORS: dict[tuple[str, str], Estimator] = {
     **{
         ("greybox", name): Estimator(fit_greybox, _fixed(options))
         for name, options in GREYBOX_METHODS.items()
+    },
+    **{
+        ("neural-state-space", name): Estimator(_fit_nss, _fixed(("rng", *NSS_OPTIONS)))
+        for name in NSS_METHODS
     },
 }
 

@@ -327,6 +327,9 @@ def identify(
     family = family_of(structure, 2 if several else 1)
     if family is None or not several:
         single_output_record(data, "identify")
+    # A family that fits several outputs itself (the grey box: its outputs
+    # are its functions') takes its options as for one.
+    several = several and family != structure.family
     method = _check_method(method)
     entry = estimator(family, method, structure)
     if several:

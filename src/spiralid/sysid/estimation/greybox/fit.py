@@ -15,6 +15,18 @@
 
 Every method ends with the Jacobian at its result, from which the
 parameters' intervals come (:mod:`.intervals`).
+
+Several outputs are weighted by their noise variance, which the record does
+not state, so the weights are estimated: the fit above runs with each
+output scaled by one over its RMS (every output counts as much, whatever
+its unit); then each output's scale becomes one over the RMS of its error
+at that fit (its noise's standard deviation, if the model is right) and
+``"spiral"`` and ``"oe"`` polish again from there, up to
+``_REWEIGHTS`` times, until no scale moves by more than a tenth. A
+well-measured sensor then weighs more than a noisy one, as maximum
+likelihood for Gaussian noise of unknown variances weighs them, and the
+intervals come from the Jacobian so weighted (for ``"sda"`` and
+``"ebsda"`` too: they are reweighted, not polished).
 """
 
 from __future__ import annotations
@@ -54,6 +66,13 @@ _RESTARTS = False
 # fit: over a tenth of the rig's record, its friction plane is smooth.
 _HORIZONS = (0.1, 0.25, 0.5)
 _RULES = {"spiral": "learned-metric", "sda": "sda", "ebsda": "ebsda"}
+# Rounds of reweighting the outputs and polishing again (several outputs).
+_REWEIGHTS = 3
+# A scale that moves by less than this share is settled.
+_SETTLED = 0.1
+# An output's noise is taken as at least this share of its RMS, so that an
+# output the model fits exactly (a noise-free one) gets a finite weight.
+_NOISE_FLOOR = 1e-6
 
 
 def _polish(
@@ -145,6 +164,50 @@ def _problem(data: IOData, structure: GreyBox, given: dict) -> GreyBoxProblem:
     )
 
 
+def _noise_scale(problem: GreyBoxProblem, residual: np.ndarray) -> np.ndarray:
+    """One over each output's error RMS in `residual` (floored at
+    ``_NOISE_FLOOR`` of the output's RMS)."""
+    e = problem.output_errors(residual)
+    floor = _NOISE_FLOOR * np.sqrt(np.mean(problem.y.reshape(e.shape) ** 2, axis=0))
+    return 1.0 / np.maximum(np.sqrt(np.mean(e**2, axis=0)), floor)
+
+
+def _reweighted(
+    problem: GreyBoxProblem,
+    z: np.ndarray,
+    method: str,
+    polish_nfev: int,
+    pool: ParallelEvaluator,
+) -> tuple[GreyBoxProblem, np.ndarray]:
+    """The problem with each output weighted by its noise variance, and the
+    fit polished under those weights (module docstring); a single output
+    as it is."""
+    if problem.n_outputs == 1:
+        return problem, z
+    for _ in range(_REWEIGHTS):
+        scale = _noise_scale(problem, problem.residual(z))
+        if np.all(np.abs(scale / problem.scale - 1.0) <= _SETTLED):
+            break
+        problem = problem.rescaled(scale)
+        pool.problem = problem
+        if method in ("spiral", "oe"):
+            polished = _polish(problem, z, polish_nfev, pool)
+            if problem(polished) <= problem(z):
+                z = polished
+    return problem, z
+
+
+def _output_fits(problem: GreyBoxProblem, residual, names) -> dict[str, float]:
+    """Each output's fit % (MATLAB's ``compare``: ``100 (1 - |e| / |y -
+    mean y|)``) of the unscaled error in `residual`."""
+    e = problem.output_errors(residual)
+    y = problem.y.reshape(e.shape)
+    spread = np.linalg.norm(y - y.mean(axis=0), axis=0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fits = 100.0 * (1.0 - np.linalg.norm(e, axis=0) / spread)
+    return {str(n): float(f) for n, f in zip(names, fits, strict=True)}
+
+
 def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
     """The grey box `structure` fitted to `data` by `method` (a key of
     :data:`GREYBOX_METHODS`), `given` identify's arguments by name.
@@ -157,6 +220,9 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
     the record (a hub that comes to rest elsewhere after each pulse), so
     over the whole record the cost can be rugged where over its start it is
     smooth, and the start's minimum lies in the whole record's basin.
+
+    A record of several outputs is weighted by their noise variances,
+    estimated from the fit's errors (module docstring).
 
     Returns
     -------
@@ -177,10 +243,11 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
             (_chain(chain, method, given, polish_nfev, pool) for chain in chains),
             key=problem,
         )
+        problem.nfev += sum(stage.nfev for chain in chains[1:] for stage in chain[:-1])
+        problem, z = _reweighted(problem, z, method, polish_nfev, pool)
         pool.problem = problem
         residual = problem.residual(z)
         jac = problem.jacobian(z, pool.residuals)
-    problem.nfev += sum(stage.nfev for chain in chains[1:] for stage in chain[:-1])
     intervals, notes = parameter_intervals(problem, z, residual, jac)
     kind = LinearGreyBoxModel if structure.kind == "linear" else GreyBoxModel
     return kind(
@@ -191,8 +258,10 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
         cost=problem.cost_of(residual),
         intervals=intervals,
         undetermined=notes,
-        output_name=str(data.output_name),
+        output_name=data.output_name,
         nfev=problem.nfev,
+        output_fits=_output_fits(problem, residual, data.output_names),
+        weights=np.square(np.broadcast_to(problem.scale, (problem.n_outputs,))),
         input_name=str(data.input_name),
         input_unit=data.input_unit,
         output_unit=data.output_unit,

@@ -76,7 +76,10 @@ AUTO = "auto"
 #: record's goal (9 of 10 seeds) but, where a record that does not drift
 #: has a flagged pole (the arm, the cascaded tanks at ARX(8, 8, 0)), it
 #: ran the folds at 3.6-5x output error's time for the same fit or 0.1
-#: point less (docs/results/identification.md).
+#: point less; and the default alone already takes 1.2-2.2x output
+#: error's processor time at orders 2-16 on the drift-process and rig
+#: records, so no folds on top keep within the 1.5x it promises
+#: (docs/results/identification.md, "auto" as the default).
 DEFAULT = False
 
 #: The folds' ends as shares of the estimation record: folds 0.4-0.6,

@@ -1,0 +1,1 @@
+"""Estimation of the neural state-space family (:mod:`.training`)."""
