@@ -39,11 +39,10 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from scipy import linalg
 
 from spiralid._checks import integer
 
-from .greybox_run import is_compiled, lti_run, rk4_compiled, rk4_python
+from .greybox_run import is_compiled, lti_run, rk4_compiled, rk4_python, zoh
 
 __all__ = ["GreyBox", "Parameter"]
 
@@ -373,16 +372,8 @@ class GreyBox:
         """The linear kind's ``(Ad, Bd, C, D)`` at sample time `ts`, input
         held between samples (exact zero-order hold)."""
         a, b, c, d = self.matrices(values)
-        n, m = b.shape
-        big = np.zeros((n + m, n + m))
-        big[:n, :n], big[:n, n:] = a, b
-        phi = linalg.expm(big * ts)
-        return (
-            np.ascontiguousarray(phi[:n, :n]),
-            np.ascontiguousarray(phi[:n, n:]),
-            np.ascontiguousarray(c),
-            np.ascontiguousarray(d),
-        )
+        ad, bd = zoh(np.ascontiguousarray(a), np.ascontiguousarray(b), float(ts))
+        return ad, bd, np.ascontiguousarray(c), np.ascontiguousarray(d)
 
     def simulate(self, values, u, ts: float) -> np.ndarray:
         """The output, shape (N,) (one output) or (N, p), over the input
