@@ -1,0 +1,65 @@
+"""The grey box's 95 % intervals against the exact ones of a model linear
+in its parameters: ``B = (b1, b2)`` of a fixed ``A`` and ``C``, so the
+record is ``y = b1 x1 + b2 x2 + e`` with ``x1``, ``x2`` SciPy's
+zero-order-hold responses to the input, and least squares gives the
+estimate and its covariance ``s^2 (X'X)^-1`` in closed form."""
+
+import numpy as np
+import pytest
+from scipy import signal
+
+import spiralid as sid
+from spiralid.sysid import GreyBox, Parameter
+
+TS = 0.1
+TRUE = np.array([2.0, 0.5])
+POLES = (1.0, 3.0)
+Z95 = 1.959963984540054
+
+
+def two_channels(p):
+    b1, b2 = p
+    a = np.diag([-POLES[0], -POLES[1]])
+    return a, [[b1], [b2]], [[1.0, 1.0]], [[0.0]]
+
+
+def regressors(u: np.ndarray) -> np.ndarray:
+    """Each channel's response to `u` with a unit gain, by SciPy."""
+    cols = []
+    for pole in POLES:
+        one = np.ones((1, 1))
+        sys = signal.cont2discrete((-pole * one, one, one, 0 * one), TS, "zoh")
+        _, x, _ = signal.dlsim(sys, u)
+        cols.append(x.ravel())
+    return np.column_stack(cols)
+
+
+@pytest.fixture(scope="module")
+def record():
+    rng = np.random.default_rng(3)
+    n = 400
+    u = np.repeat(rng.standard_normal(n // 8), 8)
+    x = regressors(u)
+    y = x @ TRUE + 0.05 * rng.standard_normal(n)
+    beta, rss, *_ = np.linalg.lstsq(x, y, rcond=None)
+    s2 = float(rss[0]) / (n - 2)
+    sd = np.sqrt(s2 * np.diag(np.linalg.inv(x.T @ x)))
+    return sid.IOData(u, y, ts=TS), beta, sd
+
+
+@pytest.mark.parametrize("log", [False, True])
+def test_intervals_are_least_squares_exact_ones(record, log):
+    rec, beta, sd = record
+    params = [
+        Parameter(f"b{i + 1}", 1.0, (0.1, 10.0), log=log) for i in range(TRUE.size)
+    ]
+    model = sid.identify(rec, GreyBox(params, ss=two_channels), method="oe")
+    np.testing.assert_allclose(model.params, beta, rtol=1e-6)
+    if log:
+        # Symmetric in log: the delta method's sd of log(b) is sd / b,
+        # exact here, as log(b) is a linear change of the Jacobian's columns.
+        half = Z95 * sd / beta
+        want = np.column_stack([beta * np.exp(-half), beta * np.exp(half)])
+    else:
+        want = np.column_stack([beta - Z95 * sd, beta + Z95 * sd])
+    np.testing.assert_allclose(model.intervals, want, rtol=1e-5)
