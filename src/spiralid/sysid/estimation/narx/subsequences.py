@@ -16,12 +16,15 @@ the road, not the goal.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = [
     "HOLD_BLOCKS",
     "HORIZONS",
     "TRAININGS",
+    "check_holdout_decay",
     "check_horizon",
     "curriculum",
     "replay_stages",
@@ -180,6 +183,25 @@ def curriculum(horizon, lo: int, stop: int) -> tuple[int, ...]:
     if horizon is not None:
         return (min(int(horizon), room),)
     return (*(h for h in HORIZONS if h < room), None)
+
+
+def check_holdout_decay(holdout, decay) -> tuple[float, float]:
+    """The early stopping's `holdout` (a share in [0, 0.5)) and the weight
+    `decay` (finite, >= 0) of a network's training, checked: the NARX's and
+    the neural state space's one check."""
+    try:
+        ok = 0.0 <= float(holdout) < 0.5
+    except (TypeError, ValueError):
+        ok = False
+    if not ok or isinstance(holdout, bool):
+        raise ValueError(f"`holdout` must be a number in [0, 0.5); got {holdout!r}")
+    try:
+        ok = float(decay) >= 0.0 and math.isfinite(float(decay))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok or isinstance(decay, bool):
+        raise ValueError(f"`decay` must be a finite number >= 0; got {decay!r}")
+    return float(holdout), float(decay)
 
 
 def check_horizon(horizon, name: str = "horizon") -> int | None:

@@ -86,6 +86,7 @@ from .starts import _starts
 from .subsequences import (
     HOLD_BLOCKS,
     TRAININGS,
+    check_holdout_decay,
     check_horizon,
     curriculum,
     replay_stages,
@@ -514,18 +515,7 @@ def identify_narx(
         )
     if initial not in ("rest", "measured"):
         raise ValueError(f"`initial` must be 'rest' or 'measured'; got {initial!r}")
-    try:
-        ok = 0.0 <= float(holdout) < 0.5
-    except (TypeError, ValueError):
-        ok = False
-    if not ok or isinstance(holdout, bool):
-        raise ValueError(f"`holdout` must be a number in [0, 0.5); got {holdout!r}")
-    try:
-        ok = float(decay) >= 0.0 and math.isfinite(float(decay))
-    except (TypeError, ValueError):
-        ok = False
-    if not ok or isinstance(decay, bool):
-        raise ValueError(f"`decay` must be a finite number >= 0; got {decay!r}")
+    holdout, decay = check_holdout_decay(holdout, decay)
     if training not in TRAININGS:
         raise ValueError(f"`training` must be one of {TRAININGS}; got {training!r}")
     horizon = check_horizon(options.pop("horizon", None))

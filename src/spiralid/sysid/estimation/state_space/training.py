@@ -48,7 +48,12 @@ from ...data import IOData
 from ...models._nss_kernels import nss_batch_loss
 from ...models.neural_state_space import NeuralStateSpace
 from ...models.neural_state_space_model import NeuralStateSpaceModel
-from ..narx.subsequences import HOLD_BLOCKS, check_horizon, subsequence_starts
+from ..narx.subsequences import (
+    HOLD_BLOCKS,
+    check_holdout_decay,
+    check_horizon,
+    subsequence_starts,
+)
 
 __all__ = ["HORIZONS", "NSS_OPTIONS", "identify_neural_state_space"]
 
@@ -230,18 +235,7 @@ def _linear_start(st: NeuralStateSpace, problem: _Problem, theta, rng) -> tuple:
 
 
 def _checked(holdout, decay, horizon, max_iter) -> tuple:
-    try:
-        ok = 0.0 <= float(holdout) < 0.5 and not isinstance(holdout, bool)
-    except (TypeError, ValueError):
-        ok = False
-    if not ok:
-        raise ValueError(f"`holdout` must be a number in [0, 0.5); got {holdout!r}")
-    try:
-        ok = float(decay) >= 0.0 and math.isfinite(float(decay))
-    except (TypeError, ValueError):
-        ok = False
-    if not ok or isinstance(decay, bool):
-        raise ValueError(f"`decay` must be a finite number >= 0; got {decay!r}")
+    holdout, decay = check_holdout_decay(holdout, decay)
     horizon = check_horizon(horizon)
     if max_iter is None:
         max_iter = _MAX_ITER
