@@ -573,6 +573,11 @@ def _check_shared_options(args, est) -> None:
     )
 
 
+# The models --na, --nb and --nk do not size: their estimator family, and
+# what sizes them instead.
+_ORDERLESS = {"rig": ("greybox", ""), "nss": ("neural-state-space", " (--order)")}
+
+
 def _check_options(args) -> None:
     """Refuse, before any data is read, what the model and method cannot
     do, and every typed option identify() would refuse from Python for this
@@ -586,21 +591,14 @@ def _check_options(args) -> None:
 
     model, method = args.model, args.method
     _check_candidates(args)
-    if model == "rig":
-        if ("greybox", method) not in ESTIMATORS:
-            able = ", ".join(methods_of("greybox"))
-            raise UsageError(f"--method {method} does not fit --model rig: {able}")
+    if model in _ORDERLESS:
+        family, instead = _ORDERLESS[model]
+        if (family, method) not in ESTIMATORS:
+            able = ", ".join(methods_of(family))
+            raise UsageError(f"--method {method} does not fit --model {model}: {able}")
         _refuse_unused(
             _given(args, "--na", "--nb", "--nk"),
-            "to --model arx, narx and polynomial, not to --model rig",
-        )
-    elif model == "nss":
-        if ("neural-state-space", method) not in ESTIMATORS:
-            able = ", ".join(methods_of("neural-state-space"))
-            raise UsageError(f"--method {method} does not fit --model nss: {able}")
-        _refuse_unused(
-            _given(args, "--na", "--nb", "--nk"),
-            "to --model arx, narx and polynomial, not to --model nss (--order)",
+            f"to --model arx, narx and polynomial, not to --model {model}{instead}",
         )
     elif model != "arx" and ("narx", method) not in ESTIMATORS:
         able = ", ".join(methods_of("narx"))
