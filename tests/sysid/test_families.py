@@ -196,5 +196,13 @@ def test_the_command_line_identifies_then_validates(family, tmp_path):
     out = run("identify", "rec.npz", "--method", "ls", *flags, "--out", "m",
               "--quiet", cwd=tmp_path)  # fmt: skip
     assert out.returncode == 0, out.stderr
+    # The summary prints the model's cost under what it is for the family
+    # (eq. 2 by default; a shared fit's joint cost says so itself).
+    model = sid.sysid.load_model(tmp_path / "m" / "model.json")
+    summary = (tmp_path / "m" / "summary.txt").read_text()
+    assert f"{model.cost:.6g}" in summary
+    if hasattr(model, "cost_label"):
+        assert f"{model.cost_label}: {model.cost:.6g}" in summary
+        assert "eq. 2" not in summary.split("\n\n")[1]
     out = run("validate", "m/model.json", "rec.npz", "--quiet", cwd=tmp_path)
     assert out.returncode == 0, out.stderr

@@ -297,7 +297,8 @@ def _write_model(staged, model, v_est, v_val, headline: str) -> str:
     summary = "\n\n".join(
         [
             headline,
-            f"estimation cost (eq. 2): {model.cost:.6g}",
+            f"{getattr(model, 'cost_label', 'estimation cost (eq. 2)')}: "
+            f"{model.cost:.6g}",
             v_est.summary(),
             v_val.summary(),
         ]

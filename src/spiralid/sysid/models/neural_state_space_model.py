@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -55,6 +56,9 @@ class NeuralStateSpaceModel:
     u_offset, y_offset : float
         Offsets removed from the record's signals before the fit.
     """
+
+    #: What :attr:`cost` is, for summaries (every other family's is eq. 2).
+    cost_label: ClassVar[str] = "held-back free-run RMS"
 
     structure: NeuralStateSpace
     params: np.ndarray
