@@ -167,7 +167,7 @@ CASES = [
     # fault round 3: models, options, pareto
     (
         "identify ok.csv --ts 0.01 --method ls --hidden 5",
-        "--hidden applies to --model narx, not to --model arx",
+        "--hidden applies to --model narx and nss, not to --model arx",
     ),
     # Abbreviated and equal to its default: still typed, still refused.
     ("identify ok.csv --ts 0.01 --method ls --hid 10", "--hidden applies to"),
@@ -197,7 +197,7 @@ CASES = [
     ),
     (
         "identify ok.csv --ts 0.01 --model polynomial --method ls --hidden 3",
-        "--hidden applies to --model narx, not to --model polynomial",
+        "--hidden applies to --model narx and nss, not to --model polynomial",
     ),
     (
         "simulate --signal prbs --width 0.04",

@@ -75,8 +75,8 @@ class NeuralStateSpace:
 
     Examples
     --------
-    >>> NeuralStateSpace(2, hidden=(4,)).n_params  # 4+2+2+1 + 12+4+8 + 12+4+4 + 12
-    65
+    >>> NeuralStateSpace(2, hidden=(4,)).n_params  # 4+2+2+1 + 12+4+8 + 12+4+4 + 16
+    69
     """
 
     order: int = 3
