@@ -28,6 +28,21 @@ def _order(value, name: str, minimum: int) -> int:
     return int(value)
 
 
+def _one_layer(hidden) -> tuple[int, ...]:
+    """A network's `hidden` sizes checked: () or one hidden layer (h,), the
+    NARX's and the neural state space's one check."""
+    try:
+        layers = tuple(hidden)
+    except TypeError:
+        layers = None
+    if layers is None or len(layers) > 1:
+        raise ValueError(
+            "`hidden` must be () or one hidden layer (h,) (deeper networks are "
+            f"not built); got {hidden!r}"
+        )
+    return tuple(_order(h, "hidden[0]", 1) for h in layers)
+
+
 @dataclass(frozen=True)
 class Scaling:
     """Affine scaling of the signals: ``(u - u_shift) / u_scale`` and the

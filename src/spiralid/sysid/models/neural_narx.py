@@ -11,7 +11,7 @@ import numpy as np
 from spiralid._checks import one_of
 
 from ._narx_kernels import _mlp_free_run, _mlp_sensitivity
-from .narx_lags import Scaling, _integrators, _Lags, _order
+from .narx_lags import Scaling, _integrators, _Lags, _one_layer, _order
 
 __all__ = ["ACTIVATIONS", "NARX"]
 
@@ -76,18 +76,7 @@ class NARX(_Lags):
         object.__setattr__(self, "ny", _order(self.ny, "ny", 1))
         object.__setattr__(self, "nu", _order(self.nu, "nu", 1))
         object.__setattr__(self, "nk", _order(self.nk, "nk", 0))
-        try:
-            hidden = tuple(self.hidden)
-        except TypeError:
-            hidden = None
-        if hidden is None or len(hidden) > 1:
-            raise ValueError(
-                "`hidden` must be () or one hidden layer (h,) (deeper networks are "
-                f"not built); got {self.hidden!r}"
-            )
-        object.__setattr__(
-            self, "hidden", tuple(_order(h, "hidden[0]", 1) for h in hidden)
-        )
+        object.__setattr__(self, "hidden", _one_layer(self.hidden))
         one_of(self.activation, "activation", ACTIVATIONS)
         if not isinstance(self.linear, bool | np.bool_):
             raise TypeError(f"`linear` must be True or False; got {self.linear!r}")

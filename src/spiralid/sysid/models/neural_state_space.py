@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._nss_kernels import nss_free_run
-from .narx_lags import _order
+from .narx_lags import _one_layer, _order
 
 __all__ = ["NeuralStateSpace"]
 
@@ -92,17 +92,7 @@ class NeuralStateSpace:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "order", _order(self.order, "order", 1))
-        try:
-            hidden = tuple(self.hidden)
-        except TypeError:
-            hidden = None
-        if hidden is None or len(hidden) > 1:
-            raise ValueError(
-                f"`hidden` must be () or one hidden layer (h,); got {self.hidden!r}"
-            )
-        object.__setattr__(
-            self, "hidden", tuple(_order(h, "hidden[0]", 1) for h in hidden)
-        )
+        object.__setattr__(self, "hidden", _one_layer(self.hidden))
         window = self.order + 2 if self.window is None else self.window
         object.__setattr__(self, "window", _order(window, "window", self.order))
 
