@@ -6,6 +6,7 @@ cancels the same poles with zeros."""
 
 import numpy as np
 import pytest
+from scipy import signal
 from test_rig_greybox import FS, VARIANT, record, torque
 
 import spiralid as sid
@@ -84,3 +85,13 @@ def test_two_sensors_list_the_flexible_modes_once():
     each = [model.output_model(name).modes for name in data.output_name]
     np.testing.assert_array_equal(table.share, np.maximum(*(t.share for t in each)))
     np.testing.assert_array_equal(table.spurious, each[0].spurious & each[1].spurious)
+    # Each sensor has its own numerator: the model of both names neither.
+    for member in ("polynomials", "zeros"):
+        with pytest.raises(ValueError, match=f"output_model\\(name\\).{member}"):
+            getattr(model, member)
+    hub = model.output_model("hub_angle")
+    c = model.structure.matrices(model.values, rec.ts)[2][:1]
+    ad, bd, _, d = model.structure.discretise(model.values, rec.ts)
+    num, den = signal.ss2tf(ad, bd, c, d[:1])
+    np.testing.assert_allclose(hub.polynomials[0], num[0], atol=1e-12)
+    np.testing.assert_allclose(hub.polynomials[1], den, atol=1e-12)

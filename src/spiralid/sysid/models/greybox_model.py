@@ -337,9 +337,21 @@ class LinearGreyBoxModel(GreyBoxModel):
             c, d = c[self.column : self.column + 1], d[self.column : self.column + 1]
         return ad, bd, c, d
 
+    def _one_output(self, member: str) -> None:
+        # Several sensors share the poles but each has its own numerator:
+        # reading the first one would be a silently wrong transfer function.
+        if self.column is None and len(self.output_names) > 1:
+            raise ValueError(
+                f"`{member}` of a grey box of {len(self.output_names)} outputs "
+                f"{self.output_names} is one per output: read "
+                f"output_model(name).{member}"
+            )
+
     @property
     def polynomials(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(num, den)`` in ``z^-1`` of equal lengths, ``den[0] = 1``."""
+        """``(num, den)`` in ``z^-1`` of equal lengths, ``den[0] = 1``, of a
+        one-output model (:meth:`output_model` gives each output's)."""
+        self._one_output("polynomials")
         ad, bd, c, d = self._discrete()
         num, den = signal.ss2tf(ad, bd, c, d)
         return np.asarray(num[0], dtype=float), np.asarray(den, dtype=float)
@@ -370,7 +382,9 @@ class LinearGreyBoxModel(GreyBoxModel):
 
     @property
     def zeros(self) -> np.ndarray:
-        """Finite zeros in z of the discretised model."""
+        """Finite zeros in z of the discretised one-output model
+        (:meth:`output_model` gives each output's)."""
+        self._one_output("zeros")
         num = np.trim_zeros(self.polynomials[0], "f")
         return np.roots(num) if num.size > 1 else np.zeros(0, dtype=complex)
 
