@@ -1,6 +1,8 @@
 """Mode shapes from residues, their intervals and the MAC
 (`sysid/models/shapes.py`, `sysid/estimation/shared/covariance.py`)."""
 
+import json
+
 import numpy as np
 import pytest
 from scipy import signal
@@ -153,3 +155,21 @@ def test_the_validation_and_the_report_show_the_shapes_and_their_mac():
     assert rows[0][2].startswith(f"{fit.shapes.shapes[0, 0].real:+.3f} +- ")
     head, rows = mac_table([[1.0, 0.5], [0.5, 1.0]])
     assert head == ["MAC", "1", "2"] and rows[1] == ["2", "0.500", "1.000"]
+
+
+def test_a_model_read_back_keeps_its_shapes_intervals():
+    fit = identify(record(2), ARX(4, 4, 1), method="oe")
+    back = type(fit).from_dict(json.loads(json.dumps(fit.to_dict())))
+    np.testing.assert_array_equal(back.shape_factor, fit.shape_factor)
+    for name in ("shapes", "real_se", "imag_se"):
+        np.testing.assert_array_equal(
+            getattr(back.shapes, name), getattr(fit.shapes, name)
+        )
+    assert np.isfinite(back.shapes.real_se).all()
+    # A hand-edited factor of the wrong size is refused by its name.
+    d = fit.to_dict()
+    d["shape_factor"] = d["shape_factor"][:-1]
+    with pytest.raises(
+        ValueError, match="field 'shape_factor' must be an array of 12 x 12"
+    ):
+        type(fit).from_dict(d)

@@ -17,6 +17,12 @@ import numpy as np
 _REQUIRED = object()
 
 
+def plain(value) -> float | None:
+    """A number as JSON holds it: NaN and infinities as null."""
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
 def number(
     d: dict,
     name: str,

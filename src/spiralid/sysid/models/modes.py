@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import signal, stats
 
+from . import _fields
+
 __all__ = ["ModeTable", "mode_table"]
 
 # A mode is reported as probably spurious when its resonant peak holds less
@@ -115,12 +117,21 @@ class ModeTable:
             "level": self.level,
             "modes": [
                 {
-                    "frequency_hz": _plain(self.frequency[i]),
-                    "frequency_interval_hz": [_plain(f_lo[i]), _plain(f_hi[i])],
-                    "damping": _plain(self.damping[i]),
-                    "damping_interval": [_plain(d_lo[i]), _plain(d_hi[i])],
-                    "pole": [_plain(self.poles[i].real), _plain(self.poles[i].imag)],
-                    "share": _plain(self.share[i]),
+                    "frequency_hz": _fields.plain(self.frequency[i]),
+                    "frequency_interval_hz": [
+                        _fields.plain(f_lo[i]),
+                        _fields.plain(f_hi[i]),
+                    ],
+                    "damping": _fields.plain(self.damping[i]),
+                    "damping_interval": [
+                        _fields.plain(d_lo[i]),
+                        _fields.plain(d_hi[i]),
+                    ],
+                    "pole": [
+                        _fields.plain(self.poles[i].real),
+                        _fields.plain(self.poles[i].imag),
+                    ],
+                    "share": _fields.plain(self.share[i]),
                     "reaches_unit_circle": bool(self.reaches_unit_circle[i]),
                     "cancelled": bool(self.cancelled[i]),
                     "spurious": bool(self.spurious[i]),
@@ -150,11 +161,6 @@ class ModeTable:
                 + (f"  ({'; '.join(notes)})" if notes else "")
             )
         return "\n".join(lines)
-
-
-def _plain(value) -> float | None:
-    value = float(value)
-    return value if np.isfinite(value) else None
 
 
 def _num(value: float, fmt: str = ".4g") -> str:

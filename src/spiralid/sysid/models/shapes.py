@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from . import _fields
 from .polynomials import with_integrator
 
 __all__ = [
@@ -327,7 +328,7 @@ class ModeShapes:
                     "shape_real": self.shapes[r].real.tolist(),
                     "shape_imag": self.shapes[r].imag.tolist(),
                     "real_interval": [
-                        [_plain(x), _plain(y)]
+                        [_fields.plain(x), _fields.plain(y)]
                         for x, y in zip(lo[r], hi[r], strict=True)
                     ],
                 }
@@ -356,11 +357,6 @@ class ModeShapes:
         pct = round(100 * self.level)
         lines.append(f"(real parts, unit norm; +- the {pct} % interval's half width)")
         return "\n".join(lines)
-
-
-def _plain(value) -> float | None:
-    value = float(value)
-    return value if np.isfinite(value) else None
 
 
 def mode_shapes(

@@ -26,6 +26,7 @@ from scipy import signal
 from spiralid._checks import named_index
 
 from . import _fields
+from . import _shared_file as _file
 from . import _shared_inputs as _several_inputs
 from ._shared_inputs import one_per, simo_state_space
 from .arx import ARX
@@ -66,7 +67,7 @@ class SharedModes:
     def to_dict(self) -> dict:
         out = self.table.to_dict()
         out["share_by_output"] = {
-            name: [_plain(v) for v in self.share[:, k]]
+            name: [_fields.plain(v) for v in self.share[:, k]]
             for k, name in enumerate(self.output_names)
         }
         return out
@@ -98,16 +99,9 @@ class SharedModes:
         return "\n".join(lines)
 
 
-def _plain(value) -> float | None:
-    return float(value) if np.isfinite(value) else None
-
-
 # Known integrators per output, outside the shared denominator: a hub
 # angle's double integrator at most (a torque drives an acceleration).
 MOST_INTEGRATORS = 2
-
-# Provenance fields this file writes as null for NaN.
-_NULLABLE = ("cost", "gain")
 
 
 @dataclass
@@ -161,8 +155,8 @@ class SharedDenominatorModel(Provenance):
     shape_factor : ndarray or None, shape (k, na + p nb)
         A square-root factor of the covariance of every parameter
         (:attr:`params`), for the mode shapes' intervals
-        (:attr:`shapes`); not saved in model.json (a model read back has
-        shapes without intervals).
+        (:attr:`shapes`), saved in model.json so that a model read back
+        has the same shapes' intervals.
     predictor, initial : str
         ``"simulation"`` and ``"rest"``: the joint cost is the outputs'
         free-run error from rest.
@@ -492,106 +486,13 @@ class SharedDenominatorModel(Provenance):
             runs; False leaves them out, so that two runs with the same
             seed write the same file.
         """
-        out = {
-            "model": "shared-denominator",
-            "structure": {"na": self.arx.na, "nb": self.arx.nb, "nk": self.arx.nk},
-            "ts": self.ts,
-            "method": self.method,
-            "a": self.a.tolist(),
-            "b": self.b.tolist(),
-            "input_name": self.input_name,
-            "input_unit": self.input_unit,
-            "output_names": list(self.output_names),
-            "output_units": list(self.output_units),
-            "u_offset": self.u_offset,
-            "y_offsets": list(self.y_offsets),
-            "cost": _plain(self.cost),
-            "costs": None if self.costs is None else [_plain(c) for c in self.costs],
-            "weights": None if self.weights is None else self.weights.tolist(),
-            "covariance": None if self.covariance is None else self.covariance.tolist(),
-            "integrators": list(self.integrators),
-            "modes": self.modes.to_dict(),
-        }
-        # The provenance every fitted model writes, after the keys this
-        # file had before it shared them (NaN as null, as for the cost).
-        if self.n_inputs > 1:
-            out["input_names"] = list(self.input_names)
-            out["input_units"] = list(self.input_units)
-            out["u_offsets"] = list(self.u_offsets)
-        prov = self._provenance_dict()
-        prov["gain"] = _plain(self.gain)
-        if not timings:
-            del prov["timings"]
-        out.update({k: v for k, v in prov.items() if k not in out})
-        return out
+        return _file.model_dict(self, timings)
 
     @classmethod
     def from_dict(cls, d: dict) -> SharedDenominatorModel:
         """The model :meth:`to_dict` wrote; a field that is missing, of the
         wrong type or out of range raises a ValueError that names it."""
-        if not isinstance(d, dict):
-            raise ValueError(f"a model must be a JSON object; got {type(d).__name__}")
-        kind = d.get("model")
-        if kind != "shared-denominator":
-            raise ValueError(
-                f"field 'model' must be 'shared-denominator'; got {kind!r}"
-            )
-        s = d.get("structure")
-        if not isinstance(s, dict):
-            raise ValueError(f"field 'structure' must be an object; got {s!r:.60}")
-        na, nb, nk = (
-            _fields.integer(
-                s, key, f"an integer >= {low}", low.__le__, where="structure."
-            )
-            for key, low in (("na", 1), ("nb", 1), ("nk", 0))
-        )
-        names = _fields.texts(d, "output_names")
-        p = len(names)
-        if not p:
-            raise ValueError("field 'output_names' must name at least one output")
-
-        def optional(key, shape, null=None):
-            if d.get(key) is None:
-                return None
-            return _fields.numbers(d, key, shape, null=null)
-
-        # Files written before the provenance was shared hold only its
-        # method, cost, input name, unit and offset: the rest defaults. A
-        # null cost or gain is NaN; any method name is read (the file
-        # names what estimated it, nothing here depends on it).
-        known = {k: v for k, v in d.items() if v is not None or k not in _NULLABLE}
-        provenance = cls._provenance_fields({"method": "", **known}, None, penalty=0.0)
-        inputs = _fields.texts(d, "input_names", None, [])
-        m = max(len(inputs), 1)
-        several = {}
-        if m > 1:
-            several = dict(
-                input_names=tuple(inputs),
-                input_units=tuple(_fields.texts(d, "input_units", m, [""] * m)),
-                u_offsets=tuple(_fields.numbers(d, "u_offsets", (m,), [0.0] * m)),
-            )
-        integrators = _fields.numbers(d, "integrators", (p,), [0] * p)
-        if not np.all(integrators == np.round(integrators)):
-            raise ValueError(
-                "field 'integrators' must be whole counts, one per output; got "
-                f"{d['integrators']!r:.60}"
-            )
-        return cls(
-            a=_fields.numbers(d, "a", (na,)),
-            b=_fields.numbers(d, "b", (p, m * nb)),
-            arx=ARX(na, nb, nk),
-            ts=_fields.number(d, "ts", "a number > 0", _fields.positive),
-            output_names=names,
-            output_units=_fields.texts(d, "output_units", p, [""] * p),
-            y_offsets=tuple(_fields.numbers(d, "y_offsets", (p,), [0.0] * p)),
-            costs=optional("costs", (p,), null=np.nan),
-            weights=optional("weights", (p,)),
-            # JSON has no infinity: an infinite variance is written as null.
-            covariance=optional("covariance", (na, na), null=np.inf),
-            integrators=tuple(int(k) for k in integrators),
-            **provenance,
-            **several,
-        )
+        return cls(**_file.model_fields(d, cls._provenance_fields))
 
     def __repr__(self) -> str:
         return (
