@@ -192,6 +192,11 @@ def choose(
     )
     if not lifted:
         return problem, result, choice
+    if free.cancel:
+        # Only a model that is returned has its pairs removed: the removal's
+        # polishes cost as much as the release, and a kept margin returns
+        # the margined model, which had its own.
+        _cancel(free, unbound, free.simulation_cost())
     unbound.elapsed += result.elapsed
     unbound.message = f"{result.message} Then {choice.sentence()}."
     return free, unbound, choice
@@ -217,8 +222,6 @@ def _released(
     # margin on the rig's hub angle at ARX(8, 8, 0).
     starts = {"released": bound, **_standard_starts(free)}
     unbound = _polish(free, starts, "simulation", cost)
-    if free.cancel:
-        _cancel(free, unbound, cost)
     return float(cost(unbound.x) / cost(result.x)), unbound
 
 
