@@ -23,7 +23,9 @@ share of it into the lower tank and the rest away; or ``"inflow"``
 falling on into the lower tank while the upper one is full (the form of
 the published grey boxes of the benchmark, Rogers et al. 2017 and Worden
 et al. 2018: a term ``k5 u`` added to the lower tank above the upper
-one's top). The upper level is never measured: its scale is the model's
+one's top); or ``"mixed"`` (:func:`tanks_f_mixed`), both: a share of the
+pump's inflow and another, ``surplus_share`` (:data:`SURPLUS_SHARE`, the
+one parameter the form adds), of the surplus. The upper level is never measured: its scale is the model's
 choice, fixed by :data:`UPPER_TOP`, or the record could not tell the pump's
 gain from the upper tank's size.
 
@@ -44,10 +46,12 @@ from spiralid.sysid.models.greybox import GreyBox, Parameter
 
 __all__ = [
     "OVERFLOWS",
+    "SURPLUS_SHARE",
     "TANKS_PARAMETERS",
     "UPPER_TOP",
     "tanks_f",
     "tanks_f_inflow",
+    "tanks_f_mixed",
     "tanks_g",
     "tanks_greybox",
 ]
@@ -73,11 +77,22 @@ TANKS_PARAMETERS: dict[str, tuple] = {
 }
 
 
+#: The mixed overflow's second share (:func:`tanks_greybox`'s
+#: ``overflow="mixed"`` appends it to :data:`TANKS_PARAMETERS`, as ``p[10]``).
+SURPLUS_SHARE: dict[str, tuple] = {
+    "surplus_share": (0.25, (1e-3, 10.0), "", None),
+}
+
+# The `form` codes of _rates.
+_SURPLUS, _INFLOW, _MIXED = 0, 1, 2
+
+
 @numba.njit(cache=True)
-def _rates(x, u, p, jet):  # pragma: no cover - compiled
-    # The two overflows share everything but what reaches the lower tank
-    # while the upper one is full: its surplus (jet False) or the pump's
-    # whole inflow (jet True), times the share.
+def _rates(x, u, p, form):  # pragma: no cover - compiled
+    # The overflows share everything but what reaches the lower tank while
+    # the upper one is full (`form`, a value of _FORMS): a share of its
+    # surplus, of the pump's whole inflow, or a share of each (the second,
+    # surplus_share, read from p[10]: only the mixed form has it).
     up = max(x[0], 0.0)
     low = max(x[1], 0.0)
     q_up = p[0] * up ** p[8]
@@ -85,8 +100,14 @@ def _rates(x, u, p, jet):  # pragma: no cover - compiled
     dx0 = pump - q_up
     spill = 0.0
     if x[0] >= UPPER_TOP and dx0 > 0.0:
-        spill, dx0 = (pump if jet else dx0), 0.0
-    dx1 = p[1] * q_up - p[2] * low ** p[9] + p[4] * spill
+        if form == _SURPLUS:
+            spill = p[4] * dx0
+        elif form == _INFLOW:
+            spill = p[4] * pump
+        else:
+            spill = p[4] * pump + p[10] * dx0
+        dx0 = 0.0
+    dx1 = p[1] * q_up - p[2] * low ** p[9] + spill
     if x[1] >= p[7] and dx1 > 0.0:
         dx1 = 0.0
     return np.array([dx0, dx1])
@@ -96,7 +117,7 @@ def _rates(x, u, p, jet):  # pragma: no cover - compiled
 def tanks_f(t, x, u, p):  # pragma: no cover - compiled
     """``dx/dt`` of the two tanks, the upper one's surplus spilling (see
     the module docstring)."""
-    return _rates(x, u, p, False)
+    return _rates(x, u, p, _SURPLUS)
 
 
 @numba.njit(cache=True)
@@ -104,13 +125,21 @@ def tanks_f_inflow(t, x, u, p):  # pragma: no cover - compiled
     """``dx/dt`` of the two tanks, a share of the pump's inflow reaching
     the lower tank while the upper one is full (see the module
     docstring)."""
-    return _rates(x, u, p, True)
+    return _rates(x, u, p, _INFLOW)
+
+
+@numba.njit(cache=True)
+def tanks_f_mixed(t, x, u, p):  # pragma: no cover - compiled
+    """``dx/dt`` of the two tanks, a share of the pump's inflow and a share
+    of the upper tank's surplus reaching the lower tank while the upper one
+    is full (see the module docstring)."""
+    return _rates(x, u, p, _MIXED)
 
 
 #: overflow name -> the ``f`` that models it (:func:`tanks_greybox`'s
 #: `overflow`).
 #: The first is :func:`tanks_greybox`'s default.
-OVERFLOWS = {"inflow": tanks_f_inflow, "surplus": tanks_f}
+OVERFLOWS = {"inflow": tanks_f_inflow, "surplus": tanks_f, "mixed": tanks_f_mixed}
 
 
 @numba.njit(cache=True)
@@ -133,11 +162,13 @@ def tanks_greybox(
     ----------
     exponents : bool, default False
         Estimate the outflow exponents too (else fixed at Torricelli's 0.5).
-    overflow : {"inflow", "surplus"}, default "inflow"
+    overflow : {"inflow", "surplus", "mixed"}, default "inflow"
         What reaches the lower tank while the upper one is full (a key of
         :data:`OVERFLOWS`): ``overflow_share`` times the pump's whole
         inflow, or times the upper tank's surplus inflow (the model's form
-        before the inflow one predicted held-back data better).
+        before the inflow one predicted held-back data better), or the
+        first plus ``surplus_share`` times the surplus (one more free
+        parameter).
     x0 : "estimated" or sequence of float, default "estimated"
         The initial levels: estimated within ``[0, 10]`` V (the records
         start from an unknown state), or given.
@@ -154,6 +185,7 @@ def tanks_greybox(
         raise ValueError(
             f"`overflow` must be one of {sorted(OVERFLOWS)}; got {overflow!r}"
         )
+    table = TANKS_PARAMETERS | (SURPLUS_SHARE if overflow == "mixed" else {})
     params = [
         Parameter(
             name,
@@ -163,7 +195,7 @@ def tanks_greybox(
             free=exponents or fixed is None,
             log=bounds[0] > 0 and fixed is None,
         )
-        for name, (value, bounds, unit, fixed) in TANKS_PARAMETERS.items()
+        for name, (value, bounds, unit, fixed) in table.items()
     ]
     if isinstance(x0, str):
         if x0 != "estimated":
