@@ -123,7 +123,7 @@ def test_the_mixed_overflow_balances_the_water():
     u = np.array([6.0])
 
     def rates(t, z):
-        x, drained = z[:2], z[2]
+        x = z[:2]
         dx = tanks_f_mixed(t, x, u, p)
         return [dx[0], dx[1], p[2] * max(x[1], 0.0) ** 0.5]
 

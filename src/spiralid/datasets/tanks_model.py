@@ -25,9 +25,9 @@ the published grey boxes of the benchmark, Rogers et al. 2017 and Worden
 et al. 2018: a term ``k5 u`` added to the lower tank above the upper
 one's top); or ``"mixed"`` (:func:`tanks_f_mixed`), both: a share of the
 pump's inflow and another, ``surplus_share`` (:data:`SURPLUS_SHARE`, the
-one parameter the form adds), of the surplus. The upper level is never measured: its scale is the model's
-choice, fixed by :data:`UPPER_TOP`, or the record could not tell the pump's
-gain from the upper tank's size.
+one parameter the form adds), of the surplus. The upper level is never
+measured: its scale is the model's choice, fixed by :data:`UPPER_TOP`, or
+the record could not tell the pump's gain from the upper tank's size.
 
 Why here and not in an example: ``model.json`` names the model's functions
 by import path, and an example's functions live in ``__main__`` when it
