@@ -12,6 +12,7 @@ import pytest
 import spiralid as sid
 from spiralid.datasets import cascaded_tanks, tanks_model
 from spiralid.datasets.tanks_model import (
+    NO_TOP,
     OVERFLOWS,
     SURPLUS_SHARE,
     TANKS_PARAMETERS,
@@ -134,6 +135,39 @@ def test_the_mixed_overflow_balances_the_water():
     assert upper == pytest.approx(10.0, abs=1e-6)  # it reached its top
     pumped = 0.05 * (6.0 - 0.6) * 400.0
     assert (upper - 9.0) + (lower - 2.0) + drained == pytest.approx(pumped, rel=1e-5)
+
+
+def test_the_steady_states_with_and_without_the_lower_top():
+    """A long run at a constant input settles where the outflows balance
+    the pump, by hand: ``x0 = (pump / k1)^2`` and ``x1 = (a pump / k2)^2``
+    (9 V each here, the upper tank below its top); with the lower tank's
+    top below that, at its top instead."""
+    u = np.full((1000, 1), 3.0)
+    pump = 0.05 * (3.0 - 0.6)
+    x1 = (1.0 * pump / 0.04) ** 2
+    assert x1 == pytest.approx(9.0)
+    values = {"upper_outflow": 0.04, "lower_outflow": 0.04, "area_ratio": 1.0}
+    values |= {"pump_gain": 0.05, "pump_threshold": 0.6, "sensor_offset": 0.3}
+    for top, level in ((False, x1), (True, 8.0)):
+        box = tanks_greybox(x0=[2.0, 1.0], lower_top=top)
+        p = box.initial_values
+        for name, value in values.items():
+            p[box.names.index(name)] = value
+        if top:
+            p[box.names.index("lower_top")] = 8.0
+        else:
+            assert p[box.names.index("lower_top")] == NO_TOP
+        y = box.simulate(p, u, 4.0)
+        assert np.ravel(y)[-1] == pytest.approx(level + 0.3, abs=1e-3)
+
+
+def test_the_builder_without_the_lower_top():
+    box = tanks_greybox(lower_top=False)
+    k = box.names.index("lower_top")
+    assert not box.free[k] and box.free.sum() == 9
+    assert box.initial_values[k] == NO_TOP
+    with pytest.raises(TypeError, match="`lower_top`"):
+        tanks_greybox(lower_top="no")
 
 
 @pytest.mark.parametrize("overflow", list(OVERFLOWS))

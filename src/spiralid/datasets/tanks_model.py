@@ -16,10 +16,11 @@ tank's level, ``x[1]`` the lower tank's. With ``p`` as
 
 The upper tank spills once ``x0`` reaches :data:`UPPER_TOP` (it then stays
 there), and the lower tank stops filling at ``lower_top`` (its own
-overflow). What the upper tank spills is one of :data:`OVERFLOWS`:
-``"surplus"`` (:func:`tanks_f`), its surplus inflow ``pump - q_up``, a
-share of it into the lower tank and the rest away; or ``"inflow"``
-(:func:`tanks_f_inflow`), a share of the pump's whole inflow ``pump``
+overflow; ``tanks_greybox(lower_top=False)`` leaves it without one). What
+the upper tank spills is one of :data:`OVERFLOWS`: ``"surplus"``
+(:func:`tanks_f`), its surplus inflow ``pump - q_up``, a share of it into
+the lower tank and the rest away; or ``"inflow"`` (:func:`tanks_f_inflow`),
+a share of the pump's whole inflow ``pump``
 falling on into the lower tank while the upper one is full (the form of
 the published grey boxes of the benchmark, Rogers et al. 2017 and Worden
 et al. 2018: a term ``k5 u`` added to the lower tank above the upper
@@ -45,6 +46,7 @@ import numpy as np
 from spiralid.sysid.models.greybox import GreyBox, Parameter
 
 __all__ = [
+    "NO_TOP",
     "OVERFLOWS",
     "SURPLUS_SHARE",
     "TANKS_PARAMETERS",
@@ -60,6 +62,9 @@ __all__ = [
 UPPER_TOP = 10.0
 #: The level sensor's saturation (both records reach it).
 SENSOR_MAX = 10.0
+#: ``lower_top`` of a lower tank without a top (:func:`tanks_greybox`'s
+#: ``lower_top=False``): no level reaches it.
+NO_TOP = 1e6
 
 #: name -> (initial value, bounds, unit, Torricelli's fixed value or None):
 #: the order ``p`` is read in.
@@ -152,6 +157,7 @@ def tanks_greybox(
     *,
     exponents: bool = False,
     overflow: str = "inflow",
+    lower_top: bool = True,
     x0="estimated",
     substeps: int = 4,
 ) -> GreyBox:
@@ -169,6 +175,11 @@ def tanks_greybox(
         before the inflow one predicted held-back data better), or the
         first plus ``surplus_share`` times the surplus (one more free
         parameter).
+    lower_top : bool, default True
+        Give the lower tank a top it fills no further than (the free
+        parameter ``lower_top``); False holds ``lower_top`` at
+        :data:`NO_TOP`, out of the levels' reach: no lower overflow, one
+        free parameter fewer.
     x0 : "estimated" or sequence of float, default "estimated"
         The initial levels: estimated within ``[0, 10]`` V (the records
         start from an unknown state), or given.
@@ -197,6 +208,13 @@ def tanks_greybox(
         )
         for name, (value, bounds, unit, fixed) in table.items()
     ]
+    if not isinstance(lower_top, bool):
+        raise TypeError(f"`lower_top` must be a bool; got {type(lower_top).__name__}")
+    if not lower_top:
+        top = list(table).index("lower_top")
+        params[top] = Parameter(
+            "lower_top", NO_TOP, (NO_TOP / 2, NO_TOP), "V", free=False
+        )
     if isinstance(x0, str):
         if x0 != "estimated":
             raise ValueError(f"`x0` must be 'estimated' or two levels; got {x0!r}")
