@@ -3,7 +3,8 @@
 repository's own families as the correction.
 
 The grey box is ``tanks_greybox(overflow=...)`` (``--overflow``, default
-the default model's ``inflow``), fitted by ``identify(est, box, rng=seed,
+the default model's ``inflow``; ``--no-lower-top``: ``lower_top=False``),
+fitted by ``identify(est, box, rng=seed,
 max_nfev=..., horizons=(0.25, 0.5))``, the documented fit of
 ``benchmarks/cascaded_tanks.py``. Its free run ``y_gb`` leaves the
 residual ``r = y - y_gb``; a correction learns ``r`` from a free run of its
@@ -24,6 +25,7 @@ the choice. Seconds are processor time of this process (the machine may be
 shared).
 
     python benchmarks/cascaded_tanks_residual.py [--seed 0] [--max-nfev 3000]
+        [--no-lower-top]
 """
 
 from __future__ import annotations
@@ -90,10 +92,11 @@ def main() -> None:
     parser.add_argument(
         "--overflow", choices=list(OVERFLOWS), default=next(iter(OVERFLOWS))
     )
+    parser.add_argument("--no-lower-top", action="store_true")
     args = parser.parse_args()
     est, test = cascaded_tanks(), cascaded_tanks("test")
     cut = round(2 * est.n / 3)
-    box = tanks_greybox(overflow=args.overflow)
+    box = tanks_greybox(overflow=args.overflow, lower_top=not args.no_lower_top)
     options = {"rng": args.seed, "max_nfev": args.max_nfev, "horizons": (0.25, 0.5)}
     start = time.process_time()
     held_box = sid.identify(est[:cut], box, **options)
