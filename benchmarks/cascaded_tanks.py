@@ -3,8 +3,8 @@
 and the published table.
 
 For each seed of ``--seeds`` and each overflow of ``--overflow`` (keys of
-``OVERFLOWS``: ``inflow``, the default model, or ``surplus``; ``all`` for
-both) it fits ``tanks_greybox(overflow=...)`` (Torricelli's exponents
+``OVERFLOWS``: ``inflow``, the default model, ``surplus`` or ``mixed``;
+``all`` for the three) it fits ``tanks_greybox(overflow=...)`` (Torricelli's exponents
 fixed, 8 parameters and the 2 initial levels free) and, with
 ``--exponents``, ``tanks_greybox(overflow=..., exponents=True)`` (the
 outflow exponents free too) to the estimation record by ``identify(est,
@@ -16,7 +16,8 @@ record's RMS, the simulations run and the seconds (compile time of the
 Numba model included in the first row only; on a loaded machine, seconds
 are indicative).
 
-With ``--horizons 0.25,0.5`` the fits run ``identify(...,
+With ``--no-lower-top`` the models are built with ``lower_top=False`` (no
+lower overflow). With ``--horizons 0.25,0.5`` the fits run ``identify(...,
 horizons=(0.25, 0.5))`` (the growing horizons' shares; the default's
 otherwise). With ``--held-out`` the fit sees only the estimation record's first two
 thirds, and the RMS on its last third (the free run continuing over the
@@ -56,6 +57,7 @@ def main() -> None:
         "--overflow", choices=[*OVERFLOWS, "all"], default=next(iter(OVERFLOWS))
     )
     parser.add_argument("--held-out", action="store_true")
+    parser.add_argument("--no-lower-top", action="store_true")
     parser.add_argument(
         "--horizons", type=lambda text: tuple(float(v) for v in text.split(","))
     )
@@ -66,10 +68,11 @@ def main() -> None:
     overflows = list(OVERFLOWS) if args.overflow == "all" else [args.overflow]
     boxes = {}
     for overflow in overflows:
-        boxes[f"{overflow}, Torricelli"] = tanks_greybox(overflow=overflow)
+        top = {"lower_top": False} if args.no_lower_top else {}
+        boxes[f"{overflow}, Torricelli"] = tanks_greybox(overflow=overflow, **top)
         if args.exponents:
             boxes[f"{overflow}, exponents"] = tanks_greybox(
-                overflow=overflow, exponents=True
+                overflow=overflow, exponents=True, **top
             )
     held = "held RMS" if args.held_out else "est RMS"
     print(f"{'model':22s} {'seed':>4s} {'test RMS':>9s} {held:>8s} "

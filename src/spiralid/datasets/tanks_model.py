@@ -16,16 +16,19 @@ tank's level, ``x[1]`` the lower tank's. With ``p`` as
 
 The upper tank spills once ``x0`` reaches :data:`UPPER_TOP` (it then stays
 there), and the lower tank stops filling at ``lower_top`` (its own
-overflow). What the upper tank spills is one of :data:`OVERFLOWS`:
-``"surplus"`` (:func:`tanks_f`), its surplus inflow ``pump - q_up``, a
-share of it into the lower tank and the rest away; or ``"inflow"``
-(:func:`tanks_f_inflow`), a share of the pump's whole inflow ``pump``
+overflow; ``tanks_greybox(lower_top=False)`` leaves it without one). What
+the upper tank spills is one of :data:`OVERFLOWS`: ``"surplus"``
+(:func:`tanks_f`), its surplus inflow ``pump - q_up``, a share of it into
+the lower tank and the rest away; or ``"inflow"`` (:func:`tanks_f_inflow`),
+a share of the pump's whole inflow ``pump``
 falling on into the lower tank while the upper one is full (the form of
 the published grey boxes of the benchmark, Rogers et al. 2017 and Worden
 et al. 2018: a term ``k5 u`` added to the lower tank above the upper
-one's top). The upper level is never measured: its scale is the model's
-choice, fixed by :data:`UPPER_TOP`, or the record could not tell the pump's
-gain from the upper tank's size.
+one's top); or ``"mixed"`` (:func:`tanks_f_mixed`), both: a share of the
+pump's inflow and another, ``surplus_share`` (:data:`SURPLUS_SHARE`, the
+one parameter the form adds), of the surplus. The upper level is never
+measured: its scale is the model's choice, fixed by :data:`UPPER_TOP`, or
+the record could not tell the pump's gain from the upper tank's size.
 
 Why here and not in an example: ``model.json`` names the model's functions
 by import path, and an example's functions live in ``__main__`` when it
@@ -43,11 +46,14 @@ import numpy as np
 from spiralid.sysid.models.greybox import GreyBox, Parameter
 
 __all__ = [
+    "NO_TOP",
     "OVERFLOWS",
+    "SURPLUS_SHARE",
     "TANKS_PARAMETERS",
     "UPPER_TOP",
     "tanks_f",
     "tanks_f_inflow",
+    "tanks_f_mixed",
     "tanks_g",
     "tanks_greybox",
 ]
@@ -56,6 +62,9 @@ __all__ = [
 UPPER_TOP = 10.0
 #: The level sensor's saturation (both records reach it).
 SENSOR_MAX = 10.0
+#: ``lower_top`` of a lower tank without a top (:func:`tanks_greybox`'s
+#: ``lower_top=False``): no level reaches it.
+NO_TOP = 1e6
 
 #: name -> (initial value, bounds, unit, Torricelli's fixed value or None):
 #: the order ``p`` is read in.
@@ -73,11 +82,22 @@ TANKS_PARAMETERS: dict[str, tuple] = {
 }
 
 
+#: The mixed overflow's second share (:func:`tanks_greybox`'s
+#: ``overflow="mixed"`` appends it to :data:`TANKS_PARAMETERS`, as ``p[10]``).
+SURPLUS_SHARE: dict[str, tuple] = {
+    "surplus_share": (0.25, (1e-3, 10.0), "", None),
+}
+
+# The `form` codes of _rates.
+_SURPLUS, _INFLOW, _MIXED = 0, 1, 2
+
+
 @numba.njit(cache=True)
-def _rates(x, u, p, jet):  # pragma: no cover - compiled
-    # The two overflows share everything but what reaches the lower tank
-    # while the upper one is full: its surplus (jet False) or the pump's
-    # whole inflow (jet True), times the share.
+def _rates(x, u, p, form):  # pragma: no cover - compiled
+    # The overflows share everything but what reaches the lower tank while
+    # the upper one is full (`form`, a value of _FORMS): a share of its
+    # surplus, of the pump's whole inflow, or a share of each (the second,
+    # surplus_share, read from p[10]: only the mixed form has it).
     up = max(x[0], 0.0)
     low = max(x[1], 0.0)
     q_up = p[0] * up ** p[8]
@@ -85,8 +105,14 @@ def _rates(x, u, p, jet):  # pragma: no cover - compiled
     dx0 = pump - q_up
     spill = 0.0
     if x[0] >= UPPER_TOP and dx0 > 0.0:
-        spill, dx0 = (pump if jet else dx0), 0.0
-    dx1 = p[1] * q_up - p[2] * low ** p[9] + p[4] * spill
+        if form == _SURPLUS:
+            spill = p[4] * dx0
+        elif form == _INFLOW:
+            spill = p[4] * pump
+        else:
+            spill = p[4] * pump + p[10] * dx0
+        dx0 = 0.0
+    dx1 = p[1] * q_up - p[2] * low ** p[9] + spill
     if x[1] >= p[7] and dx1 > 0.0:
         dx1 = 0.0
     return np.array([dx0, dx1])
@@ -96,7 +122,7 @@ def _rates(x, u, p, jet):  # pragma: no cover - compiled
 def tanks_f(t, x, u, p):  # pragma: no cover - compiled
     """``dx/dt`` of the two tanks, the upper one's surplus spilling (see
     the module docstring)."""
-    return _rates(x, u, p, False)
+    return _rates(x, u, p, _SURPLUS)
 
 
 @numba.njit(cache=True)
@@ -104,13 +130,21 @@ def tanks_f_inflow(t, x, u, p):  # pragma: no cover - compiled
     """``dx/dt`` of the two tanks, a share of the pump's inflow reaching
     the lower tank while the upper one is full (see the module
     docstring)."""
-    return _rates(x, u, p, True)
+    return _rates(x, u, p, _INFLOW)
+
+
+@numba.njit(cache=True)
+def tanks_f_mixed(t, x, u, p):  # pragma: no cover - compiled
+    """``dx/dt`` of the two tanks, a share of the pump's inflow and a share
+    of the upper tank's surplus reaching the lower tank while the upper one
+    is full (see the module docstring)."""
+    return _rates(x, u, p, _MIXED)
 
 
 #: overflow name -> the ``f`` that models it (:func:`tanks_greybox`'s
 #: `overflow`).
 #: The first is :func:`tanks_greybox`'s default.
-OVERFLOWS = {"inflow": tanks_f_inflow, "surplus": tanks_f}
+OVERFLOWS = {"inflow": tanks_f_inflow, "surplus": tanks_f, "mixed": tanks_f_mixed}
 
 
 @numba.njit(cache=True)
@@ -123,6 +157,7 @@ def tanks_greybox(
     *,
     exponents: bool = False,
     overflow: str = "inflow",
+    lower_top: bool = True,
     x0="estimated",
     substeps: int = 4,
 ) -> GreyBox:
@@ -133,11 +168,18 @@ def tanks_greybox(
     ----------
     exponents : bool, default False
         Estimate the outflow exponents too (else fixed at Torricelli's 0.5).
-    overflow : {"inflow", "surplus"}, default "inflow"
+    overflow : {"inflow", "surplus", "mixed"}, default "inflow"
         What reaches the lower tank while the upper one is full (a key of
         :data:`OVERFLOWS`): ``overflow_share`` times the pump's whole
         inflow, or times the upper tank's surplus inflow (the model's form
-        before the inflow one predicted held-back data better).
+        before the inflow one predicted held-back data better), or the
+        first plus ``surplus_share`` times the surplus (one more free
+        parameter).
+    lower_top : bool, default True
+        Give the lower tank a top it fills no further than (the free
+        parameter ``lower_top``); False holds ``lower_top`` at
+        :data:`NO_TOP`, out of the levels' reach: no lower overflow, one
+        free parameter fewer.
     x0 : "estimated" or sequence of float, default "estimated"
         The initial levels: estimated within ``[0, 10]`` V (the records
         start from an unknown state), or given.
@@ -154,6 +196,7 @@ def tanks_greybox(
         raise ValueError(
             f"`overflow` must be one of {sorted(OVERFLOWS)}; got {overflow!r}"
         )
+    table = TANKS_PARAMETERS | (SURPLUS_SHARE if overflow == "mixed" else {})
     params = [
         Parameter(
             name,
@@ -163,8 +206,15 @@ def tanks_greybox(
             free=exponents or fixed is None,
             log=bounds[0] > 0 and fixed is None,
         )
-        for name, (value, bounds, unit, fixed) in TANKS_PARAMETERS.items()
+        for name, (value, bounds, unit, fixed) in table.items()
     ]
+    if not isinstance(lower_top, bool):
+        raise TypeError(f"`lower_top` must be a bool; got {type(lower_top).__name__}")
+    if not lower_top:
+        top = list(table).index("lower_top")
+        params[top] = Parameter(
+            "lower_top", NO_TOP, (NO_TOP / 2, NO_TOP), "V", free=False
+        )
     if isinstance(x0, str):
         if x0 != "estimated":
             raise ValueError(f"`x0` must be 'estimated' or two levels; got {x0!r}")
