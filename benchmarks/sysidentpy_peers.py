@@ -36,7 +36,9 @@ tanks run 0-10 V, where tanh units start saturated), and the free run is
 mapped back to volts. Each lag count and hidden width of the grid is
 chosen per seed on the estimation record's last third as above; the seed
 (``torch.manual_seed``) draws the network's starting weights. PyTorch runs
-on one thread: processor seconds are then one core's.
+on one thread: processor seconds are then one core's. ``--record arm``
+runs the same grid on the DaISy robot arm (``daisy_robot_arm.csv``, see
+``_splits``) and prints its fit % beside the RMS.
 """
 
 import argparse
@@ -53,6 +55,38 @@ SKIP = 5  # the benchmark's: the first samples may set the state
 def _record(name: str) -> tuple[np.ndarray, np.ndarray]:
     data = np.loadtxt(RECORDS / name, delimiter=",", skiprows=1)
     return data[:, :1], data[:, 1:2]
+
+
+def _splits(record: str) -> dict:
+    """Where each fit trains and where its free run is scored.
+
+    ``fit`` and ``part`` are the (u, y) the model and the held-back
+    candidate train on; ``test`` and ``held`` are the (u, y, skip) their free
+    runs cover from the first samples, scored after ``skip``. The tanks: the
+    benchmark's two records. The DaISy arm (one record, started in motion):
+    estimation on its first two thirds, validation on the last third after
+    a free run over the first two as warm-up, as the grey-box page scores
+    it; the held-back third is the estimation part's last, warmed up alike.
+    """
+    if record == "tanks":
+        u_est, y_est = _record("cascaded_tanks_est.csv")
+        u_test, y_test = _record("cascaded_tanks_val.csv")
+        cut = 2 * y_est.size // 3
+        return {
+            "fit": (u_est, y_est),
+            "test": (u_test, y_test, SKIP),
+            "part": (u_est[:cut], y_est[:cut]),
+            "held": (u_est[cut:], y_est[cut:], SKIP),
+        }
+    u, y = _record("daisy_robot_arm.csv")
+    n_est = 2 * y.size // 3
+    cut = 2 * n_est // 3
+    return {
+        "fit": (u[:n_est], y[:n_est]),
+        "test": (u, y, n_est),
+        "part": (u[:cut], y[:cut]),
+        "held": (u[:n_est], y[:n_est], cut),
+    }
 
 
 def _frols(degree: int, lags: int, n_terms: int):
@@ -136,16 +170,18 @@ def _ints(text: str) -> list[int]:
     return [int(n) for n in text.split(",")]
 
 
-def neural(lags: list[int], hidden: list[int], epochs: int, seeds: list[int]):
+def neural(
+    lags: list[int], hidden: list[int], epochs: int, seeds: list[int], record: str
+):
     """The neural NARX's grid per seed, and the test RMS of the lag count
     and width its held-back third keeps."""
     import torch
 
     torch.set_num_threads(1)  # the machine is shared
-    u_est, y_est = _record("cascaded_tanks_est.csv")
-    u_test, y_test = _record("cascaded_tanks_val.csv")
-    cut = 2 * y_est.size // 3
-    print("seed lags hidden  held-back RMS  test RMS (V)  s")
+    where = _splits(record)
+    u_test, y_test, skip = where["test"]
+    unit = " V" if record == "tanks" else ""  # the arm's units are unstated
+    print(f"seed lags hidden  held-back RMS  test RMS{unit}  s")
     kept, seconds = [], []
     for seed in seeds:
         rows = []
@@ -155,24 +191,28 @@ def neural(lags: list[int], hidden: list[int], epochs: int, seeds: list[int]):
                 held = np.nan  # nothing to choose among: no held-back fit
                 if len(lags) * len(hidden) > 1:
                     part = _Standardised(
-                        _narxnn(n, width, epochs, seed), u_est[:cut], y_est[:cut]
+                        _narxnn(n, width, epochs, seed), *where["part"]
                     )
-                    held = _free_run_rms(part, u_est[cut:], y_est[cut:], SKIP)
-                whole = _Standardised(_narxnn(n, width, epochs, seed), u_est, y_est)
-                test = _free_run_rms(whole, u_test, y_test, SKIP)
+                    held = _free_run_rms(part, *where["held"])
+                whole = _Standardised(_narxnn(n, width, epochs, seed), *where["fit"])
+                test = _free_run_rms(whole, u_test, y_test, skip)
                 seconds.append(time.process_time() - start)
                 rows.append((held, test, n, width))
                 cells = f"{seed:4d} {n:4d} {width:6d}  {held:13.3f}  {test:12.3f}"
                 print(f"{cells}  {seconds[-1]:.1f}", flush=True)
         held, test, n, width = min(rows)
-        print(f"seed {seed} keeps lags {n}, {width} units: test {test:.3f} V")
+        print(f"seed {seed} keeps lags {n}, {width} units: test {test:.3f}{unit}")
         kept.append(test)
     tests = np.array(kept)
     print(
         f"kept by the held-back third, seeds {seeds[0]}-{seeds[-1]}: test RMS "
-        f"median {np.median(tests):.3f} V [{tests.min():.3f}, {tests.max():.3f}]; "
+        f"median {np.median(tests):.3f}{unit} [{tests.min():.3f}, {tests.max():.3f}]; "
         f"{min(seconds):.0f}-{max(seconds):.0f} processor s per candidate"
     )
+    # fit % = 100 (1 - |e| / |y - mean y|) over the scored part
+    spread = float(np.std(y_test[skip:]))
+    fits = np.sort(100 * (1 - tests / spread))
+    print(f"as fit %: median {np.median(fits):.2f} [{fits[0]:.2f}, {fits[-1]:.2f}]")
 
 
 def main() -> None:
@@ -187,10 +227,17 @@ def main() -> None:
     parser.add_argument("--hidden", default="10,30", help="default 10,30")
     parser.add_argument("--epochs", type=int, default=200, help="default 200")
     parser.add_argument("--seeds", default="0-4", help="default 0-4")
+    parser.add_argument(
+        "--record",
+        choices=("tanks", "arm"),
+        default="tanks",
+        help="--neural's record: the Cascaded Tanks or the DaISy robot arm",
+    )
     args = parser.parse_args()
     if args.neural:
         hidden = _ints(args.hidden)
-        neural(_ints(args.nn_lags), hidden, args.epochs, _ints(args.seeds))
+        lags = _ints(args.nn_lags)
+        neural(lags, hidden, args.epochs, _ints(args.seeds), args.record)
         return
     # FROLS caps n_info_values at the candidate count and says so each time.
     warnings.filterwarnings("ignore", message="n_info_values is greater")
