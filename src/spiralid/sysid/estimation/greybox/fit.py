@@ -4,8 +4,9 @@
 - ``"spiral"`` (default): the learned-metric spiral
   (:func:`spiralid.optim.minimize` with ``method="learned-metric"``) over
   the free parameters in their unit box (log-scaled where a parameter has a
-  log scale), seeded with the initial values, then Levenberg-Marquardt on
-  the simulation error from the best point, projected into the box;
+  log scale), seeded with the initial values, restarting once a run's steps
+  are below a hundredth of the box (``_RESTARTS``), then Levenberg-Marquardt
+  on the simulation error from the best point, projected into the box;
 - ``"oe"``: that Levenberg-Marquardt alone, from the initial values;
 - both beside a second fit over growing horizons (``horizons``, shares of
   the record): the search on the first share, the polish on each longer
