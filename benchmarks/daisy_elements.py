@@ -79,6 +79,7 @@ def _element(kind: str, q):
         return [1.0, 0.0], [1.0, wh], [-wh], 0.0, "zoh"
     w, z = np.exp(q[0]), q[1]
     if kind == "second-order sensor":
+        z = abs(z)  # a sensor is stable: its damping's sign is not free
         return [w * w], [1.0, 2 * z * w, w * w], [], 0.0, "zoh"
     return [1 / w**2, 2 * z / w, 1.0], [1.0], [], 0.0, "zoh"  # zero pair
 
