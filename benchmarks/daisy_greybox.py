@@ -25,6 +25,10 @@ invisible in the record). Rows:
   state and even each mode's damping free: the residues and the state by
   least squares, the modes by Levenberg-Marquardt from the ARX's.
 
+``--input-delay`` also frees the rig's ``input_delay`` (s, within 0.009 s
+either way, started at minus half a sample: the lag of a zero-order hold
+behind a measured input).
+
 ``--bound-only`` prints the black boxes and that bound, without the rig;
 ``--starts modes`` only the rig's start from the ARX's modes.
 
@@ -45,7 +49,7 @@ from scipy.optimize import least_squares
 
 from spiralid.datasets import robot_arm
 from spiralid.fms import FlexibleManipulator, Sensors
-from spiralid.fms.greybox import GAIN, RigGreyBox
+from spiralid.fms.greybox import DELAY, GAIN, RigGreyBox
 from spiralid.fms.greybox_start import rig_start_from_modes
 from spiralid.sysid import ARX, Parameter, identify, validate
 from spiralid.sysid.models.greybox_model import LinearGreyBoxModel
@@ -91,7 +95,7 @@ def _form_bound(est, val, table) -> float:
     return float(100 * (1 - np.linalg.norm(e) / np.linalg.norm(val.y - val.y.mean())))
 
 
-def _box() -> RigGreyBox:
+def _box(delay: bool = False) -> RigGreyBox:
     """The rig's free fields with bounds a factor 100 around the preset
     (the payload from a thousandth to a hundred times the beam's)."""
     rig = FlexibleManipulator()
@@ -106,6 +110,8 @@ def _box() -> RigGreyBox:
                   (beam * rig.length**2 / 3e3, beam * rig.length**2 * 30), "kg m^2"),
         Parameter("damping_ratio", 0.02, (0.001, 0.3)),
     ]  # fmt: skip
+    if delay:
+        free.append(Parameter(DELAY, -0.005, (-0.009, 0.009), "s"))
     n_states = 2 * (MODES + 1)
     x0 = [Parameter(f"s{i}", 0.0, (-1.0, 1.0)) for i in range(n_states)]
     return RigGreyBox(
@@ -123,6 +129,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--bound-only", action="store_true")
+    ap.add_argument("--input-delay", action="store_true")
     ap.add_argument(
         "--starts", default="preset,modes", help="the rig's starts, comma-separated"
     )
@@ -145,7 +152,7 @@ def main() -> None:
     print(f"| rig's form, any fields | {_form_bound(est, val, table):.2f} | - |")
     if args.bound_only:
         return
-    box = _box()
+    box = _box(args.input_delay)
     keep = ~table.spurious
     modes = {"preset": box.rig.modes(MODES), "modes": arx}
     starts = {

@@ -78,6 +78,8 @@ RIG_PARAMETERS: dict[str, str] = {
     "static_friction": "N m",
     "stribeck_velocity": "rad/s",
     "torque_limit": "N m",
+    # Not a field: the record's input delay before the rig (a real arm's).
+    "input_delay": "s",
 }
 
 

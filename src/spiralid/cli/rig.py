@@ -44,7 +44,8 @@ def add_rig_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="FIELDS",
         help="--model rig: the rig's fields to estimate, separated by commas "
-        "(e.g. flexural_rigidity,hub_inertia); the others are held at --rig's "
+        "(e.g. flexural_rigidity,hub_inertia; input_delay, s, delays the "
+        "record's input before the rig); the others are held at --rig's "
         "(no default: --model rig needs it)",
     )
     p.add_argument(

@@ -1,4 +1,5 @@
-"""Exact zero-order-hold discretisation and a vectorised discrete simulation."""
+"""Exact zero-order-hold discretisation (with an input delay, whole or
+fractional) and a vectorised discrete simulation."""
 
 from __future__ import annotations
 
@@ -7,7 +8,14 @@ import math
 import numpy as np
 from scipy.linalg import expm
 
-__all__ = ["discretise_zoh", "simulate_discrete"]
+__all__ = [
+    "delay_split",
+    "delayed_inputs",
+    "delayed_system",
+    "discretise_delayed",
+    "discretise_zoh",
+    "simulate_discrete",
+]
 
 
 def discretise_zoh(
@@ -94,3 +102,106 @@ def simulate_discrete(
     sb = np.where((lag >= 1)[..., None], pb[np.clip(lag - 1, 0, None)], 0.0)
     xt += (U @ sb.transpose(1, 0, 2).reshape(m, m * n)).reshape(nb, m, n)
     return y, xt.reshape(nb * m, n)[:N]
+
+
+def _hold_integral(A: np.ndarray, B: np.ndarray, h: float):
+    """``(e^{A h}, int_0^h e^{A s} ds B)`` from one exponential."""
+    n = A.shape[0]
+    aug = np.zeros((n + 1, n + 1))
+    aug[:n, :n] = A * h
+    aug[:n, n] = B * h
+    e = expm(aug)
+    return e[:n, :n], e[:n, n]
+
+
+def delay_split(delay: float, ts: float) -> tuple[int, float]:
+    """``delay = (k + f) ts`` with an integer ``k >= -1`` and ``0 <= f < 1``
+    (a ValueError for an advance of a whole sample or more: the output
+    would need later inputs)."""
+    r = delay / ts
+    if not math.isfinite(r) or r <= -1.0:
+        raise ValueError(
+            f"`input_delay` must be finite and above -ts = {-ts}; got {delay}"
+        )
+    k = math.floor(r)
+    return k, r - k
+
+
+def discretise_delayed(
+    A: np.ndarray, B: np.ndarray, ts: float, delay: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The exact sampled model of ``x' = A x + B u(t - delay)``, `u` held
+    between samples: ``x[n+1] = Ad x[n] + G0 u[n-k] + G1 u[n-k-1]`` with
+    ``delay = (k + f) ts`` (:func:`delay_split`). Within a sample the
+    delayed input is ``u[n-k-1]`` for ``f ts``, then ``u[n-k]`` (the
+    modified z-transform's split): ``G0 = int_0^{(1-f) ts} e^{A s} ds B``,
+    ``G1 = e^{A (1-f) ts} int_0^{f ts} e^{A s} ds B``. Returns
+    ``(Ad, G0, G1)``."""
+    _, f = delay_split(delay, ts)
+    late, g0 = _hold_integral(A, B, (1.0 - f) * ts)
+    first, early = _hold_integral(A, B, f * ts)
+    # e^{A ts} as the product of the two parts' (they commute): two
+    # exponentials per run, not three.
+    return late @ first, g0, late @ early
+
+
+def delayed_inputs(u: np.ndarray, delay: float, ts: float) -> np.ndarray:
+    """The two input columns of :func:`discretise_delayed`'s recursion,
+    ``u[n-k]`` and ``u[n-k-1]`` (zero before the record; ``u[n+1]`` past
+    its end, which only the unused state after the last sample sees),
+    shape (N, 2)."""
+    k, _ = delay_split(delay, ts)
+    u = np.asarray(u, dtype=float).ravel()
+    n = u.size
+    padded = np.zeros(n + abs(k) + 2)
+    start = k + 1  # padded[j + start] holds u[j] for k >= -1
+    padded[start : start + n] = u
+    out = np.empty((n, 2))
+    out[:, 0] = padded[1 : n + 1]
+    out[:, 1] = padded[0:n]
+    return out
+
+
+def delayed_system(
+    ad: np.ndarray,
+    g0: np.ndarray,
+    g1: np.ndarray,
+    c: np.ndarray,
+    d: np.ndarray,
+    delay: float,
+    ts: float,
+) -> tuple[np.ndarray, ...]:
+    """The proper one-input model ``(Ad, Bd, C, D)`` of the delayed
+    recursion (for its transfer function, poles and zeros): the past
+    inputs it needs as extra states after the plant's (``m_j = u[n-j]``);
+    an advance (``k = -1``) with the state ``x - G0 u[n]`` instead. `c`
+    is ``(p, n)``, `d` ``(p,)``."""
+    k, f = delay_split(delay, ts)
+    n, p = ad.shape[0], c.shape[0]
+    if k < 0:
+        return ad, (ad @ g0 + g1)[:, None], c, (c @ g0 + d)[:, None]
+    memory = k + (1 if f > 0 else 0)
+    size = n + memory
+    a = np.zeros((size, size))
+    b = np.zeros((size, 1))
+    cc = np.zeros((p, size))
+    dd = np.zeros((p, 1))
+    a[:n, :n] = ad
+    cc[:, :n] = c
+    if memory:
+        b[n, 0] = 1.0  # m_1[n+1] = u[n]
+        for j in range(1, memory):
+            a[n + j, n + j - 1] = 1.0
+    # x[n+1] gets G0 u[n-k] and, for a fractional delay, G1 u[n-k-1].
+    if k == 0:
+        b[:n, 0] += g0
+    else:
+        a[:n, n + k - 1] += g0
+    if f > 0:
+        a[:n, n + k] += g1
+        cc[:, n + k] += d
+    elif k == 0:
+        dd[:, 0] = d
+    else:
+        cc[:, n + k - 1] += d
+    return a, b, cc, dd

@@ -11,10 +11,15 @@ friction on, the amplifier's clip with a torque limit. Nothing of the
 physics is restated here, so the grey box and the simulator that made a
 record cannot drift apart.
 
-Two options connect the rig to a record made elsewhere (a real arm):
+Three options connect the rig to a record made elsewhere (a real arm):
 ``output_gain``, a factor between the rig's output in SI units and the
-record's (a sensor's scale and sign), and ``x0``, the modal initial state,
-given or estimated (a record that starts in motion).
+record's (a sensor's scale and sign), ``x0``, the modal initial state,
+given or estimated (a record that starts in motion), and the parameter
+``input_delay`` (named in ``free``), a delay in seconds between the
+record's input and the torque the rig feels, fractional and of either
+sign (a negative one an advance: a measured input, not a held one, leads
+its zero-order hold by about half a sample), run by the exact sampled
+model of the delayed, held input (:func:`spiralid.fms._zoh.discretise_delayed`).
 :func:`spiralid.fms.greybox_start.rig_start_from_modes` picks a start whose
 finite-element modes are those of a black box fitted to the record.
 
@@ -37,15 +42,26 @@ import numpy as np
 
 from spiralid._checks import integer, one_of
 from spiralid.choices import RIG_PARAMETERS
+from spiralid.fms._zoh import (
+    delay_split,
+    delayed_inputs,
+    delayed_system,
+    discretise_delayed,
+)
 from spiralid.fms.rig import _OUTPUTS, FlexibleManipulator, _continuous, _discrete
 from spiralid.fms.sensors import Sensors
 from spiralid.sysid.models.greybox import GreyBox, Parameter
 from spiralid.sysid.models.greybox_run import lti_run
 
-__all__ = ["GAIN", "RIG_PARAMETERS", "RigGreyBox", "default_parameter"]
+__all__ = ["DELAY", "GAIN", "RIG_PARAMETERS", "RigGreyBox", "default_parameter"]
 
 #: The name of the output gain's parameter (not a field of the rig).
 GAIN = "output_gain"
+#: The name of the input delay's parameter (in ``free``; not a field of the
+#: rig): seconds between the record's input and the rig's torque.
+DELAY = "input_delay"
+# Its default bounds (s): a sample either way at 0.01 s, a common record's.
+_DELAY_BOUNDS = (-0.01, 0.01)
 
 # The derived parameters and the fields they are computed from: freeing one
 # with any of its fields would leave a direction the model cannot see.
@@ -92,7 +108,8 @@ def _zero_preset_high(rig: FlexibleManipulator, name: str) -> float:
 def default_parameter(rig: FlexibleManipulator, name: str) -> Parameter:
     """The free parameter `name` (a key of :data:`RIG_PARAMETERS`) at its
     value on `rig`: bounds a factor 4 either side on a log scale, or from
-    zero up to a scale of the rig where the preset is zero.
+    zero up to a scale of the rig where the preset is zero; the input delay
+    from 0 within 0.01 s either way.
 
     Parameters
     ----------
@@ -107,6 +124,8 @@ def default_parameter(rig: FlexibleManipulator, name: str) -> Parameter:
     """
     one_of(name, "free", RIG_PARAMETERS)
     unit = RIG_PARAMETERS[name]
+    if name == DELAY:
+        return Parameter(name, 0.0, _DELAY_BOUNDS, unit)
     value = _value(rig, name)
     if value is None:
         raise ValueError(
@@ -149,7 +168,10 @@ class RigGreyBox(GreyBox):
         The fields to estimate, each a key of :data:`RIG_PARAMETERS`; a name
         takes :func:`default_parameter`'s value and bounds, a
         :class:`~spiralid.sysid.Parameter` of such a name its own (and with
-        ``free=False`` just sets the field).
+        ``free=False`` just sets the field). ``"input_delay"`` (s) delays
+        the record's input before the rig (negative: an advance, above one
+        sample; fractional delays exact for the held input); the linear
+        kind only.
     rig : FlexibleManipulator, optional
         The rig whose other fields are held and whose values start the
         free ones; default ``FlexibleManipulator()``.
@@ -260,6 +282,12 @@ class RigGreyBox(GreyBox):
         self.kind = (
             "nonlinear" if nonlinear or set(names) & set(_NONLINEAR) else "linear"
         )
+        self._delay_at = names.index(DELAY) if DELAY in names else None
+        if self._delay_at is not None and self.kind == "nonlinear":
+            raise ValueError(
+                "`free`: input_delay needs the linear rig (no friction, no torque "
+                "limit)"
+            )
         self.functions = {}
         self.substeps = rig.friction_substeps
         self.n_inputs, self.n_outputs = 1, len(self.outputs)
@@ -296,6 +324,13 @@ class RigGreyBox(GreyBox):
         if not (np.isfinite(value) and value != 0.0):
             raise ValueError(f"`output_gain` must be finite and nonzero; got {value}")
         return float(value)
+
+    def delay_at(self, values) -> float | None:
+        """The input delay (s) at `values` (every parameter, in order), or
+        None when `free` does not name it (the plain zero-order hold)."""
+        if self._delay_at is None:
+            return None
+        return float(np.asarray(values, dtype=float)[self._delay_at])
 
     def gain_at(self, values) -> float:
         """The output gain at `values` (every parameter, in order)."""
@@ -353,7 +388,8 @@ class RigGreyBox(GreyBox):
         fields_of = self.parameters[: self._n_fields]
         values = np.asarray(values, dtype=float)[: self._n_fields]
         for p, v in zip(fields_of, values, strict=True):
-            (derived if p.name in _DERIVED else fields)[p.name] = float(v)
+            if p.name != DELAY:  # the record's, not the rig's
+                (derived if p.name in _DERIVED else fields)[p.name] = float(v)
         rig = dataclasses.replace(self.rig, **fields)
         if "flexural_rigidity" in derived:
             second_moment = rig.width * rig.thickness**3 / 12.0
@@ -383,7 +419,13 @@ class RigGreyBox(GreyBox):
 
     def discretise(self, values, ts: float) -> tuple[np.ndarray, ...]:
         """The linear rig's exact zero-order hold ``(Ad, Bd, C, D)`` at
-        sample time `ts` for the output."""
+        sample time `ts` for the output; with an input delay, the proper
+        model of the delayed held input (its past inputs as states after
+        the rig's, see :func:`spiralid.fms._zoh.delayed_system`)."""
+        delay = self.delay_at(values)
+        if delay is not None:
+            ad, g0, g1, c, d = self._delayed(values, float(ts))
+            return delayed_system(ad, g0, g1, c, d[:, 0], delay, float(ts))
         s = self._sim_sensors
         ad, bd, c, d, _ = _discrete(
             self.rig_at(values),
@@ -403,6 +445,13 @@ class RigGreyBox(GreyBox):
             k * np.array(d[rows])[:, None],
         )
 
+    def _delayed(self, values, ts: float) -> tuple[np.ndarray, ...]:
+        """``(Ad, G0, G1, C, D)`` of the rig with its input delayed
+        (:func:`spiralid.fms._zoh.discretise_delayed`)."""
+        a, b, c, d = self.matrices(values, ts)
+        ad, g0, g1 = discretise_delayed(a, b[:, 0], ts, self.delay_at(values))
+        return ad, g0, g1, c, d
+
     def simulate(self, values, u, ts: float) -> np.ndarray:
         """The output, shape (N,) (one sensor) or (N, p), over the torque
         `u` from rest, by the rig's own sampled simulation (from another
@@ -418,6 +467,8 @@ class RigGreyBox(GreyBox):
             rig = self.rig_at(values)
         except (TypeError, ValueError):
             return nan
+        if self._delay_at is not None:
+            return self._from_delayed(values, uu, float(ts), nan)
         if self.state_parameters or self._x0_given.any():
             return self._from_state(values, uu, float(ts), nan)
         with np.errstate(all="ignore"):
@@ -445,6 +496,26 @@ class RigGreyBox(GreyBox):
                 return nan
             x0 = self.initial_state(values)
             y = lti_run(ad, bd, c, d, x0, np.ascontiguousarray(uu))
+        return y[:, 0] if self.n_outputs == 1 else y
+
+    def _from_delayed(self, values, uu, ts: float, nan) -> np.ndarray:
+        """The linear rig's run with its input delayed, from the initial
+        state at `values` (the inputs before the record zero): the
+        recursion of :func:`spiralid.fms._zoh.discretise_delayed` on the
+        two shifted input columns."""
+        delay = self.delay_at(values)
+        with np.errstate(all="ignore"):
+            try:
+                ad, g0, g1, c, d = self._delayed(values, ts)
+                shifted = delayed_inputs(uu[:, 0], delay, ts)
+            except (ValueError, np.linalg.LinAlgError):
+                return nan
+            # The output's feedthrough sees u[n-k] on a whole delay, else
+            # u[n-k-1] (the delayed input at the sampling instant).
+            whole = delay_split(delay, ts)[1] == 0.0
+            dd = np.hstack([d, np.zeros_like(d)] if whole else [np.zeros_like(d), d])
+            bd = np.column_stack([g0, g1])
+            y = lti_run(ad, bd, c, dd, self.initial_state(values), shifted)
         return y[:, 0] if self.n_outputs == 1 else y
 
     # -- the modes beside the FEM's ----------------------------------------------

@@ -164,7 +164,15 @@ def _state_and_gain(box: RigGreyBox, values: np.ndarray, data) -> np.ndarray:
     c, d = c / k, d / k
     x0 = box.initial_state(values)
     x0[state_rows] = 0.0
-    forced = lti_run(ad, bd, c, d, x0, u)[:, 0]
+    if box.delay_at(values) is None:
+        forced = lti_run(ad, bd, c, d, x0, u)[:, 0]
+    else:
+        # The delayed model's discrete state holds past inputs: run the
+        # box itself, its estimated state at rest.
+        rest = values.copy()
+        rest[[len(box.parameters) + i for i, p in enumerate(box.state_parameters)
+              if p.free]] = 0.0  # fmt: skip
+        forced = box.simulate(rest, u, float(data.ts)) / k
     free_response = np.zeros((y.size, state_rows.size))
     x = np.eye(ad.shape[0])[:, state_rows]
     for t in range(y.size):
