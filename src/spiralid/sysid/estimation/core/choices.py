@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 
-from spiralid._checks import integer, real
+from spiralid._checks import generator, integer, real
 from spiralid.optim import minimize
 from spiralid.optim.result import OptimiserResult
 
@@ -28,15 +28,11 @@ from ...data import IOData
 from ..narx.subsequences import check_horizon
 
 __all__ = [
-    "choice_result",
-    "decay_range",
     "half_decades",
-    "held_back",
     "held_back_fit",
-    "horizons_checked",
     "int_range",
     "nearest",
-    "run_search",
+    "spiral_choice",
 ]
 
 
@@ -59,7 +55,7 @@ def int_range(value, name: str, minimum: int) -> tuple[int, int]:
     return lo, hi
 
 
-def decay_range(value) -> tuple[float, float]:
+def _decay_range(value) -> tuple[float, float]:
     """`log_decay` checked: a pair of numbers holding a multiple of 0.5."""
     try:
         lo, hi = value
@@ -81,7 +77,7 @@ def half_decades(log_decay: tuple[float, float]) -> tuple[int, int]:
     return math.ceil(2 * log_decay[0]), math.floor(2 * log_decay[1])
 
 
-def horizons_checked(value) -> tuple[int, ...] | None:
+def _horizons(value) -> tuple[int, ...] | None:
     """`horizons` checked: None, or a non-empty sequence of integers >= 2."""
     if value is None:
         return None
@@ -101,14 +97,14 @@ def horizons_checked(value) -> tuple[int, ...] | None:
 
 def held_back_fit(y: np.ndarray, yhat: np.ndarray) -> float:
     """MATLAB's ``compare`` fit in percent (as ``validate``); -inf for a
-    free run that diverged. `y` varies (:func:`held_back` checks it)."""
+    free run that diverged. `y` varies (:func:`_held_back` checks it)."""
     if not np.all(np.isfinite(yhat)):
         return -math.inf
     spread = np.linalg.norm(y - y.mean())
     return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / spread))
 
 
-def held_back(data: IOData, holdback) -> tuple[IOData, np.ndarray]:
+def _held_back(data: IOData, holdback) -> tuple[IOData, np.ndarray]:
     """The training part of `data` and the held-back output, its last
     `holdback` share (checked in (0, 0.5]): at least 2 samples, and an
     output that moves (a fit is scored on it)."""
@@ -152,7 +148,7 @@ def nearest(x, grid) -> tuple[int, ...]:
     )
 
 
-def run_search(
+def _run_search(
     score, grid, choice_of, *, budget: int, rule: str, n_points: int, rng
 ) -> tuple[dict, int, str]:
     """The spiral search over `grid` until `budget` trainings are spent.
@@ -212,12 +208,12 @@ def run_search(
     return trials, calls[0], message
 
 
-def choice_result(trials: dict, calls: int, message: str, t0: float, fields_of):
+def _choice_result(trials: dict, calls: int, message: str, t0: float, fields_of):
     """The search's result: the best choice's ``x`` and ``fit`` (``fun`` =
     ``100 - fit``), every trial as ``(*choice, fit)``, the trainings
     (``nfev``), the search's evaluations (``n_calls``), the seconds since
-    `t0` (``time.perf_counter``) and ``fields_of(best choice)``, the
-    caller's fields (its refit model among them)."""
+    `t0` (``time.perf_counter``) and ``fields_of(best choice)`` (the refit
+    model among them)."""
     key, best = max(trials.items(), key=lambda kv: kv[1])
     fields = fields_of(key)
     return OptimiserResult(
@@ -234,3 +230,93 @@ def choice_result(trials: dict, calls: int, message: str, t0: float, fields_of):
         elapsed=time.perf_counter() - t0,
         **fields,
     )
+
+
+def spiral_choice(
+    data: IOData,
+    grid,
+    structure_of,
+    train,
+    *,
+    largest: str,
+    log_decay,
+    budget,
+    holdback,
+    rule: str,
+    n_points,
+    horizons,
+    rng,
+    normalise=None,
+) -> OptimiserResult:
+    """The spiral's choice of a structure and its decay (and horizon), each
+    candidate trained on the first part of `data` and scored by its free run
+    from rest on the held-back end; the best trained again on all of `data`.
+
+    Parameters
+    ----------
+    data : IOData
+        The estimation record (checked by the caller).
+    grid : sequence of (int, int)
+        Checked inclusive ranges of the structure's coordinates.
+    structure_of : callable
+        ``structure_of(*coords)`` -> the structure of a choice.
+    train : callable
+        ``train(record, structure, decay, horizon, rng)`` -> a fitted model
+        (``horizon`` None without `horizons`).
+    largest : str
+        The ranges named in the message when the largest choice is too long
+        for the samples before the held-back part.
+    log_decay, budget, holdback, rule, n_points, horizons, rng
+        The chooser's arguments (checked here).
+    normalise : callable, optional
+        ``normalise(coords)`` -> the coordinates of the choice they stand
+        for (points of one choice are trained once).
+
+    Returns
+    -------
+    OptimiserResult
+        As :func:`~spiralid.sysid.choose_narx` describes: ``x`` (the
+        coordinates, ``log10 decay``, then the horizon), ``fun``, ``fit``,
+        ``model``, ``structure``, ``decay``, ``horizon``, ``trials``,
+        ``nfev``, ``n_calls``, ``elapsed``.
+    """
+    t0 = time.perf_counter()
+    log_decay = _decay_range(log_decay)
+    budget = integer(budget, "budget", 1)
+    n_points = integer(n_points, "n_points", 2)
+    horizons = _horizons(horizons)
+    gen = generator(rng)
+    part, y_end = _held_back(data, holdback)
+    # Any choice in the ranges may be trained: the largest must fit before
+    # the search starts, not fail at whichever point first reaches it.
+    try:
+        structure_of(*(hi for _, hi in grid)).check_length(part, "data")
+    except ValueError as e:
+        raise ValueError(
+            f"{e} before the held-back part (`holdback` = {holdback!r}), for the "
+            f"largest choice of {largest}: narrow them, lower `holdback` or give "
+            "a longer record"
+        ) from None
+    k = len(grid)
+    full = [*grid, half_decades(log_decay)]
+    if horizons is not None:
+        full.append((0, len(horizons) - 1))
+
+    def choice_of(point: tuple) -> tuple:
+        coords = point[:k] if normalise is None else normalise(point[:k])
+        tail = () if horizons is None else (horizons[point[k + 1]],)
+        return (*coords, point[k] / 2, *tail)
+
+    def fields(key: tuple, record: IOData = data) -> dict:
+        st, horizon = structure_of(*key[:k]), None if horizons is None else key[k + 1]
+        model = train(record, st, 10.0 ** key[k], horizon, gen)
+        return dict(model=model, structure=st, decay=10.0 ** key[k], horizon=horizon)
+
+    def score(key: tuple) -> float:
+        model = fields(key, part)["model"]
+        return held_back_fit(y_end, model.simulate(data.u)[part.n :])
+
+    trials, calls, message = _run_search(
+        score, full, choice_of, budget=budget, rule=rule, n_points=n_points, rng=gen
+    )
+    return _choice_result(trials, calls, message, t0, fields)

@@ -27,24 +27,12 @@ coordinates the spiral rule has little to learn from.
 
 from __future__ import annotations
 
-import time
-
-from spiralid._checks import generator, integer
+from spiralid._checks import integer
 from spiralid.optim.result import OptimiserResult
 
 from ...data import IOData
 from ...models.narx import NARX
-from ..core.choices import (
-    choice_result,
-    decay_range,
-    half_decades,
-    held_back,
-    held_back_fit,
-    horizons_checked,
-    int_range,
-    nearest,
-    run_search,
-)
+from ..core.choices import half_decades, int_range, nearest, spiral_choice
 from ..core.identify import identify
 
 __all__ = ["choose_narx", "round_choice"]
@@ -167,66 +155,33 @@ def choose_narx(
     >>> res.nfev <= 3, res.model.structure == res.structure
     (True, True)
     """
-    t0 = time.perf_counter()
     if not isinstance(data, IOData):
         raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     nk = integer(nk, "nk", 0)
     lags = int_range(lags, "lags", 1)
     hidden = int_range(hidden, "hidden", 1)
-    log_decay = decay_range(log_decay)
-    budget = integer(budget, "budget", 1)
-    n_points = integer(n_points, "n_points", 2)
     integrator = integer(integrator, "integrator", 0)
-    horizons = horizons_checked(horizons)
-    gen = generator(rng)
-    train, y_end = held_back(data, holdback)
-    split = train.n
 
     def structure(n: int, h: int) -> NARX:
         return NARX(n, n, nk, hidden=(h,), integrator=integrator)
 
-    # Any choice in the ranges may be trained: the largest must fit before
-    # the search starts, not fail at whichever point first reaches it.
-    try:
-        structure(lags[1], hidden[1]).check_length(train, "data")
-    except ValueError as e:
-        raise ValueError(
-            f"{e} before the held-back part (`holdback` = {holdback!r}), for the "
-            "largest choice of `lags` and `hidden`: narrow them, lower "
-            "`holdback` or give a longer record"
-        ) from None
+    def train(record: IOData, st: NARX, decay: float, horizon, gen):
+        training = {} if horizon is None else {"training": "subsequences"}
+        if horizon is not None:
+            training["horizon"] = horizon
+        return identify(record, st, method="oe", decay=decay, rng=gen, **training)
 
-    grid = [lags, hidden, half_decades(log_decay)]
-    if horizons is not None:
-        grid.append((0, len(horizons) - 1))
-
-    def choice_of(point: tuple) -> tuple:
-        n, h, k = point[:3]
-        return (n, h, k / 2) + (() if horizons is None else (horizons[point[3]],))
-
-    def fit(record: IOData, key: tuple):
-        n, h, d = key[:3]
-        training = {} if horizons is None else {"training": "subsequences"}
-        if horizons is not None:
-            training["horizon"] = key[3]
-        return identify(
-            record, structure(n, h), method="oe", decay=10.0**d, rng=gen, **training
-        )
-
-    def score(key: tuple) -> float:
-        return held_back_fit(y_end, fit(train, key).simulate(data.u)[split:])
-
-    trials, calls, message = run_search(
-        score, grid, choice_of, budget=budget, rule=rule, n_points=n_points, rng=gen
+    return spiral_choice(
+        data,
+        [lags, hidden],
+        structure,
+        train,
+        largest="`lags` and `hidden`",
+        log_decay=log_decay,
+        budget=budget,
+        holdback=holdback,
+        rule=rule,
+        n_points=n_points,
+        horizons=horizons,
+        rng=rng,
     )
-
-    def refit(key: tuple) -> dict:
-        n, h, d = key[:3]
-        return dict(
-            model=fit(data, key),
-            structure=structure(n, h),
-            decay=10.0**d,
-            horizon=None if horizons is None else key[3],
-        )
-
-    return choice_result(trials, calls, message, t0, refit)

@@ -21,23 +21,11 @@ points that round to a choice already trained cost none.
 
 from __future__ import annotations
 
-import time
-
-from spiralid._checks import generator, integer
 from spiralid.optim.result import OptimiserResult
 
 from ...data import IOData
 from ...models.neural_state_space import NeuralStateSpace
-from ..core.choices import (
-    choice_result,
-    decay_range,
-    half_decades,
-    held_back,
-    held_back_fit,
-    horizons_checked,
-    int_range,
-    run_search,
-)
+from ..core.choices import int_range, spiral_choice
 from ..core.identify import identify
 
 __all__ = ["choose_state_space"]
@@ -88,21 +76,12 @@ def choose_state_space(
         Inclusive range of the encoder's window ``w`` (>= 1); a candidate's
         window is ``max(w, n)``, as the encoder needs at least ``n``
         samples, so the range must reach ``order[0]``.
-    log_decay : (float, float)
-        Inclusive range of ``log10`` of the weight decay, searched in steps
-        of 0.5.
-    budget : int
-        Trainings at most in the search, 1 or more (a point that rounds to a
-        choice already trained costs none), beside the final one. With 1,
-        the choice is the search's first point, uniform in the ranges.
-    holdback : float
-        Share of `data` held back to score the candidates, in (0, 0.5]; it
-        must hold at least 2 samples, and the output must vary over them.
-    rule : str
-        The spiral rule of :func:`spiralid.optim.minimize`.
-    n_points : int
-        The search's uniform first points, 2 or more (no more than `budget`
-        are drawn, but never fewer than 2).
+    log_decay, budget, holdback, rule, n_points : as in choose_narx
+        The range of ``log10`` decay (searched in half decades); the
+        trainings at most beside the final one (>= 1; a point that rounds
+        to a choice already trained costs none); the share of `data` held
+        back, in (0, 0.5]; the spiral rule; the search's first points
+        (>= 2), as :func:`~spiralid.sysid.choose_narx` has them.
     horizons : sequence of int, optional
         Train every candidate on subsequences of one fixed length
         (``identify``'s ``horizon``) and search it among these (each >= 2)
@@ -114,22 +93,18 @@ def choose_state_space(
     Returns
     -------
     OptimiserResult
-        ``model`` (the best choice trained on the whole record),
-        ``structure``, ``decay``, ``horizon`` (None without `horizons`),
-        ``x`` (``[n, h, window, log10 decay]``, then the horizon), ``fun``
-        (the best held-back fit's shortfall, ``100 - fit``), ``fit``,
-        ``trials`` (one ``(n, h, window, log10 decay, held-back fit %)``
-        per training, in order; with `horizons`, the horizon before the
-        fit), ``nfev`` (trainings, the final one excluded), ``n_calls``
-        (the search's evaluations, repeats included), ``elapsed``.
+        As :func:`~spiralid.sysid.choose_narx`'s, with ``x`` = ``[n, h,
+        window, log10 decay]`` (then the horizon) and one ``(n, h, window,
+        log10 decay, held-back fit %)`` per training in ``trials`` (the
+        horizon before the fit with `horizons`); ``model`` is the best
+        choice trained on the whole record.
 
     Raises
     ------
     ValueError
-        Before any training, for an argument out of its range, a held-back
-        part of fewer than 2 samples or with a constant output, or ranges
-        whose largest choice is too long for the samples before the
-        held-back part.
+        Before any training, in one line naming the argument (as
+        ``choose_narx``); for the largest order and window too long for the
+        samples before the held-back part, naming `data`.
 
     Examples
     --------
@@ -143,64 +118,32 @@ def choose_state_space(
     >>> res.nfev <= 2, res.model.structure == res.structure
     (True, True)
     """
-    t0 = time.perf_counter()
     if not isinstance(data, IOData):
         raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     order = int_range(order, "order", 1)
     hidden = int_range(hidden, "hidden", 1)
     window = _window_range(window, order)
-    log_decay = decay_range(log_decay)
-    budget = integer(budget, "budget", 1)
-    n_points = integer(n_points, "n_points", 2)
-    horizons = horizons_checked(horizons)
-    gen = generator(rng)
-    train, y_end = held_back(data, holdback)
-    split = train.n
 
     def structure(n: int, h: int, w: int) -> NeuralStateSpace:
         return NeuralStateSpace(n, hidden=(h,), window=max(w, n))
 
-    # The longest window (and the largest order) must fit before the search
-    # starts, not fail at whichever point first reaches it.
-    try:
-        structure(order[1], hidden[1], window[1]).check_length(train, "data")
-    except ValueError as e:
-        raise ValueError(
-            f"{e} before the held-back part (`holdback` = {holdback!r}), for the "
-            "largest choice of `order` and `window`: narrow them, lower "
-            "`holdback` or give a longer record"
-        ) from None
+    def train(record: IOData, st: NeuralStateSpace, decay: float, horizon, gen):
+        options = {} if horizon is None else {"horizon": horizon}
+        return identify(record, st, method="oe", decay=decay, rng=gen, **options)
 
-    grid = [order, hidden, window, half_decades(log_decay)]
-    if horizons is not None:
-        grid.append((0, len(horizons) - 1))
-
-    def choice_of(point: tuple) -> tuple:
-        n, h, w, k = point[:4]
-        key = (n, h, max(w, n), k / 2)
-        return key + (() if horizons is None else (horizons[point[4]],))
-
-    def fit(record: IOData, key: tuple):
-        n, h, w, d = key[:4]
-        options = {} if horizons is None else {"horizon": key[4]}
-        return identify(
-            record, structure(n, h, w), method="oe", decay=10.0**d, rng=gen, **options
-        )
-
-    def score(key: tuple) -> float:
-        return held_back_fit(y_end, fit(train, key).simulate(data.u)[split:])
-
-    trials, calls, message = run_search(
-        score, grid, choice_of, budget=budget, rule=rule, n_points=n_points, rng=gen
+    return spiral_choice(
+        data,
+        [order, hidden, window],
+        structure,
+        train,
+        largest="`order` and `window`",
+        log_decay=log_decay,
+        budget=budget,
+        holdback=holdback,
+        rule=rule,
+        n_points=n_points,
+        horizons=horizons,
+        rng=rng,
+        # A window below the order is the order's: one choice, one training.
+        normalise=lambda c: (c[0], c[1], max(c[2], c[0])),
     )
-
-    def refit(key: tuple) -> dict:
-        n, h, w, d = key[:4]
-        return dict(
-            model=fit(data, key),
-            structure=structure(n, h, w),
-            decay=10.0**d,
-            horizon=None if horizons is None else key[4],
-        )
-
-    return choice_result(trials, calls, message, t0, refit)
