@@ -26,12 +26,14 @@ The spiral's choice (``--choose``): ``choose_state_space`` over the order,
 hidden units, encoder window and weight decay (``--budget`` trainings on
 the estimation record's first three quarters, each scored on its last
 quarter, then the choice trained on the whole record), one row a seed;
-with ``--rig``, the same on the rig's estimation part, scored as above.
+``--blocks``: each candidate trained on the whole record and judged on
+its training's own held-back blocks (``holdback="blocks"``); with
+``--rig``, the same on the rig's estimation part, scored as above.
 
 Seconds are processor time of this process (the machine may be shared).
 
 Usage: ``python benchmarks/cascaded_tanks_nss.py [--seeds 0-4] [--narx]
-[--choose [--budget 8]] [--rig [--order 8] [--window 16]]``
+[--choose [--budget 8] [--blocks]] [--rig [--order 8] [--window 16]]``
 """
 
 from __future__ import annotations
@@ -77,7 +79,7 @@ def choice_row(seed, res, cpu: float, score: str) -> None:
     )
 
 
-def choose(seeds, est, budget: int, scored, **ranges) -> list[float]:
+def choose(seeds, est, budget: int, scored, **options) -> list[float]:
     """The spiral's choice on `est` for each seed: one row each (the
     choice, its held-back fit on the estimation record's end, ``scored(model)``
     on the record no training saw, trainings, processor s), then every
@@ -88,7 +90,7 @@ def choose(seeds, est, budget: int, scored, **ranges) -> list[float]:
     scores, trials = [], []
     for seed in seeds:
         t0 = time.process_time()
-        res = choose_state_space(est, budget=budget, rng=seed, **ranges)
+        res = choose_state_space(est, budget=budget, rng=seed, **options)
         cpu = time.process_time() - t0
         scores.append(scored(res.model))
         trials.append(res.trials)
@@ -102,7 +104,7 @@ def choose(seeds, est, budget: int, scored, **ranges) -> list[float]:
     return scores
 
 
-def rig_choice(seeds, budget: int) -> None:
+def rig_choice(seeds, budget: int, holdback) -> None:
     from spiralid.fms import nonlinear_rig, paper_experiment
 
     print("## Nonlinear rig, end acceleration: the spiral's choice, validation fit %")
@@ -122,6 +124,7 @@ def rig_choice(seeds, budget: int) -> None:
             # Order 8 is the ARX's; the family's window needed 16-24 here.
             order=(4, 10),
             window=(8, 32),
+            holdback=holdback,
         )
 
 
@@ -165,9 +168,13 @@ def main() -> None:
     ap.add_argument("--window", type=int, default=None, help="its encoder's window")
     ap.add_argument("--choose", action="store_true", help="the spiral's choice")
     ap.add_argument("--budget", type=int, default=8, help="its trainings")
+    ap.add_argument(
+        "--blocks", action="store_true", help="judge on the trainings' blocks"
+    )
     args = ap.parse_args()
+    holdback = "blocks" if args.blocks else 0.25
     if args.rig and args.choose:
-        rig_choice(args.seeds, args.budget)
+        rig_choice(args.seeds, args.budget, holdback)
         return
     if args.rig:
         rig(args.seeds, args.order, args.window)

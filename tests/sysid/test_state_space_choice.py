@@ -151,3 +151,38 @@ def test_data_must_be_a_record():
 def test_it_is_exported_with_choose_narx():
     assert sid.sysid.choose_state_space is choose_state_space
     assert "choose_state_space" in sid.sysid.__all__
+
+
+def test_judged_on_its_own_blocks_the_best_trained_candidate_is_returned(
+    record, monkeypatch
+):
+    trained = []
+
+    def recording(data, structure, **options):
+        model = identify(data, structure, **options)
+        trained.append((data.n, options["holdout"], model))
+        return model
+
+    monkeypatch.setattr(nss_choice, "identify", recording)
+    res = choose_state_space(
+        record, **BOX, holdback="blocks", budget=2, n_points=2, rng=1
+    )
+    # Every training on the whole record, none after the search.
+    assert [(n, share) for n, share, _ in trained] == [(200, 0.2)] * res.nfev
+    # The held-back blocks worked by hand: a fifth of 200 samples in 10
+    # blocks of 4, each centred on the middle of a tenth of the record.
+    held = np.zeros(200, dtype=bool)
+    for i in range(10):
+        held[20 * i + 8 : 20 * i + 12] = True
+    fits = [
+        fit_percent(record.y[held], m.simulate(record.u)[held]) for *_, m in trained
+    ]
+    for (*_, f), g in zip(res.trials, fits, strict=True):
+        assert f == pytest.approx(g, abs=1e-9)
+    assert res.model is trained[int(np.argmax(fits))][2]
+    assert res.fit == pytest.approx(max(fits), abs=1e-9)
+
+
+def test_a_holdback_neither_a_share_nor_blocks_is_refused_by_name(record):
+    with pytest.raises((TypeError, ValueError), match="`holdback`"):
+        choose_state_space(record, **BOX, holdback="end")

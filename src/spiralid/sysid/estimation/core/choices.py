@@ -247,6 +247,7 @@ def spiral_choice(
     horizons,
     rng,
     normalise=None,
+    judge=None,
 ) -> OptimiserResult:
     """The spiral's choice of a structure and its decay (and horizon), each
     candidate trained on the first part of `data` and scored by its free run
@@ -271,6 +272,11 @@ def spiral_choice(
     normalise : callable, optional
         ``normalise(coords)`` -> the coordinates of the choice they stand
         for (points of one choice are trained once).
+    judge : callable, optional
+        ``judge(model)`` -> the held-back fit % of a model trained on all
+        of `data` (its own held-back samples): every candidate is then
+        trained on the whole record and the best returned as trained, no
+        refit; `holdback` is not used.
 
     Returns
     -------
@@ -286,16 +292,18 @@ def spiral_choice(
     n_points = integer(n_points, "n_points", 2)
     horizons = _horizons(horizons)
     gen = generator(rng)
-    part, y_end = _held_back(data, holdback)
+    part, y_end = (data, None) if judge else _held_back(data, holdback)
     # Any choice in the ranges may be trained: the largest must fit before
     # the search starts, not fail at whichever point first reaches it.
     try:
         structure_of(*(hi for _, hi in grid)).check_length(part, "data")
     except ValueError as e:
+        where = (
+            "" if judge else f" before the held-back part (`holdback` = {holdback!r})"
+        )
         raise ValueError(
-            f"{e} before the held-back part (`holdback` = {holdback!r}), for the "
-            f"largest choice of {largest}: narrow them, lower `holdback` or give "
-            "a longer record"
+            f"{e}{where}, for the largest choice of {largest}: narrow them, "
+            "lower `holdback` or give a longer record"
         ) from None
     k = len(grid)
     full = [*grid, half_decades(log_decay)]
@@ -312,11 +320,17 @@ def spiral_choice(
         model = train(record, st, 10.0 ** key[k], horizon, gen)
         return dict(model=model, structure=st, decay=10.0 ** key[k], horizon=horizon)
 
+    kept: dict[tuple, dict] = {}
+
     def score(key: tuple) -> float:
-        model = fields(key, part)["model"]
-        return held_back_fit(y_end, model.simulate(data.u)[part.n :])
+        kept[key] = fields(key, part)
+        if judge:
+            return judge(kept[key]["model"])
+        return held_back_fit(y_end, kept[key]["model"].simulate(data.u)[part.n :])
 
     trials, calls, message = _run_search(
         score, full, choice_of, budget=budget, rule=rule, n_points=n_points, rng=gen
     )
-    return _choice_result(trials, calls, message, t0, fields)
+    # Judged on its own held-back samples, the best is already trained on
+    # the whole record.
+    return _choice_result(trials, calls, message, t0, kept.get if judge else fields)

@@ -21,14 +21,23 @@ points that round to a choice already trained cost none.
 
 from __future__ import annotations
 
+import numpy as np
+
 from spiralid.optim.result import OptimiserResult
 
 from ...data import IOData
 from ...models.neural_state_space import NeuralStateSpace
-from ..core.choices import int_range, spiral_choice
+from ..core.choices import held_back_fit, int_range, spiral_choice
 from ..core.identify import identify
+from .training import _hold_mask
 
-__all__ = ["choose_state_space"]
+#: ``holdback=BLOCKS``: judge each candidate on its own training's held-back
+#: blocks.
+BLOCKS = "blocks"
+# The share the trainings hold back in blocks (identify's default).
+_HOLDOUT = 0.2
+
+__all__ = ["BLOCKS", "choose_state_space"]
 
 
 def _window_range(window, order: tuple[int, int]) -> tuple[int, int]:
@@ -52,7 +61,7 @@ def choose_state_space(
     window: tuple[int, int] = (2, 16),
     log_decay: tuple[float, float] = (-5.0, -1.0),
     budget: int = 8,
-    holdback: float = 0.25,
+    holdback: float | str = 0.25,
     rule: str = "learned-metric",
     n_points: int = 6,
     horizons: tuple[int, ...] | None = None,
@@ -76,12 +85,19 @@ def choose_state_space(
         Inclusive range of the encoder's window ``w`` (>= 1); a candidate's
         window is ``max(w, n)``, as the encoder needs at least ``n``
         samples, so the range must reach ``order[0]``.
-    log_decay, budget, holdback, rule, n_points : as in choose_narx
+    log_decay, budget, rule, n_points : as in choose_narx
         The range of ``log10`` decay (searched in half decades); the
         trainings at most beside the final one (>= 1; a point that rounds
-        to a choice already trained costs none); the share of `data` held
-        back, in (0, 0.5]; the spiral rule; the search's first points
-        (>= 2), as :func:`~spiralid.sysid.choose_narx` has them.
+        to a choice already trained costs none); the spiral rule; the
+        search's first points (>= 2), as :func:`~spiralid.sysid.choose_narx`
+        has them.
+    holdback : float or "blocks"
+        The share of `data` held back at its end to score the candidates,
+        in (0, 0.5], as in ``choose_narx``. ``"blocks"``: every candidate
+        is trained on the whole record and scored by its free run from
+        rest on the blocks its own training held back for early stopping
+        (a fifth of the record in 10 blocks spread over it); the best is
+        returned as trained, with no refit.
     horizons : sequence of int, optional
         Train every candidate on subsequences of one fixed length
         (``identify``'s ``horizon``) and search it among these (each >= 2)
@@ -129,7 +145,9 @@ def choose_state_space(
 
     def train(record: IOData, st: NeuralStateSpace, decay: float, horizon, gen):
         options = {} if horizon is None else {"horizon": horizon}
-        return identify(record, st, method="oe", decay=decay, rng=gen, **options)
+        return identify(
+            record, st, method="oe", decay=decay, holdout=_HOLDOUT, rng=gen, **options
+        )
 
     return spiral_choice(
         data,
@@ -146,4 +164,18 @@ def choose_state_space(
         rng=rng,
         # A window below the order is the order's: one choice, one training.
         normalise=lambda c: (c[0], c[1], max(c[2], c[0])),
+        judge=_blocks_judge(data) if holdback == BLOCKS else None,
     )
+
+
+def _blocks_judge(data: IOData):
+    """The fit % of a model's free run from rest on the blocks its training
+    held back (refused in one line when the output is constant there)."""
+    held = _hold_mask(data.n, _HOLDOUT)
+    y = data.y[held]
+    if np.ptp(y) == 0.0:
+        raise ValueError(
+            "`holdback` = 'blocks': the output is constant over the held-back "
+            "blocks of `data`; no variance to score a fit against"
+        )
+    return lambda model: held_back_fit(y, model.simulate(data.u)[held])
