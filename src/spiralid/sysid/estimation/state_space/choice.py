@@ -124,13 +124,17 @@ def choose_state_space(
 
     Examples
     --------
+    A first-order lag behind a saturation, 400 samples:
+
     >>> import numpy as np
-    >>> from scipy.signal import lfilter
     >>> u = np.random.default_rng(0).standard_normal(400)
-    >>> y = np.tanh(lfilter([0.0, 0.5], [1.0, -0.8], u))
-    >>> res = choose_state_space(IOData(u, y, ts=0.01), order=(1, 2),
-    ...                          hidden=(1, 3), window=(2, 4), budget=2,
-    ...                          n_points=2, horizons=(50,), rng=0)
+    >>> x = np.zeros(401)
+    >>> for t in range(400):
+    ...     x[t + 1] = 0.8 * x[t] + 0.5 * u[t]
+    >>> data = IOData(u, np.tanh(x[:-1]), ts=0.01)
+    >>> res = choose_state_space(data, order=(1, 2), hidden=(1, 3),
+    ...                          window=(2, 4), budget=2, n_points=2,
+    ...                          horizons=(50,), rng=0)
     >>> res.nfev <= 2, res.model.structure == res.structure
     (True, True)
     """
