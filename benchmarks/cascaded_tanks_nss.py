@@ -184,7 +184,11 @@ def main() -> None:
     if args.choose:
         print("## Cascaded Tanks, the spiral's choice: test-record RMS (V)")
         choose(
-            args.seeds, est, args.budget, lambda m: tanks_rms(m.simulate(test.u), test)
+            args.seeds,
+            est,
+            args.budget,
+            lambda m: tanks_rms(m.simulate(test.u), test),
+            holdback=holdback,
         )
         return
     print("## Cascaded Tanks: test-record RMS (V), processor s per fit")
