@@ -209,7 +209,8 @@ def grid_choice(est: IOData, k: int, seed: int, trainings: int):
 def random_choice(est: IOData, k: int, seed: int, trainings: int):
     """`trainings` distinct uniform choices in choose_narx's box, each
     scored as choose_narx scores them; the best refitted."""
-    from spiralid.sysid.estimation.narx.choice import _held_back_fit, round_choice
+    from spiralid.sysid.estimation.core.choices import held_back_fit as _held_back_fit
+    from spiralid.sysid.estimation.narx.choice import round_choice
 
     rng = np.random.default_rng(seed)
     train, end = _split(est)

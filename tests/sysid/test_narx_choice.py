@@ -120,7 +120,7 @@ def test_data_must_be_a_record():
 
 
 def test_the_horizon_is_searched_with_training_on_subsequences(second_order):
-    from spiralid.sysid.estimation.narx.choice import _held_back_fit
+    from spiralid.sysid.estimation.core.choices import held_back_fit as _held_back_fit
 
     res = choose_narx(
         second_order, **BOX, horizons=(10, 40), budget=4, n_points=3, rng=0

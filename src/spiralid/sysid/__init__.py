@@ -17,6 +17,7 @@ from .estimation.narx.choice import choose_narx as choose_narx
 from .estimation.pareto.identify import ParetoIdentification as ParetoIdentification
 from .estimation.pareto.identify import identify_pareto as identify_pareto
 from .estimation.shared.subspace import subspace_denominator as subspace_denominator
+from .estimation.state_space.choice import choose_state_space as choose_state_space
 from .models.arx import ARX as ARX
 from .models.arx import arx_least_squares as arx_least_squares
 from .models.files import load_model as load_model
@@ -110,6 +111,7 @@ __all__ = [
     "choose",
     "choose_narx",
     "choose_order",
+    "choose_state_space",
     "default_bounds",
     "find_resonances",
     "fit_percent",

@@ -1,1 +1,2 @@
-"""Estimation of the neural state-space family (:mod:`.training`)."""
+"""Estimation of the neural state-space family (:mod:`.training`) and the
+spiral's choice of its size (:mod:`.choice`)."""
