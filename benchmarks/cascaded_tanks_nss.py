@@ -55,7 +55,7 @@ def row(label: str, scores, cpu=None) -> None:
     print(f"| {label} | {cells} | {np.median(scores):.3f} | {seconds} |", flush=True)
 
 
-def rig(seeds, order: int, window: int | None) -> None:
+def rig(seeds, order: int, window: int | None, free_run: bool = False) -> None:
     from spiralid.fms import nonlinear_rig, paper_experiment
 
     print("## Nonlinear rig, end acceleration: validation fit %")
@@ -69,7 +69,11 @@ def rig(seeds, order: int, window: int | None) -> None:
         arx = identify(est, ARX(8, 8, 0), rng=seed)
         t0 = time.process_time()
         nss = identify(
-            est, NeuralStateSpace(order, window=window), method="oe", rng=seed
+            est,
+            NeuralStateSpace(order, window=window),
+            method="oe",
+            rng=seed,
+            free_run=free_run,
         )
         cpu = time.process_time() - t0
         fa, fl, fn = (
@@ -93,9 +97,12 @@ def main() -> None:
     ap.add_argument("--rig", action="store_true", help="the rig's table only")
     ap.add_argument("--order", type=int, default=8, help="the rig's NSS order")
     ap.add_argument("--window", type=int, default=None, help="its encoder's window")
+    ap.add_argument(
+        "--free-run", action="store_true", help="the NSS's last stage on the free run"
+    )
     args = ap.parse_args()
     if args.rig:
-        rig(args.seeds, args.order, args.window)
+        rig(args.seeds, args.order, args.window, args.free_run)
         return
     raw = cascaded_tanks()
     est, test = raw.detrend(), cascaded_tanks("test").detrend(like=raw)
@@ -107,7 +114,13 @@ def main() -> None:
     rest, measured, linear, cpu = [], [], [], []
     for seed in args.seeds:
         t0 = time.process_time()
-        model = identify(est, NeuralStateSpace(3, hidden=(8,)), method="oe", rng=seed)
+        model = identify(
+            est,
+            NeuralStateSpace(3, hidden=(8,)),
+            method="oe",
+            rng=seed,
+            free_run=args.free_run,
+        )
         cpu.append(time.process_time() - t0)
         rest.append(tanks_rms(model.simulate(test.u), test))
         measured.append(tanks_rms(model.simulate(test.u, y0=test.y), test))
