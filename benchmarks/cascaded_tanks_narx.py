@@ -11,7 +11,9 @@ rows: the linear model by output error (``ARX(2, 2, 1)``, method
 (free-run training, then on subsequences), by ``"oe"`` on the free run,
 and by ``"oe"`` on subsequences (``training="subsequences"``: the default
 held-back share in 10 blocks; and ``holdout=0``, 30 rounds a stage, no
-early stopping).
+early stopping); and, with ``--rows default-none,oe-sub-none``, the
+default method and ``"oe"`` on subsequences with ``refit="none"`` (the
+early-stopped network without the replay on the whole record).
 
 Nonlinear rig (``--rig``): the paper's experiment on the nonlinear rig,
 end acceleration, estimation on the first two thirds, validation fit on
@@ -56,6 +58,16 @@ ROWS = {
         {"training": "subsequences"},
     ),
     "oe-sub": ("NARX by oe, subsequences", lambda: NARX(2, 2, 1, hidden=(8,)), SUB),
+    "default-none": (
+        "NARX, default method, refit='none'",
+        lambda: NARX(2, 2, 1, hidden=(8,)),
+        {"refit": "none"},
+    ),
+    "oe-sub-none": (
+        "NARX by oe, subsequences, refit='none'",
+        lambda: NARX(2, 2, 1, hidden=(8,)),
+        {**SUB, "refit": "none"},
+    ),
     "oe-sub-all": (
         "NARX by oe, subsequences, holdout=0",
         lambda: NARX(2, 2, 1, hidden=(8,)),

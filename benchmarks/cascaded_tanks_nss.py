@@ -128,7 +128,7 @@ def rig_choice(seeds, budget: int, holdback) -> None:
         )
 
 
-def rig(seeds, order: int, window: int | None) -> None:
+def rig(seeds, order: int, window: int | None, free_run: bool = False) -> None:
     from spiralid.fms import nonlinear_rig, paper_experiment
 
     print("## Nonlinear rig, end acceleration: validation fit %")
@@ -142,7 +142,11 @@ def rig(seeds, order: int, window: int | None) -> None:
         arx = identify(est, ARX(8, 8, 0), rng=seed)
         t0 = time.process_time()
         nss = identify(
-            est, NeuralStateSpace(order, window=window), method="oe", rng=seed
+            est,
+            NeuralStateSpace(order, window=window),
+            method="oe",
+            rng=seed,
+            free_run=free_run,
         )
         cpu = time.process_time() - t0
         fa, fl, fn = (
@@ -171,13 +175,16 @@ def main() -> None:
     ap.add_argument(
         "--blocks", action="store_true", help="judge on the trainings' blocks"
     )
+    ap.add_argument(
+        "--free-run", action="store_true", help="the NSS's last stage on the free run"
+    )
     args = ap.parse_args()
     holdback = "blocks" if args.blocks else 0.25
     if args.rig and args.choose:
         rig_choice(args.seeds, args.budget, holdback)
         return
     if args.rig:
-        rig(args.seeds, args.order, args.window)
+        rig(args.seeds, args.order, args.window, args.free_run)
         return
     raw = cascaded_tanks()
     est, test = raw.detrend(), cascaded_tanks("test").detrend(like=raw)
@@ -199,7 +206,13 @@ def main() -> None:
     rest, measured, linear, cpu = [], [], [], []
     for seed in args.seeds:
         t0 = time.process_time()
-        model = identify(est, NeuralStateSpace(3, hidden=(8,)), method="oe", rng=seed)
+        model = identify(
+            est,
+            NeuralStateSpace(3, hidden=(8,)),
+            method="oe",
+            rng=seed,
+            free_run=args.free_run,
+        )
         cpu.append(time.process_time() - t0)
         rest.append(tanks_rms(model.simulate(test.u), test))
         measured.append(tanks_rms(model.simulate(test.u, y0=test.y), test))

@@ -16,8 +16,14 @@ The default setting (identify's own run) is printed first. Settings are
 ``n_inits`` (the linear start with this many Glorot draws of the hidden
 weights, drawn after the search).
 
+With ``--refit`` each seed also gets the row ``refit=none``: the same
+run's early-stopped network as trained on the training part, without the
+replay on the whole record (``identify(..., refit="none")``, contained by
+the linear start as identify contains it), from the same search and
+polish, so it costs no second fit.
+
 Usage: ``python benchmarks/narx_stopping.py --seeds 4-7 [--record "nonlinear
-acc"] [--settings "default=max_rounds:50 long=max_rounds:500"]``
+acc"] [--settings "default=max_rounds:50 long=max_rounds:500"] [--refit]``
 """
 
 from __future__ import annotations
@@ -69,11 +75,15 @@ def main() -> None:
         default="",
         help="space-separated name=key:value,... (see the module docstring)",
     )
+    ap.add_argument(
+        "--refit", action="store_true", help="add the refit=none row (same run)"
+    )
     args = ap.parse_args()
     settings = parse_settings(args.settings)
     nonlinear, out, k = RECORDS[args.record]
     warnings.simplefilter("ignore")
     real_train = narx_mod._train
+    real_stopped = narx_mod._early_stopped
     real_polish = narx_problem.NARXProblem.polish
     log: list = []
     captured: dict = {}
@@ -116,12 +126,19 @@ def main() -> None:
             captured["rounds"] = "/".join(str(r) for held, r, _ in log if held)
             return res
 
+        def stopped(problem, starts, predictor, options):
+            out = real_stopped(problem, starts, predictor, options)
+            captured["stopped"] = out
+            return out
+
         narx_mod._train = capture
+        narx_mod._early_stopped = stopped
         st = NARX(7 if k else 8, 8, 0, integrator=k)
         try:
             model = identify(est, st, rng=seed)
         finally:
             narx_mod._train = real_train
+            narx_mod._early_stopped = real_stopped
         fn = fit_percent(val.y, model.simulate(data.u)[est.n :])
         print(
             f"| {seed} | default | {fa:.2f} | {fn:.2f} | {fn - fa:+.2f} | "
@@ -131,6 +148,20 @@ def main() -> None:
             f"{captured['train_s']:.0f} |",
             flush=True,
         )
+        if args.refit:
+            p, start, schedule = captured["stopped"]
+            p, kept = narx_mod._contain(
+                captured["problem"], p, captured["linear"], captured["predictor"]
+            )
+            m = dataclasses.replace(model, params=p)
+            fn = fit_percent(val.y, m.simulate(data.u)[est.n :])
+            print(
+                f"| {seed} | refit=none | {fa:.2f} | {fn:.2f} | {fn - fa:+.2f} | "
+                f"{target:.2f} | {'yes' if fn >= target else 'no'} | "
+                f"{'linear' if kept else start} | "
+                f"{sum(r for _, r in schedule)} |",
+                flush=True,
+            )
         for name, opts in settings.items():
             problem = captured["problem"]
             problem.rng = copy.deepcopy(captured["rng"])

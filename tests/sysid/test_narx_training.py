@@ -96,6 +96,7 @@ def test_spiral_takes_the_early_stopping_options():
         ("patience_share", float("nan"), "`patience_share`"),
         ("max_rounds", 0, "`max_rounds`"),
         ("patience", 0, "`patience`"),
+        ("refit", "twice", "`refit`"),
     ],
 )
 def test_bad_early_stopping_options_are_one_line_errors(option, value, match):
@@ -149,3 +150,31 @@ def test_early_stopping_starts_from_the_training_parts_linear_model():
         theta = np.asarray(arx.theta)
         assert np.allclose(params, st.from_arx(theta[:2], theta[2:], problem.scaling))
     assert not np.allclose(train, whole)
+
+
+def test_without_the_refit_the_network_never_ends_worse_on_held_back_data():
+    # refit="none" returns the network the early stopping chose, trained on
+    # the first four fifths only: on the held-back fifth it is no worse
+    # than its start, the training part's default ARX (recomputed here).
+    from spiralid.sysid import ARX
+
+    data = _problem().data
+    options = {"method": "oe", "rng": 0, "max_rounds": 20}
+    none = identify(data, NARX(2, 2, 1, hidden=(3,)), refit="none", **options)
+    replay = identify(data, NARX(2, 2, 1, hidden=(3,)), **options)
+    assert not none.result.kept_linear and none.result.nit > 0
+    # The same early stopping; only the refit differs.
+    assert (none.result.start, none.result.nit) == (
+        replay.result.start,
+        replay.result.nit,
+    )
+    assert not np.allclose(none.params, replay.params)
+    g = np.random.default_rng(0)
+    identify(data, ARX(2, 2, 1), rng=g)  # the whole record's start comes first
+    split = data.n - round(0.2 * data.n)
+    start = identify(data[:split], ARX(2, 2, 1), rng=g)
+
+    def held_back(y):
+        return np.sqrt(np.mean((data.y[split:] - y[split:]) ** 2))
+
+    assert held_back(none.simulate(data.u)) < held_back(start.simulate(data.u))

@@ -59,6 +59,54 @@ def test_the_gradient_is_exact():
     np.testing.assert_allclose(g, numeric, rtol=1e-5, atol=1e-8 * np.abs(g).max())
 
 
+def test_the_free_run_stage_is_the_free_run_from_rest():
+    # Its loss is the held-back score's run (from rest, the whole record)
+    # on the training samples, and its gradient is exact.
+    data = _wiener(200)
+    st = NeuralStateSpace(2, hidden=(3,))
+    problem = _Problem(st, data, 0.2, 1e-2)
+    problem.batch(None)
+    rng = np.random.default_rng(3)
+    p = st.from_linear([-1.4, 0.6], [0.3, 0.15]) + 0.1 * rng.standard_normal(
+        st.n_params
+    )
+    e = st.free_run(p, problem.us) - problem.ys
+    train = ~_hold_mask(data.n, 0.2)
+    w = p[st.network_mask()]
+    expected = np.mean(e[train] ** 2) + 1e-2 * np.mean(w**2)
+    f, g = problem.loss(p)
+    assert f == pytest.approx(expected, rel=1e-12)
+    eps = 1e-6
+    numeric = np.array(
+        [
+            (problem.loss(p + eps * d)[0] - problem.loss(p - eps * d)[0]) / (2 * eps)
+            for d in np.eye(p.size)
+        ]
+    )
+    np.testing.assert_allclose(g, numeric, rtol=1e-5, atol=1e-8 * np.abs(g).max())
+
+
+def test_the_free_run_stage_never_ends_worse_on_the_held_back_samples():
+    est = _wiener(300)
+    model = sid.identify(
+        est,
+        NeuralStateSpace(2, hidden=(4,)),
+        method="oe",
+        rng=1,
+        horizon=50,
+        free_run=True,
+    )
+    stages = model.result["schedule"]
+    # Three starts, each ending on the free run (horizon None).
+    assert [s[0] for s in stages[1::2]] == [None] * 3
+    for before, after in zip(stages[::2], stages[1::2], strict=True):
+        assert after[2] <= before[2]
+    held = _hold_mask(est.n, 0.2)
+    rms = np.sqrt(np.mean((model.simulate(est.u) - est.y)[held] ** 2))
+    assert rms == pytest.approx(model.cost, rel=1e-9)
+    assert rms <= min(s[2] for s in stages[::2]) + 1e-12
+
+
 @pytest.fixture(scope="module")
 def fitted():
     data = _wiener()
@@ -153,6 +201,7 @@ def test_a_bad_structure_is_refused_in_one_line(make):
         ({"decay": -1.0}, ValueError, "decay"),
         ({"horizon": 1}, ValueError, "horizon"),
         ({"max_iter": 2.5}, TypeError, "max_iter"),
+        ({"free_run": 1}, TypeError, "free_run"),
         ({"method": "sda"}, ValueError, "method"),
     ],
 )

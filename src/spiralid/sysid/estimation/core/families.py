@@ -121,7 +121,10 @@ def arx_estimator(method: str) -> Estimator:
 
 # -- NARX and polynomial NARX ---------------------------------------------------
 
-_NARX_OWN = ("rng", "predictor", "initial", "holdout", "decay", "training", "horizon")
+_NARX_OWN = (
+    "rng", "predictor", "initial", "holdout", "decay", "training", "horizon",
+    "refit",
+)  # fmt: skip
 
 
 def _default_arx(data: IOData, arx, integrator: int, rng):

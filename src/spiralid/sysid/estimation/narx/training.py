@@ -93,7 +93,12 @@ from .subsequences import (
     train_stages,
 )
 
-__all__ = ["NARXProblem", "identify_narx"]
+__all__ = ["REFITS", "NARXProblem", "identify_narx"]
+
+#: What follows the early stopping: ``"replay"`` the winning start's rounds
+#: again on the whole record (from the whole record's linear start), or
+#: ``"none"``, the network as trained on the training part.
+REFITS = ("replay", "none")
 
 
 def _fit(
@@ -107,29 +112,38 @@ def _fit(
 
     Each start is polished in rounds on the training part while the
     held-back part is scored; the start and round count with the lowest
-    held-back cost win. That start (or its entry in `refit`: the same
-    network on the whole record's linear model) is then polished again on
-    the whole record for exactly that many rounds, so the end of the record
-    is not thrown away. Returns ``(params, start name, rounds)``; with
-    nothing held back the rounds run until `max_rounds` or convergence.
+    held-back cost win (:func:`_early_stopped`). With ``refit="replay"``
+    that start (or its entry in `refit`: the same network on the whole
+    record's linear model) is then polished again on the whole record for
+    exactly that many rounds, so the end of the record is not thrown away;
+    with ``refit="none"`` the winner is returned as trained. Returns
+    ``(params, start name, rounds)``; with nothing held back the rounds run
+    until `max_rounds` or convergence.
     """
-    best = None
-    stages = problem.stages if predictor == "simulation" else (None,)
-    for name, p0 in starts.items():
-        p, schedule = train_stages(problem, p0, predictor, stages, options)
-        pick = 1 if problem.hold is not None else 0
-        score = problem._score(p, predictor, pick)
-        if best is None or score < best[0]:
-            best = (score, name, p, schedule)
-    _, name, p, schedule = best
+    p, name, schedule = _early_stopped(problem, starts, predictor, options)
     rounds = sum(r for _, r in schedule)
-    if problem.hold is None:
+    if problem.hold is None or getattr(problem, "refit", "replay") == "none":
         return p, name, rounds
     whole = problem.whole()
     p0 = (refit or {}).get(name, starts[name])
     p = replay_stages(whole, p0, predictor, schedule)
     problem.nfev += whole.nfev
     return p, name, rounds
+
+
+def _early_stopped(problem: NARXProblem, starts: dict, predictor: str, options):
+    """Each start polished through the problem's stages with early stopping;
+    the one with the lowest held-back cost (the training cost with nothing
+    held back): ``(params, start name, schedule)``."""
+    best = None
+    stages = problem.stages if predictor == "simulation" else (None,)
+    pick = 1 if problem.hold is not None else 0
+    for name, p0 in starts.items():
+        p, schedule = train_stages(problem, p0, predictor, stages, options)
+        score = problem._score(p, predictor, pick)
+        if best is None or score < best[0]:
+            best = (score, name, p, schedule)
+    return best[2], best[1], best[3]
 
 
 def _contain(problem: NARXProblem, p, linear, predictor: str):
@@ -447,6 +461,7 @@ def identify_narx(
     holdout: float = 0.2,
     decay: float = 1e-3,
     training: str = "free-run",
+    refit: str = "replay",
     linear_estimator=None,
     **options,
 ) -> NARXModel:
@@ -494,6 +509,13 @@ def identify_narx(
         (>= 2), or None (default) for the curriculum
         :data:`~.subsequences.HORIZONS` (each stage starting where the one
         before stopped, up to the training part's length).
+    refit : {"replay", "none"}
+        After the early stopping (a key of :data:`REFITS`): ``"replay"``
+        (default) runs the winning start's rounds again on the whole
+        record, from the whole record's linear start; ``"none"`` returns
+        the network the held-back cost chose, trained on the training part
+        only (the held-back samples then only stop the training). Either
+        way the result is contained by the whole record's linear start.
     linear_estimator : callable or None
         ``linear_estimator(data, arx, integrator, rng) -> theta``: the
         default method's ARX, the linear start of a free run from rest.
@@ -519,6 +541,8 @@ def identify_narx(
     if training not in TRAININGS:
         raise ValueError(f"`training` must be one of {TRAININGS}; got {training!r}")
     horizon = check_horizon(options.pop("horizon", None))
+    if refit not in REFITS:
+        raise ValueError(f"`refit` must be one of {REFITS}; got {refit!r}")
     if training == "subsequences" and predictor != "simulation":
         raise ValueError(
             "`training` 'subsequences' trains the simulation error; got "
@@ -535,6 +559,7 @@ def identify_narx(
     if training == "subsequences":
         problem.stages = curriculum(horizon, structure.max_lag, data.n)
     problem.decay = float(decay)
+    problem.refit = refit
     problem.linear_estimator = linear_estimator
     res = estimate(problem, **options)
     history = res.get("history")

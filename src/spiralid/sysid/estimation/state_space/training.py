@@ -62,7 +62,7 @@ __all__ = ["HORIZONS", "NSS_OPTIONS", "identify_neural_state_space"]
 HORIZONS = (50, 100, 200)
 
 #: The family's options beside identify's ``rng``.
-NSS_OPTIONS = ("holdout", "decay", "horizon", "max_iter")
+NSS_OPTIONS = ("holdout", "decay", "horizon", "max_iter", "free_run")
 
 # L-BFGS iterations between two held-back scores, and chunks without a
 # better score before a stage stops.
@@ -107,10 +107,18 @@ class _Problem:
         self.net = st.network_mask()
         self.nfev = 0
 
-    def batch(self, horizon: int) -> None:
+    def batch(self, horizon: int | None) -> None:
         """The stretches of `horizon` samples (training weights 1, held-back
-        0), each encoder window free of held-back samples."""
+        0), each encoder window free of held-back samples; None: the free
+        run from rest over the whole record, the one stretch the held-back
+        score runs (the encoder is not used, its state is zero)."""
         st, n = self.st, self.us.size
+        if horizon is None:
+            self.U, self.Y = self.us[None, :].copy(), self.ys[None, :].copy()
+            self.W = (~self.held[None, :]).astype(float)
+            self.W /= max(self.W.sum(), 1.0)
+            self.Z = np.zeros((1, 2 * st.window))
+            return
         horizon = max(2, min(horizon, n - st.window))
         starts = subsequence_starts(st.window, n, horizon)
         starts = np.array(
@@ -257,6 +265,7 @@ def identify_neural_state_space(
     decay: float = 1e-3,
     horizon: int | None = None,
     max_iter: int | None = None,
+    free_run: bool = False,
 ) -> NeuralStateSpaceModel:
     """A neural state-space model of `structure` on `data` (the module
     docstring says how).
@@ -283,6 +292,13 @@ def identify_neural_state_space(
         Subsequence length (>= 2); None grows it through :data:`HORIZONS`.
     max_iter : int or None
         L-BFGS iterations per stage at most (default 1000).
+    free_run : bool
+        Add a last stage on the free run from rest over the whole record
+        (its training samples), the run the held-back score and a free-run
+        benchmark measure, from each start's best point on the
+        subsequences. Its early stopping is the other stages': it ends
+        where the held-back RMS was lowest, so it never ends above its
+        start there. Default False.
 
     Returns
     -------
@@ -290,6 +306,8 @@ def identify_neural_state_space(
     """
     t_start = time.perf_counter()
     holdout, decay, horizon, max_iter = _checked(holdout, decay, horizon, max_iter)
+    if not isinstance(free_run, bool | np.bool_):
+        raise TypeError(f"`free_run` must be True or False; got {free_run!r}")
     if not isinstance(structure, NeuralStateSpace):
         raise TypeError(
             f"`structure` must be a NeuralStateSpace; got {type(structure).__name__}"
@@ -305,6 +323,8 @@ def identify_neural_state_space(
     horizons = (horizon,) if horizon is not None else HORIZONS
     room = data.n - structure.window
     horizons = tuple(h for h in horizons if h < room) or (room,)
+    if free_run:
+        horizons = (*horizons, None)
     for run in range(_STARTS if structure.h else 0):
         if run:
             p0 = _linear_start(structure, problem, theta, gen)[1]
@@ -313,7 +333,7 @@ def identify_neural_state_space(
         for h in horizons:
             problem.batch(h)
             ours, used = _stage(problem, start, ours, max_iter)
-            schedule.append([int(h), int(used), float(ours[0])])
+            schedule.append([None if h is None else int(h), int(used), float(ours[0])])
             # The next (longer) stage starts from this start's best point;
             # from the random input weights while that is the linear start.
             start = start if ours[1] is p_lin else ours[1]
