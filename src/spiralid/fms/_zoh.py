@@ -104,16 +104,6 @@ def simulate_discrete(
     return y, xt.reshape(nb * m, n)[:N]
 
 
-def _hold_integral(A: np.ndarray, B: np.ndarray, h: float):
-    """``(e^{A h}, int_0^h e^{A s} ds B)`` from one exponential."""
-    n = A.shape[0]
-    aug = np.zeros((n + 1, n + 1))
-    aug[:n, :n] = A * h
-    aug[:n, n] = B * h
-    e = expm(aug)
-    return e[:n, :n], e[:n, n]
-
-
 def delay_split(delay: float, ts: float) -> tuple[int, float]:
     """``delay = (k + f) ts`` with an integer ``k >= -1`` and ``0 <= f < 1``
     (a ValueError for an advance of a whole sample or more: the output
@@ -138,8 +128,8 @@ def discretise_delayed(
     ``G1 = e^{A (1-f) ts} int_0^{f ts} e^{A s} ds B``. Returns
     ``(Ad, G0, G1)``."""
     _, f = delay_split(delay, ts)
-    late, g0 = _hold_integral(A, B, (1.0 - f) * ts)
-    first, early = _hold_integral(A, B, f * ts)
+    late, g0 = discretise_zoh(A, B, (1.0 - f) * ts)
+    first, early = discretise_zoh(A, B, f * ts)
     # e^{A ts} as the product of the two parts' (they commute): two
     # exponentials per run, not three.
     return late @ first, g0, late @ early
