@@ -39,6 +39,19 @@ def test_the_linear_start_is_the_arx_realisation():
     np.testing.assert_allclose(st.free_run(p, u[t:], x0), y[t:], atol=1e-10)
 
 
+def _assert_exact_gradient(problem, p):
+    """The loss's gradient against central finite differences."""
+    g = problem.loss(p)[1]
+    eps = 1e-6
+    numeric = np.array(
+        [
+            (problem.loss(p + eps * d)[0] - problem.loss(p - eps * d)[0]) / (2 * eps)
+            for d in np.eye(p.size)
+        ]
+    )
+    np.testing.assert_allclose(g, numeric, rtol=1e-5, atol=1e-8 * np.abs(g).max())
+
+
 def test_the_gradient_is_exact():
     data = _wiener(200)
     st = NeuralStateSpace(2, hidden=(3,))
@@ -48,15 +61,7 @@ def test_the_gradient_is_exact():
     p = st.from_linear([-1.4, 0.6], [0.3, 0.15]) + 0.2 * rng.standard_normal(
         st.n_params
     )
-    _, g = problem.loss(p)
-    eps = 1e-6
-    numeric = np.array(
-        [
-            (problem.loss(p + eps * e)[0] - problem.loss(p - eps * e)[0]) / (2 * eps)
-            for e in np.eye(p.size)
-        ]
-    )
-    np.testing.assert_allclose(g, numeric, rtol=1e-5, atol=1e-8 * np.abs(g).max())
+    _assert_exact_gradient(problem, p)
 
 
 def test_the_free_run_stage_is_the_free_run_from_rest():
@@ -74,16 +79,8 @@ def test_the_free_run_stage_is_the_free_run_from_rest():
     train = ~_hold_mask(data.n, 0.2)
     w = p[st.network_mask()]
     expected = np.mean(e[train] ** 2) + 1e-2 * np.mean(w**2)
-    f, g = problem.loss(p)
-    assert f == pytest.approx(expected, rel=1e-12)
-    eps = 1e-6
-    numeric = np.array(
-        [
-            (problem.loss(p + eps * d)[0] - problem.loss(p - eps * d)[0]) / (2 * eps)
-            for d in np.eye(p.size)
-        ]
-    )
-    np.testing.assert_allclose(g, numeric, rtol=1e-5, atol=1e-8 * np.abs(g).max())
+    assert problem.loss(p)[0] == pytest.approx(expected, rel=1e-12)
+    _assert_exact_gradient(problem, p)
 
 
 def test_the_free_run_stage_never_ends_worse_on_the_held_back_samples():
