@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,6 +30,7 @@ from ...data import IOData
 from ..narx.subsequences import check_horizon
 
 __all__ = [
+    "Candidates",
     "half_decades",
     "held_back_fit",
     "int_range",
@@ -232,31 +235,13 @@ def _choice_result(trials: dict, calls: int, message: str, t0: float, fields_of)
     )
 
 
-def spiral_choice(
-    data: IOData,
-    grid,
-    structure_of,
-    train,
-    *,
-    largest: str,
-    log_decay,
-    budget,
-    holdback,
-    rule: str,
-    n_points,
-    horizons,
-    rng,
-    normalise=None,
-    judge=None,
-) -> OptimiserResult:
-    """The spiral's choice of a structure and its decay (and horizon), each
-    candidate trained on the first part of `data` and scored by its free run
-    from rest on the held-back end; the best trained again on all of `data`.
+@dataclass(frozen=True)
+class Candidates:
+    """The candidates a chooser searches over: the grid of their structures,
+    how each is built and trained, and how it is judged.
 
     Parameters
     ----------
-    data : IOData
-        The estimation record (checked by the caller).
     grid : sequence of (int, int)
         Checked inclusive ranges of the structure's coordinates.
     structure_of : callable
@@ -267,16 +252,48 @@ def spiral_choice(
     largest : str
         The ranges named in the message when the largest choice is too long
         for the samples before the held-back part.
-    log_decay, budget, holdback, rule, n_points, horizons, rng
-        The chooser's arguments (checked here).
     normalise : callable, optional
         ``normalise(coords)`` -> the coordinates of the choice they stand
         for (points of one choice are trained once).
     judge : callable, optional
         ``judge(model)`` -> the held-back fit % of a model trained on all
-        of `data` (its own held-back samples): every candidate is then
+        of the record (its own held-back samples): every candidate is then
         trained on the whole record and the best returned as trained, no
         refit; `holdback` is not used.
+    """
+
+    grid: Sequence[tuple[int, int]]
+    structure_of: Callable
+    train: Callable
+    largest: str
+    normalise: Callable | None = None
+    judge: Callable | None = None
+
+
+def spiral_choice(
+    data: IOData,
+    candidates: Candidates,
+    *,
+    log_decay,
+    budget,
+    holdback,
+    rule: str,
+    n_points,
+    horizons,
+    rng,
+) -> OptimiserResult:
+    """The spiral's choice of a structure and its decay (and horizon), each
+    candidate trained on the first part of `data` and scored by its free run
+    from rest on the held-back end; the best trained again on all of `data`.
+
+    Parameters
+    ----------
+    data : IOData
+        The estimation record (checked by the caller).
+    candidates : Candidates
+        The structures searched, their training and judge.
+    log_decay, budget, holdback, rule, n_points, horizons, rng
+        The chooser's arguments (checked here).
 
     Returns
     -------
@@ -287,6 +304,16 @@ def spiral_choice(
         ``nfev``, ``n_calls``, ``elapsed``.
     """
     t0 = time.perf_counter()
+    grid, structure_of, train = (
+        candidates.grid,
+        candidates.structure_of,
+        candidates.train,
+    )
+    largest, normalise, judge = (
+        candidates.largest,
+        candidates.normalise,
+        candidates.judge,
+    )
     log_decay = _decay_range(log_decay)
     budget = integer(budget, "budget", 1)
     n_points = integer(n_points, "n_points", 2)

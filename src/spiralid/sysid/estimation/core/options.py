@@ -52,7 +52,7 @@ def identify_options(
     ('rng', 'predictor', 'initial', 'gain', 'penalty', 'integrator')
     >>> identify_options("oe", NARX(2, 2, 1))  # doctest: +NORMALIZE_WHITESPACE
     ('rng', 'predictor', 'initial', 'holdout', 'decay', 'training', 'horizon',
-     'max_rounds', 'patience', 'patience_share')
+     'refit', 'max_rounds', 'patience', 'patience_share')
     """
     family = family_of(structure, n_outputs)
     return estimator(family, method, structure).options(refine)

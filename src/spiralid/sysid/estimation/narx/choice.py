@@ -32,7 +32,13 @@ from spiralid.optim.result import OptimiserResult
 
 from ...data import IOData
 from ...models.narx import NARX
-from ..core.choices import half_decades, int_range, nearest, spiral_choice
+from ..core.choices import (
+    Candidates,
+    half_decades,
+    int_range,
+    nearest,
+    spiral_choice,
+)
 from ..core.identify import identify
 
 __all__ = ["choose_narx", "round_choice"]
@@ -173,10 +179,7 @@ def choose_narx(
 
     return spiral_choice(
         data,
-        [lags, hidden],
-        structure,
-        train,
-        largest="`lags` and `hidden`",
+        Candidates([lags, hidden], structure, train, largest="`lags` and `hidden`"),
         log_decay=log_decay,
         budget=budget,
         holdback=holdback,

@@ -461,7 +461,6 @@ def identify_narx(
     holdout: float = 0.2,
     decay: float = 1e-3,
     training: str = "free-run",
-    refit: str = "replay",
     linear_estimator=None,
     **options,
 ) -> NARXModel:
@@ -509,13 +508,6 @@ def identify_narx(
         (>= 2), or None (default) for the curriculum
         :data:`~.subsequences.HORIZONS` (each stage starting where the one
         before stopped, up to the training part's length).
-    refit : {"replay", "none"}
-        After the early stopping (a key of :data:`REFITS`): ``"replay"``
-        (default) runs the winning start's rounds again on the whole
-        record, from the whole record's linear start; ``"none"`` returns
-        the network the held-back cost chose, trained on the training part
-        only (the held-back samples then only stop the training). Either
-        way the result is contained by the whole record's linear start.
     linear_estimator : callable or None
         ``linear_estimator(data, arx, integrator, rng) -> theta``: the
         default method's ARX, the linear start of a free run from rest.
@@ -523,8 +515,14 @@ def identify_narx(
         imports neither it nor the estimators' table (no import circle,
         tests/test_layout.py). None: the least-squares ARX.
     **options
-        The estimator's own options (a search's ``max_nfev``...), and
-        ``horizon`` (see `training`).
+        The estimator's own options (a search's ``max_nfev``...),
+        ``horizon`` (see `training`) and ``refit``, what follows the early
+        stopping (a key of :data:`REFITS`): ``"replay"`` (default) runs
+        the winning start's rounds again on the whole record, from the
+        whole record's linear start; ``"none"`` returns the network the
+        held-back cost chose, trained on the training part only (the
+        held-back samples then only stop the training). Either way the
+        result is contained by the whole record's linear start.
 
     Returns
     -------
@@ -541,6 +539,7 @@ def identify_narx(
     if training not in TRAININGS:
         raise ValueError(f"`training` must be one of {TRAININGS}; got {training!r}")
     horizon = check_horizon(options.pop("horizon", None))
+    refit = options.pop("refit", "replay")
     if refit not in REFITS:
         raise ValueError(f"`refit` must be one of {REFITS}; got {refit!r}")
     if training == "subsequences" and predictor != "simulation":

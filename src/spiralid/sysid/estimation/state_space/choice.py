@@ -27,7 +27,7 @@ from spiralid.optim.result import OptimiserResult
 
 from ...data import IOData
 from ...models.neural_state_space import NeuralStateSpace
-from ..core.choices import held_back_fit, int_range, spiral_choice
+from ..core.choices import Candidates, held_back_fit, int_range, spiral_choice
 from ..core.identify import identify
 from .training import _hold_mask
 
@@ -153,12 +153,18 @@ def choose_state_space(
             record, st, method="oe", decay=decay, holdout=_HOLDOUT, rng=gen, **options
         )
 
-    return spiral_choice(
-        data,
+    candidates = Candidates(
         [order, hidden, window],
         structure,
         train,
         largest="`order` and `window`",
+        # A window below the order is the order's: one choice, one training.
+        normalise=lambda c: (c[0], c[1], max(c[2], c[0])),
+        judge=_blocks_judge(data) if holdback == BLOCKS else None,
+    )
+    return spiral_choice(
+        data,
+        candidates,
         log_decay=log_decay,
         budget=budget,
         holdback=holdback,
@@ -166,9 +172,6 @@ def choose_state_space(
         n_points=n_points,
         horizons=horizons,
         rng=rng,
-        # A window below the order is the order's: one choice, one training.
-        normalise=lambda c: (c[0], c[1], max(c[2], c[0])),
-        judge=_blocks_judge(data) if holdback == BLOCKS else None,
     )
 
 
