@@ -256,10 +256,10 @@ class Candidates:
         ``normalise(coords)`` -> the coordinates of the choice they stand
         for (points of one choice are trained once).
     judge : callable, optional
-        ``judge(model)`` -> the held-back fit % of a model trained on all
-        of the record (its own held-back samples): every candidate is then
-        trained on the whole record and the best returned as trained, no
-        refit; `holdback` is not used.
+        ``judge(data)`` -> a function ``(model) -> held-back fit %`` of a
+        model trained on all of the record `data` (its own held-back
+        samples): every candidate is then trained on the whole record and
+        the best returned as trained, no refit; `holdback` is not used.
     """
 
     grid: Sequence[tuple[int, int]]
@@ -289,7 +289,7 @@ def spiral_choice(
     Parameters
     ----------
     data : IOData
-        The estimation record (checked by the caller).
+        The estimation record.
     candidates : Candidates
         The structures searched, their training and judge.
     log_decay, budget, holdback, rule, n_points, horizons, rng
@@ -304,6 +304,8 @@ def spiral_choice(
         ``nfev``, ``n_calls``, ``elapsed``.
     """
     t0 = time.perf_counter()
+    if not isinstance(data, IOData):
+        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     grid, structure_of, train = (
         candidates.grid,
         candidates.structure_of,
@@ -319,7 +321,10 @@ def spiral_choice(
     n_points = integer(n_points, "n_points", 2)
     horizons = _horizons(horizons)
     gen = generator(rng)
-    part, y_end = (data, None) if judge else _held_back(data, holdback)
+    if judge:
+        judge, (part, y_end) = judge(data), (data, None)
+    else:
+        part, y_end = _held_back(data, holdback)
     # Any choice in the ranges may be trained: the largest must fit before
     # the search starts, not fail at whichever point first reaches it.
     try:

@@ -161,8 +161,6 @@ def choose_narx(
     >>> res.nfev <= 3, res.model.structure == res.structure
     (True, True)
     """
-    if not isinstance(data, IOData):
-        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     nk = integer(nk, "nk", 0)
     lags = int_range(lags, "lags", 1)
     hidden = int_range(hidden, "hidden", 1)

@@ -138,8 +138,6 @@ def choose_state_space(
     >>> res.nfev <= 2, res.model.structure == res.structure
     (True, True)
     """
-    if not isinstance(data, IOData):
-        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
     order = int_range(order, "order", 1)
     hidden = int_range(hidden, "hidden", 1)
     window = _window_range(window, order)
@@ -160,7 +158,7 @@ def choose_state_space(
         largest="`order` and `window`",
         # A window below the order is the order's: one choice, one training.
         normalise=lambda c: (c[0], c[1], max(c[2], c[0])),
-        judge=_blocks_judge(data) if holdback == BLOCKS else None,
+        judge=_blocks_judge if holdback == BLOCKS else None,
     )
     return spiral_choice(
         data,
