@@ -5,6 +5,8 @@ delayed held input on a fine grid; the proper discrete model has the same
 run; a record made with a delay gives it back; off by default; bad values
 refused in one line."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy import signal
@@ -106,6 +108,33 @@ def test_a_record_made_with_an_advance_gives_it_back_and_reads_back():
     again = load_model(model.to_dict())
     assert again.structure.delay_at(again.values) == pytest.approx(truth, rel=1e-6)
     np.testing.assert_allclose(again.simulate(data), model.simulate(data), rtol=1e-12)
+
+
+def test_a_delay_adds_no_zero_and_keeps_scipys_transfer_function():
+    # A delay of whole samples only multiplies the transfer function by
+    # z^-k: the finite zeros are the undelayed model's, none of them a
+    # rounding root near 1e16.
+    delayed, _ = _boxes()
+    u = _torque(200)
+    y = delayed.simulate([RIG.hub_inertia, 0.0], u, TS)
+    fitted = sid.identify(sid.IOData(u, y, ts=TS), delayed, method="oe")
+    at = {k: dataclasses.replace(fitted, values=np.array([RIG.hub_inertia, k * TS]))
+          for k in (0, 1, 2, 0.37)}  # fmt: skip
+    plain = np.sort_complex(at[0].zeros)
+    for k in (1, 2):
+        np.testing.assert_allclose(np.sort_complex(at[k].zeros), plain, rtol=1e-8)
+        num, den = at[k].polynomials
+        np.testing.assert_array_equal(num[:k], 0.0)
+        scale = np.max(np.abs(num))
+        head = at[0].polynomials[0][: num.size - k]
+        np.testing.assert_allclose(num[k:], head, rtol=1e-9, atol=1e-12 * scale)
+    # A fractional delay's numerator is SciPy's to rounding, its zeros finite.
+    assert np.max(np.abs(at[0.37].zeros)) < 10.0
+    ad, bd, c, d = delayed.discretise(at[0.37].values, TS)
+    num, den = signal.ss2tf(ad, bd, c, d)
+    np.testing.assert_allclose(at[0.37].polynomials[0], num[0],
+                               atol=1e-10 * np.max(np.abs(num)))  # fmt: skip
+    np.testing.assert_allclose(at[0.37].polynomials[1], den, rtol=1e-12)
 
 
 def test_bad_delays_are_refused_in_one_line():

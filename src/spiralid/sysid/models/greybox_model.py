@@ -17,7 +17,6 @@ import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
 
 from ..data import IOData
 from .greybox import GreyBox, _import
@@ -352,9 +351,7 @@ class LinearGreyBoxModel(GreyBoxModel):
         """``(num, den)`` in ``z^-1`` of equal lengths, ``den[0] = 1``, of a
         one-output model (:meth:`output_model` gives each output's)."""
         self._one_output("polynomials")
-        ad, bd, c, d = self._discrete()
-        num, den = signal.ss2tf(ad, bd, c, d)
-        return np.asarray(num[0], dtype=float), np.asarray(den, dtype=float)
+        return _transfer_function(*self._discrete())
 
     @property
     def integrator(self) -> int:
@@ -409,3 +406,26 @@ class LinearGreyBoxModel(GreyBoxModel):
             cancelled=np.all([t.cancelled for t in tables], axis=0),
             spurious=np.all([t.spurious for t in tables], axis=0),
         )
+
+
+def _transfer_function(ad, bd, c, d) -> tuple[np.ndarray, np.ndarray]:
+    """``(num, den)`` in ``z^-1`` of a one-output sampled model: ``den`` the
+    characteristic polynomial of `ad` and ``num`` the first ``n + 1`` terms
+    of ``den`` times the Markov parameters ``d, c bd, c ad bd, ...``.
+
+    SciPy's ``ss2tf`` forms each numerator coefficient as a difference of
+    two characteristic polynomials' coefficients, so a coefficient that is
+    zero by structure (a delay's leading zeros) comes out as rounding, and
+    its root as a zero near 1e16. The Markov parameters of a delay line
+    are exact zeros, so their product keeps them.
+    """
+    den = np.real(np.poly(ad))
+    n = den.size - 1
+    markov = np.empty(n + 1)
+    markov[0] = d[0, 0]
+    reach = bd[:, 0]
+    for k in range(1, n + 1):
+        markov[k] = c[0] @ reach
+        reach = ad @ reach
+    num = np.convolve(den, markov)[: n + 1]
+    return num, den
