@@ -79,7 +79,7 @@ def _timed(fn):
     return out, time.perf_counter() - t0
 
 
-def part_hub(seeds: list[int]) -> None:
+def part_hub(seeds: list[int], n_modes: int = MODES) -> None:
     print("## Nonlinear rig, hub angle, validation on the last third")
     print("| seed | grey box % | s | ARX oe % |")
     print("|---|---|---|---|")
@@ -87,7 +87,7 @@ def part_hub(seeds: list[int]) -> None:
     friction = []
     for seed in seeds:
         est, val = _hub_record(seed)
-        box = RigGreyBox(FREE, START, n_modes=MODES)
+        box = RigGreyBox(FREE, START, n_modes=n_modes)
         t0 = time.perf_counter()
         model = identify(est, box, method="spiral", rng=seed)
         secs = time.perf_counter() - t0
@@ -136,10 +136,10 @@ def part_reduce() -> None:
         print(f"| {label} | {box.n_states} | {fit:.2f} | {secs / runs:.3f} |")
 
 
-def part_six(seed: int = 0) -> None:
+def part_six(seed: int = 0, n_modes: int = MODES) -> None:
     print("\n## Six free parameters (seed 0)")
     est, val = _hub_record(seed)
-    box = RigGreyBox(SIX, START, n_modes=MODES)
+    box = RigGreyBox(SIX, START, n_modes=n_modes)
     model, secs = _timed(lambda: identify(est, box, method="spiral", rng=seed))
     print(
         f"validation fit {_fit(model, est, val):.2f} %, {secs:.0f} s, "
@@ -228,17 +228,23 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument(
+        "--modes",
+        type=int,
+        default=MODES,
+        help="flexible modes of the grey box in the hub and six parts",
+    )
+    ap.add_argument(
         "--part",
         choices=["all", "hub", "reduce", "six", "sensors", "arm"],
         default="all",
     )
     args = ap.parse_args()
     if args.part in ("all", "hub"):
-        part_hub(list(range(args.seeds)))
+        part_hub(list(range(args.seeds)), args.modes)
     if args.part in ("all", "reduce"):
         part_reduce()
     if args.part in ("all", "six"):
-        part_six()
+        part_six(n_modes=args.modes)
     if args.part in ("all", "sensors"):
         part_sensors(list(range(args.seeds)))
     if args.part in ("all", "arm"):

@@ -63,3 +63,26 @@ def test_intervals_are_least_squares_exact_ones(record, log):
     else:
         want = np.column_stack([beta - Z95 * sd, beta + Z95 * sd])
     np.testing.assert_allclose(model.intervals, want, rtol=1e-5)
+
+
+def test_coloured_noise_widens_the_intervals_to_the_exact_sandwich():
+    # AR(1) noise: least squares' exact covariance is the sandwich
+    # (X'X)^-1 X' R X (X'X)^-1 with R_ij = s^2 phi^|i-j| / (1 - phi^2).
+    rng = np.random.default_rng(5)
+    n, phi, s = 2000, 0.9, 0.02
+    u = np.repeat(rng.standard_normal(n // 8), 8)
+    x = regressors(u)
+    noise = signal.lfilter([1.0], [1.0, -phi], s * rng.standard_normal(n))
+    rec = sid.IOData(u, x @ TRUE + noise, ts=TS)
+    params = [Parameter(f"b{i + 1}", 1.0, (0.1, 10.0)) for i in range(TRUE.size)]
+    model = sid.identify(rec, GreyBox(params, ss=two_channels), method="oe")
+    lag = np.abs(np.subtract.outer(np.arange(n), np.arange(n)))
+    r = s**2 * phi**lag / (1 - phi**2)
+    inv = np.linalg.inv(x.T @ x)
+    exact = np.sqrt(np.diag(inv @ x.T @ r @ x @ inv))
+    half = np.diff(model.intervals, axis=1).ravel() / 2
+    np.testing.assert_allclose(half, Z95 * exact, rtol=0.2)
+    # The white formula would claim intervals about three times narrower.
+    _, rss, *_ = np.linalg.lstsq(x, rec.y, rcond=None)
+    white = np.sqrt(float(rss[0]) / (n - 2) * np.diag(inv))
+    assert np.all(half > 2 * Z95 * white)

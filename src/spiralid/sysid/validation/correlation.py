@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import linalg, stats
 
+from ..estimation.core.coloured import ljung_box
 from ..signals import check_pair, check_signal
 
 __all__ = [
@@ -269,8 +270,7 @@ def whiteness_test(e, lags: int = 25, levels=_DEFAULT_LEVELS) -> CorrelationTest
     levels = _check_levels(levels)
     r = correlation(e, e, lags)[lags + 1 :]
     k = np.arange(1, lags + 1)
-    q = n * (n + 2) * np.sum(r**2 / (n - k))
-    return _finish("autocorrelation", k, r, n, levels, q, lags)
+    return _finish("autocorrelation", k, r, n, levels, ljung_box(r, n), lags)
 
 
 def independence_test(
