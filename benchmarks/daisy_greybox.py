@@ -29,6 +29,13 @@ invisible in the record). Rows:
 either way, started at minus half a sample: the lag of a zero-order hold
 behind a measured input).
 
+``--damping rayleigh`` replaces the one damping ratio (held at 0) by the
+rig's Rayleigh damping, ``mass_damping`` and ``stiffness_damping`` free
+(each mode its own ratio, ``alpha / (2 w_k) + beta w_k / 2``: with two
+modes, any two ratios within a factor ``w2 / w1`` of each other), started
+at the values that give the ARX fit's two ratios (clipped at zero) and
+bounded by a ratio of 0.3 at the first mode.
+
 ``--bound-only`` prints the black boxes and that bound, without the rig;
 ``--starts modes`` only the rig's start from the ARX's modes.
 
@@ -95,10 +102,27 @@ def _form_bound(est, val, table) -> float:
     return float(100 * (1 - np.linalg.norm(e) / np.linalg.norm(val.y - val.y.mean())))
 
 
-def _box(delay: bool = False) -> RigGreyBox:
+def _rayleigh(table) -> list[Parameter]:
+    """``mass_damping`` and ``stiffness_damping`` at the values that give
+    `table`'s first two modes their damping ratios (clipped at zero),
+    bounded by a ratio of 0.3 at the first mode."""
+    keep = ~table.spurious
+    w = 2 * np.pi * table.frequency[keep][:MODES]
+    # zeta_k = alpha / (2 w_k) + beta w_k / 2, solved for (alpha, beta).
+    a = np.column_stack([1 / (2 * w), w / 2])
+    alpha, beta = np.clip(np.linalg.solve(a, table.damping[keep][:MODES]), 0, None)
+    return [
+        Parameter("mass_damping", alpha, (0.0, 0.6 * w[0]), "1/s"),
+        Parameter("stiffness_damping", beta, (0.0, 0.6 / w[0]), "s"),
+    ]
+
+
+def _box(delay: bool = False, damping=None) -> RigGreyBox:
     """The rig's free fields with bounds a factor 100 around the preset
-    (the payload from a thousandth to a hundred times the beam's)."""
-    rig = FlexibleManipulator()
+    (the payload from a thousandth to a hundred times the beam's); with
+    `damping` (Rayleigh's two Parameters) those instead of the one damping
+    ratio, held at 0."""
+    rig = FlexibleManipulator(damping_ratio=0.0 if damping else 0.02)
     beam = rig.density * rig.area * rig.length
     free = [
         Parameter("flexural_rigidity", rig.flexural_rigidity,
@@ -108,8 +132,8 @@ def _box(delay: bool = False) -> RigGreyBox:
         Parameter("payload_mass", beam, (beam / 1e3, beam * 100), "kg"),
         Parameter("payload_inertia", beam * rig.length**2 / 3,
                   (beam * rig.length**2 / 3e3, beam * rig.length**2 * 30), "kg m^2"),
-        Parameter("damping_ratio", 0.02, (0.001, 0.3)),
     ]  # fmt: skip
+    free += damping or [Parameter("damping_ratio", 0.02, (0.001, 0.3))]
     if delay:
         free.append(Parameter(DELAY, -0.005, (-0.009, 0.009), "s"))
     n_states = 2 * (MODES + 1)
@@ -130,9 +154,11 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--bound-only", action="store_true")
     ap.add_argument("--input-delay", action="store_true")
+    ap.add_argument("--damping", choices=("ratio", "rayleigh"), default="ratio")
     ap.add_argument(
         "--starts", default="preset,modes", help="the rig's starts, comma-separated"
     )
+    ap.add_argument("--methods", default="oe,spiral", help="comma-separated")
     args = ap.parse_args()
     seed = args.seed
     data = robot_arm().detrend()
@@ -152,7 +178,8 @@ def main() -> None:
     print(f"| rig's form, any fields | {_form_bound(est, val, table):.2f} | - |")
     if args.bound_only:
         return
-    box = _box(args.input_delay)
+    rayleigh = _rayleigh(table) if args.damping == "rayleigh" else None
+    box = _box(args.input_delay, rayleigh)
     keep = ~table.spurious
     modes = {"preset": box.rig.modes(MODES), "modes": arx}
     starts = {
@@ -164,12 +191,12 @@ def main() -> None:
         at_start = LinearGreyBoxModel(start, start.initial_values, est.ts, "start")
         print(f"| rig, {label} start (no fit) | "
               f"{_fit(at_start, est, val):.2f} | - |", flush=True)  # fmt: skip
-        for method in ("oe", "spiral"):
-            t0 = time.perf_counter()
+        for method in args.methods.split(","):
+            t0, c0 = time.perf_counter(), time.process_time()
             model = identify(est, start, method=method, rng=seed)
-            secs = time.perf_counter() - t0
+            secs, cpu = time.perf_counter() - t0, time.process_time() - c0
             print(f"| rig, {label} start, {method} | {_fit(model, est, val):.2f} | "
-                  f"{secs:.0f} |", flush=True)  # fmt: skip
+                  f"{secs:.0f} (cpu {cpu:.0f}) |", flush=True)  # fmt: skip
             fitted[label, method] = model
     pairs = zip(table.frequency[keep], table.damping[keep], strict=True)
     print("\nARX(8, 8, 0)'s modes (Hz, damping):",
