@@ -95,7 +95,8 @@ def test_zero_coefficients_give_todays_one_ratio_model():
     np.testing.assert_array_equal(rig.mode_damping(), np.full(8, 0.03))
     kw = dict(output="end_acceleration", sensors=Sensors.ideal(), n_modes=3)
     one = RigGreyBox(["damping_ratio"], rig, **kw)
-    three = RigGreyBox(["damping_ratio", "mass_damping", "stiffness_damping"], rig, **kw)
+    rayleigh = ["damping_ratio", "mass_damping", "stiffness_damping"]
+    three = RigGreyBox(rayleigh, rig, **kw)
     u = np.random.default_rng(0).standard_normal(200)
     np.testing.assert_array_equal(
         three.simulate([0.03, 0.0, 0.0], u, TS), one.simulate([0.03], u, TS)

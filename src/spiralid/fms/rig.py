@@ -461,8 +461,10 @@ class FlexibleManipulator:
         array([0.0042, 0.011 ])
         """
         w = 2.0 * math.pi * self.modes(n)
-        return self.damping_ratio + self.mass_damping / (2.0 * w) + (
-            self.stiffness_damping * w / 2.0
+        return (
+            self.damping_ratio
+            + self.mass_damping / (2.0 * w)
+            + (self.stiffness_damping * w / 2.0)
         )
 
     @property
