@@ -3,9 +3,12 @@ mode's ratio is ``alpha / (2 w) + beta w / 2`` on the finite elements' own
 modes (SciPy's generalised eigenproblem of K and M); the damping matrix is
 ``alpha M + beta K`` without its rigid share; the model's poles are the
 damped modes'; zero coefficients give today's one-ratio model; a record
-made with Rayleigh damping gives it back; bad values refused in one line."""
+made with Rayleigh damping gives it back; the start from modes gives each
+mode its damping; bad values refused in one line."""
 
+import dataclasses
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -16,6 +19,7 @@ from spiralid.choices import RIG_PARAMETERS
 from spiralid.cli.rig import _free_fields
 from spiralid.fms import FlexibleManipulator, Sensors
 from spiralid.fms.greybox import RigGreyBox, default_parameter
+from spiralid.fms.greybox_start import rig_start_from_modes
 from spiralid.sysid import Parameter, load_model
 
 TS = 0.01
@@ -151,3 +155,20 @@ def test_bad_coefficients_are_refused_in_one_line(field, value):
     assert "\n" not in str(err.value)
     with pytest.raises(TypeError, match=field):
         FlexibleManipulator(**{field: "0.1"})
+
+
+def test_the_start_from_modes_gives_each_mode_its_damping():
+    base = FlexibleManipulator(n_elements=4, damping_ratio=0.002)
+    truth = dataclasses.replace(base, mass_damping=ALPHA, stiffness_damping=BETA)
+    table = SimpleNamespace(
+        frequency=truth.modes(2), damping=truth.mode_damping(2), spurious=[0, 0]
+    )
+    box = RigGreyBox(
+        ["hub_inertia", "mass_damping", "stiffness_damping"], base, n_modes=2
+    )
+    start = rig_start_from_modes(box, table, rng=0)
+    np.testing.assert_allclose(start.initial_values[1:], [ALPHA, BETA], rtol=1e-8)
+    # A held ratio above the modes' damping: the coefficients stop at zero.
+    high = dataclasses.replace(base, damping_ratio=0.5)
+    box = RigGreyBox(["hub_inertia", "mass_damping"], high, n_modes=2)
+    assert rig_start_from_modes(box, table, rng=0).initial_values[1] == 0.0
