@@ -33,8 +33,8 @@ behind a measured input).
 rig's Rayleigh damping, ``mass_damping`` and ``stiffness_damping`` free
 (each mode its own ratio, ``alpha / (2 w_k) + beta w_k / 2``: with two
 modes, any two ratios within a factor ``w2 / w1`` of each other), started
-at the values that give the ARX fit's two ratios (clipped at zero) and
-bounded by a ratio of 0.3 at the first mode.
+where they give the ARX fit's two modes their damping and bounded by a
+ratio of 0.3 at the first mode.
 
 ``--bound-only`` prints the black boxes and that bound, without the rig;
 ``--starts modes`` only the rig's start from the ARX's modes.
@@ -103,17 +103,13 @@ def _form_bound(est, val, table) -> float:
 
 
 def _rayleigh(table) -> list[Parameter]:
-    """``mass_damping`` and ``stiffness_damping`` at the values that give
-    `table`'s first two modes their damping ratios (clipped at zero),
-    bounded by a ratio of 0.3 at the first mode."""
-    keep = ~table.spurious
-    w = 2 * np.pi * table.frequency[keep][:MODES]
-    # zeta_k = alpha / (2 w_k) + beta w_k / 2, solved for (alpha, beta).
-    a = np.column_stack([1 / (2 * w), w / 2])
-    alpha, beta = np.clip(np.linalg.solve(a, table.damping[keep][:MODES]), 0, None)
+    """``mass_damping`` and ``stiffness_damping``, bounded by a ratio of 0.3
+    at `table`'s first mode (``rig_start_from_modes`` starts them where
+    they give the table's modes their damping)."""
+    w1 = 2 * np.pi * table.frequency[~table.spurious][0]
     return [
-        Parameter("mass_damping", alpha, (0.0, 0.6 * w[0]), "1/s"),
-        Parameter("stiffness_damping", beta, (0.0, 0.6 / w[0]), "s"),
+        Parameter("mass_damping", 0.0, (0.0, 0.6 * w1), "1/s"),
+        Parameter("stiffness_damping", 0.0, (0.0, 0.6 / w1), "s"),
     ]
 
 
