@@ -36,6 +36,17 @@ modes, any two ratios within a factor ``w2 / w1`` of each other), started
 where they give the ARX fit's two modes their damping and bounded by a
 ratio of 0.3 at the first mode.
 
+``--accelerometer X`` reads the record's acceleration at a fraction ``X``
+of the beam's length (an accelerometer's position, a sensor of
+``Sensors.ideal(acceleration_at=(X,))``) rather than at the end; choose
+``X`` on the estimation record's held-back part (``--scan``), not on the
+validation third.
+
+``--scan X1,X2,...`` fits the rig (``oe``, from the ARX's modes) on the
+first three quarters of the estimation record for each accelerometer
+position (1 the end) and prints the fit on its last quarter (warm-up: the
+three quarters): the positions' choice, the validation third unseen.
+
 ``--bound-only`` prints the black boxes and that bound, without the rig;
 ``--starts modes`` only the rig's start from the ARX's modes.
 
@@ -113,11 +124,12 @@ def _rayleigh(table) -> list[Parameter]:
     ]
 
 
-def _box(delay: bool = False, damping=None) -> RigGreyBox:
+def _box(delay: bool = False, damping=None, at: float | None = None) -> RigGreyBox:
     """The rig's free fields with bounds a factor 100 around the preset
     (the payload from a thousandth to a hundred times the beam's); with
     `damping` (Rayleigh's two Parameters) those instead of the one damping
-    ratio, held at 0."""
+    ratio, held at 0; the acceleration at the end or, with `at`, at that
+    fraction of the length."""
     rig = FlexibleManipulator(damping_ratio=0.0 if damping else 0.02)
     beam = rig.density * rig.area * rig.length
     free = [
@@ -134,15 +146,31 @@ def _box(delay: bool = False, damping=None) -> RigGreyBox:
         free.append(Parameter(DELAY, -0.005, (-0.009, 0.009), "s"))
     n_states = 2 * (MODES + 1)
     x0 = [Parameter(f"s{i}", 0.0, (-1.0, 1.0)) for i in range(n_states)]
+    sensors = Sensors.ideal(acceleration_at=() if at is None else (at,))
     return RigGreyBox(
         free,
         rig,
-        output="end_acceleration",
-        sensors=Sensors.ideal(),
+        output="end_acceleration" if at is None else sensors.positional_names[0],
+        sensors=sensors,
         n_modes=MODES,
         output_gain=Parameter(GAIN, 1.0, (-10.0, 10.0)),
         x0=x0,
     )
+
+
+def _scan(est, args, rayleigh) -> None:
+    """The accelerometer's position chosen on the estimation record alone:
+    fitted on its first three quarters, scored on its last quarter."""
+    part, held = est.split(3 / 4)
+    arx = identify(part, ARX(8, 8, 0), method="oe", rng=args.seed)
+    print("\n| accelerometer at | fit % (3/4) | held-back % (1/4) |")
+    print("|---|---|---|")
+    for x in map(float, args.scan.split(",")):
+        box = _box(args.input_delay, rayleigh, None if x == 1.0 else x)
+        start = rig_start_from_modes(box, arx, part, rng=args.seed)
+        model = identify(part, start, method="oe", rng=args.seed)
+        print(f"| {x:g} | {validate(model, part).fit_percent:.2f} | "
+              f"{_fit(model, part, held):.2f} |", flush=True)  # fmt: skip
 
 
 def main() -> None:
@@ -155,6 +183,8 @@ def main() -> None:
         "--starts", default="preset,modes", help="the rig's starts, comma-separated"
     )
     ap.add_argument("--methods", default="oe,spiral", help="comma-separated")
+    ap.add_argument("--accelerometer", type=float, default=None)
+    ap.add_argument("--scan", default=None, help="accelerometer positions")
     args = ap.parse_args()
     seed = args.seed
     data = robot_arm().detrend()
@@ -175,7 +205,10 @@ def main() -> None:
     if args.bound_only:
         return
     rayleigh = _rayleigh(table) if args.damping == "rayleigh" else None
-    box = _box(args.input_delay, rayleigh)
+    if args.scan:
+        _scan(est, args, rayleigh)
+        return
+    box = _box(args.input_delay, rayleigh, args.accelerometer)
     keep = ~table.spurious
     modes = {"preset": box.rig.modes(MODES), "modes": arx}
     starts = {
