@@ -36,6 +36,10 @@ modes, any two ratios within a factor ``w2 / w1`` of each other), started
 where they give the ARX fit's two modes their damping and bounded by a
 ratio of 0.3 at the first mode.
 
+``--hub-friction`` also frees ``hub_friction`` (the rigid mode's viscous
+damping; from 1e-4 N m s/rad, up to ten times the rig's inertia per
+second).
+
 ``--accelerometer X`` reads the record's acceleration at a fraction ``X``
 of the beam's length (an accelerometer's position, a sensor of
 ``Sensors.ideal(acceleration_at=(X,))``) rather than at the end; choose
@@ -124,12 +128,14 @@ def _rayleigh(table) -> list[Parameter]:
     ]
 
 
-def _box(delay: bool = False, damping=None, at: float | None = None) -> RigGreyBox:
+def _box(
+    delay: bool = False, damping=None, at: float | None = None, hub: bool = False
+) -> RigGreyBox:
     """The rig's free fields with bounds a factor 100 around the preset
     (the payload from a thousandth to a hundred times the beam's); with
     `damping` (Rayleigh's two Parameters) those instead of the one damping
     ratio, held at 0; the acceleration at the end or, with `at`, at that
-    fraction of the length."""
+    fraction of the length; with `hub`, the hub's viscous friction free."""
     rig = FlexibleManipulator(damping_ratio=0.0 if damping else 0.02)
     beam = rig.density * rig.area * rig.length
     free = [
@@ -142,6 +148,9 @@ def _box(delay: bool = False, damping=None, at: float | None = None) -> RigGreyB
                   (beam * rig.length**2 / 3e3, beam * rig.length**2 * 30), "kg m^2"),
     ]  # fmt: skip
     free += damping or [Parameter("damping_ratio", 0.02, (0.001, 0.3))]
+    if hub:
+        high = 10 * rig.total_inertia
+        free.append(Parameter("hub_friction", 1e-4, (0.0, high), "N m s/rad"))
     if delay:
         free.append(Parameter(DELAY, -0.005, (-0.009, 0.009), "s"))
     n_states = 2 * (MODES + 1)
@@ -166,7 +175,8 @@ def _scan(est, args, rayleigh) -> None:
     print("\n| accelerometer at | fit % (3/4) | held-back % (1/4) |")
     print("|---|---|---|")
     for x in map(float, args.scan.split(",")):
-        box = _box(args.input_delay, rayleigh, None if x == 1.0 else x)
+        at = None if x == 1.0 else x
+        box = _box(args.input_delay, rayleigh, at, args.hub_friction)
         start = rig_start_from_modes(box, arx, part, rng=args.seed)
         model = identify(part, start, method="oe", rng=args.seed)
         print(f"| {x:g} | {validate(model, part).fit_percent:.2f} | "
@@ -184,6 +194,7 @@ def main() -> None:
     )
     ap.add_argument("--methods", default="oe,spiral", help="comma-separated")
     ap.add_argument("--accelerometer", type=float, default=None)
+    ap.add_argument("--hub-friction", action="store_true")
     ap.add_argument("--scan", default=None, help="accelerometer positions")
     args = ap.parse_args()
     seed = args.seed
@@ -208,7 +219,7 @@ def main() -> None:
     if args.scan:
         _scan(est, args, rayleigh)
         return
-    box = _box(args.input_delay, rayleigh, args.accelerometer)
+    box = _box(args.input_delay, rayleigh, args.accelerometer, args.hub_friction)
     keep = ~table.spurious
     modes = {"preset": box.rig.modes(MODES), "modes": arx}
     starts = {
