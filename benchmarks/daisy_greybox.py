@@ -29,6 +29,28 @@ invisible in the record). Rows:
 either way, started at minus half a sample: the lag of a zero-order hold
 behind a measured input).
 
+``--damping rayleigh`` replaces the one damping ratio (held at 0) by the
+rig's Rayleigh damping, ``mass_damping`` and ``stiffness_damping`` free
+(each mode its own ratio, ``alpha / (2 w_k) + beta w_k / 2``: with two
+modes, any two ratios within a factor ``w2 / w1`` of each other), started
+where they give the ARX fit's two modes their damping and bounded by a
+ratio of 0.3 at the first mode.
+
+``--hub-friction`` also frees ``hub_friction`` (the rigid mode's viscous
+damping; from 1e-4 N m s/rad, up to ten times the rig's inertia per
+second).
+
+``--accelerometer X`` reads the record's acceleration at a fraction ``X``
+of the beam's length (an accelerometer's position, a sensor of
+``Sensors.ideal(acceleration_at=(X,))``) rather than at the end; choose
+``X`` on the estimation record's held-back part (``--scan``), not on the
+validation third.
+
+``--scan X1,X2,...`` fits the rig (``oe``, from the ARX's modes) on the
+first three quarters of the estimation record for each accelerometer
+position (1 the end) and prints the fit on its last quarter (warm-up: the
+three quarters): the positions' choice, the validation third unseen.
+
 ``--bound-only`` prints the black boxes and that bound, without the rig;
 ``--starts modes`` only the rig's start from the ARX's modes.
 
@@ -95,10 +117,26 @@ def _form_bound(est, val, table) -> float:
     return float(100 * (1 - np.linalg.norm(e) / np.linalg.norm(val.y - val.y.mean())))
 
 
-def _box(delay: bool = False) -> RigGreyBox:
+def _rayleigh(table) -> list[Parameter]:
+    """``mass_damping`` and ``stiffness_damping``, bounded by a ratio of 0.3
+    at `table`'s first mode (``rig_start_from_modes`` starts them where
+    they give the table's modes their damping)."""
+    w1 = 2 * np.pi * table.frequency[~table.spurious][0]
+    return [
+        Parameter("mass_damping", 0.0, (0.0, 0.6 * w1), "1/s"),
+        Parameter("stiffness_damping", 0.0, (0.0, 0.6 / w1), "s"),
+    ]
+
+
+def _box(
+    delay: bool = False, damping=None, at: float | None = None, hub: bool = False
+) -> RigGreyBox:
     """The rig's free fields with bounds a factor 100 around the preset
-    (the payload from a thousandth to a hundred times the beam's)."""
-    rig = FlexibleManipulator()
+    (the payload from a thousandth to a hundred times the beam's); with
+    `damping` (Rayleigh's two Parameters) those instead of the one damping
+    ratio, held at 0; the acceleration at the end or, with `at`, at that
+    fraction of the length; with `hub`, the hub's viscous friction free."""
+    rig = FlexibleManipulator(damping_ratio=0.0 if damping else 0.02)
     beam = rig.density * rig.area * rig.length
     free = [
         Parameter("flexural_rigidity", rig.flexural_rigidity,
@@ -108,21 +146,41 @@ def _box(delay: bool = False) -> RigGreyBox:
         Parameter("payload_mass", beam, (beam / 1e3, beam * 100), "kg"),
         Parameter("payload_inertia", beam * rig.length**2 / 3,
                   (beam * rig.length**2 / 3e3, beam * rig.length**2 * 30), "kg m^2"),
-        Parameter("damping_ratio", 0.02, (0.001, 0.3)),
     ]  # fmt: skip
+    free += damping or [Parameter("damping_ratio", 0.02, (0.001, 0.3))]
+    if hub:
+        high = 10 * rig.total_inertia
+        free.append(Parameter("hub_friction", 1e-4, (0.0, high), "N m s/rad"))
     if delay:
         free.append(Parameter(DELAY, -0.005, (-0.009, 0.009), "s"))
     n_states = 2 * (MODES + 1)
     x0 = [Parameter(f"s{i}", 0.0, (-1.0, 1.0)) for i in range(n_states)]
+    sensors = Sensors.ideal(acceleration_at=() if at is None else (at,))
     return RigGreyBox(
         free,
         rig,
-        output="end_acceleration",
-        sensors=Sensors.ideal(),
+        output="end_acceleration" if at is None else sensors.positional_names[0],
+        sensors=sensors,
         n_modes=MODES,
         output_gain=Parameter(GAIN, 1.0, (-10.0, 10.0)),
         x0=x0,
     )
+
+
+def _scan(est, args, rayleigh) -> None:
+    """The accelerometer's position chosen on the estimation record alone:
+    fitted on its first three quarters, scored on its last quarter."""
+    part, held = est.split(3 / 4)
+    arx = identify(part, ARX(8, 8, 0), method="oe", rng=args.seed)
+    print("\n| accelerometer at | fit % (3/4) | held-back % (1/4) |")
+    print("|---|---|---|")
+    for x in map(float, args.scan.split(",")):
+        at = None if x == 1.0 else x
+        box = _box(args.input_delay, rayleigh, at, args.hub_friction)
+        start = rig_start_from_modes(box, arx, part, rng=args.seed)
+        model = identify(part, start, method="oe", rng=args.seed)
+        print(f"| {x:g} | {validate(model, part).fit_percent:.2f} | "
+              f"{_fit(model, part, held):.2f} |", flush=True)  # fmt: skip
 
 
 def main() -> None:
@@ -130,9 +188,14 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--bound-only", action="store_true")
     ap.add_argument("--input-delay", action="store_true")
+    ap.add_argument("--damping", choices=("ratio", "rayleigh"), default="ratio")
     ap.add_argument(
         "--starts", default="preset,modes", help="the rig's starts, comma-separated"
     )
+    ap.add_argument("--methods", default="oe,spiral", help="comma-separated")
+    ap.add_argument("--accelerometer", type=float, default=None)
+    ap.add_argument("--hub-friction", action="store_true")
+    ap.add_argument("--scan", default=None, help="accelerometer positions")
     args = ap.parse_args()
     seed = args.seed
     data = robot_arm().detrend()
@@ -152,7 +215,11 @@ def main() -> None:
     print(f"| rig's form, any fields | {_form_bound(est, val, table):.2f} | - |")
     if args.bound_only:
         return
-    box = _box(args.input_delay)
+    rayleigh = _rayleigh(table) if args.damping == "rayleigh" else None
+    if args.scan:
+        _scan(est, args, rayleigh)
+        return
+    box = _box(args.input_delay, rayleigh, args.accelerometer, args.hub_friction)
     keep = ~table.spurious
     modes = {"preset": box.rig.modes(MODES), "modes": arx}
     starts = {
@@ -164,12 +231,12 @@ def main() -> None:
         at_start = LinearGreyBoxModel(start, start.initial_values, est.ts, "start")
         print(f"| rig, {label} start (no fit) | "
               f"{_fit(at_start, est, val):.2f} | - |", flush=True)  # fmt: skip
-        for method in ("oe", "spiral"):
-            t0 = time.perf_counter()
+        for method in args.methods.split(","):
+            t0, c0 = time.perf_counter(), time.process_time()
             model = identify(est, start, method=method, rng=seed)
-            secs = time.perf_counter() - t0
+            secs, cpu = time.perf_counter() - t0, time.process_time() - c0
             print(f"| rig, {label} start, {method} | {_fit(model, est, val):.2f} | "
-                  f"{secs:.0f} |", flush=True)  # fmt: skip
+                  f"{secs:.0f} (cpu {cpu:.0f}) |", flush=True)  # fmt: skip
             fitted[label, method] = model
     pairs = zip(table.frequency[keep], table.damping[keep], strict=True)
     print("\nARX(8, 8, 0)'s modes (Hz, damping):",

@@ -73,6 +73,8 @@ RIG_PARAMETERS: dict[str, str] = {
     "payload_mass": "kg",
     "payload_inertia": "kg m^2",
     "damping_ratio": "",
+    "mass_damping": "1/s",
+    "stiffness_damping": "s",
     "hub_friction": "N m s/rad",
     "coulomb_friction": "N m",
     "static_friction": "N m",

@@ -94,9 +94,14 @@ def _zero_preset_high(rig: FlexibleManipulator, name: str) -> float:
     """The upper bound of a field whose preset is zero (our choice, a
     scale of the rig): a payload up to the beam's mass or its inertia about
     the hub, friction torques up to 0.1 N m (a third of the paper's
-    pulses) and a viscous friction that would stop the rigid rig in 0.1 s."""
+    pulses), a viscous friction that would stop the rigid rig in 0.1 s and
+    Rayleigh coefficients that alone give the first flexible mode a damping
+    ratio of 0.5."""
     beam_mass = rig.density * rig.area * rig.length
+    w1 = 2.0 * np.pi * float(rig.modes(1)[0])
     return {
+        "mass_damping": w1,
+        "stiffness_damping": 1.0 / w1,
         "payload_mass": beam_mass,
         "payload_inertia": beam_mass * rig.length**2 / 3.0,
         "coulomb_friction": 0.1,
@@ -523,7 +528,8 @@ class RigGreyBox(GreyBox):
     def modes_beside(self, values, n: int = 4) -> str:
         """A table of the first `n` flexible modes (Hz) of the rig at
         `values` beside those of `rig` (the finite-element model at its
-        preset), with the modal damping ratio of each.
+        preset), with the fitted damping ratio of each
+        (:meth:`~spiralid.fms.FlexibleManipulator.mode_damping`).
 
         Parameters
         ----------
@@ -538,11 +544,12 @@ class RigGreyBox(GreyBox):
         """
         n = min(integer(n, "n", 1), 2 * self.rig.n_elements)
         fitted = self.rig_at(values)
+        zeta = fitted.mode_damping(n)
         rows = ["mode  FEM preset Hz  fitted Hz  fitted damping"]
         for k, (f0, f1) in enumerate(
             zip(self.rig.modes(n), fitted.modes(n), strict=True), 1
         ):
-            rows.append(f"{k:>4}  {f0:13.2f}  {f1:9.2f}  {fitted.damping_ratio:14.4f}")
+            rows.append(f"{k:>4}  {f0:13.2f}  {f1:9.2f}  {zeta[k - 1]:14.4f}")
         return "\n".join(rows)
 
     # -- text and JSON ----------------------------------------------------------

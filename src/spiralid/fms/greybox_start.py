@@ -16,7 +16,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, nnls
 
 from spiralid._checks import generator, integer
 from spiralid.fms.greybox import RigGreyBox
@@ -230,6 +230,35 @@ def _rebuilt(box: RigGreyBox, values: np.ndarray) -> RigGreyBox:
     )
 
 
+# Each damping field's share of a mode's damping ratio at w (rad/s).
+_RAYLEIGH = {
+    "damping_ratio": lambda w: np.ones_like(w),
+    "mass_damping": lambda w: 1.0 / (2.0 * w),
+    "stiffness_damping": lambda w: w / 2.0,
+}
+
+
+def _start_rayleigh(box: RigGreyBox, values, freq, damping) -> None:
+    """The free damping fields of `values` (in place) where the modes'
+    damping ratios are best matched, in least squares with each field
+    non-negative, the held ones' share subtracted; then clipped to their
+    bounds."""
+    w = 2.0 * np.pi * np.asarray(freq, dtype=float)
+    rig = box.rig_at(values)
+    names, params = box.names, box.all_parameters
+    free = [n for n in _RAYLEIGH if n in names and params[names.index(n)].free]
+    if not free:
+        return
+    held = sum(getattr(rig, n) * _RAYLEIGH[n](w) for n in _RAYLEIGH if n not in free)
+    cols = np.column_stack([_RAYLEIGH[n](w) for n in free])
+    # Scaled columns: the fields differ by orders of magnitude.
+    size = np.linalg.norm(cols, axis=0)
+    coef = nnls(cols / size, np.asarray(damping, dtype=float) - held)[0] / size
+    for n, c in zip(free, coef, strict=True):
+        i = names.index(n)
+        values[i] = np.clip(c, *params[i].bounds)
+
+
 def rig_start_from_modes(
     box: RigGreyBox, modes, data=None, *, starts: int = 20, rng=None
 ) -> RigGreyBox:
@@ -243,7 +272,10 @@ def rig_start_from_modes(
     from the box's initial values and `starts` random points, the best
     kept (with `data`, of the fits that match, the one whose simulation
     is closest to the record: the modes fix the frequencies, not the
-    residues). A free damping ratio starts at the modes' mean damping.
+    residues). A free damping ratio starts at the modes' mean damping;
+    with Rayleigh's ``mass_damping`` or ``stiffness_damping`` free, the
+    free damping fields start where they best give each mode its damping
+    (non-negative least squares).
     With `data` (the linear kind), the output gain and the initial state,
     where estimated, start at their least-squares values on the record, the
     simulation being linear in both, and their bounds become 4 times the
@@ -297,7 +329,10 @@ def rig_start_from_modes(
         )
     candidates = _match(box, freq, starts, generator(rng))
     names = box.names
-    if damping is not None and "damping_ratio" in names:
+    if damping is not None and {"mass_damping", "stiffness_damping"} & set(names):
+        for values in candidates:
+            _start_rayleigh(box, values, freq, damping)
+    elif damping is not None and "damping_ratio" in names:
         i = names.index("damping_ratio")
         p = box.all_parameters[i]
         for values in candidates if p.free else ():

@@ -266,6 +266,18 @@ class FlexibleManipulator:
         Sub-steps per sample of the friction's time stepping (see
         :mod:`spiralid.fms._friction`), >= 1.  Default 20.  Only used when
         a friction torque is on.
+    mass_damping : float
+        Rayleigh damping's mass-proportional coefficient alpha (1/s), >= 0:
+        adds ``alpha / (2 w_k)`` to flexible mode k's damping ratio.
+        Default 0.
+    stiffness_damping : float
+        Rayleigh damping's stiffness-proportional coefficient beta (s),
+        >= 0: adds ``beta w_k / 2`` to flexible mode k's damping ratio (a
+        material's internal damping, growing with frequency).  Default 0.
+        With `mass_damping`, the flexible modes are damped as by ``C =
+        alpha M + beta K`` (see :meth:`mode_damping`); the rigid mode's
+        share of ``alpha M`` (a damping to the ground, which no hub-driven
+        arm has) is left out, as `damping_ratio`'s is.
 
     Examples
     --------
@@ -290,6 +302,9 @@ class FlexibleManipulator:
     stribeck_velocity: float = 0.1
     torque_limit: float | None = None
     friction_substeps: int = 20
+    # Last, so that the fields before keep their positions.
+    mass_damping: float = 0.0
+    stiffness_damping: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -304,6 +319,8 @@ class FlexibleManipulator:
         for name in (
             "payload_mass",
             "payload_inertia",
+            "mass_damping",
+            "stiffness_damping",
             "hub_friction",
             "coulomb_friction",
             "static_friction",
@@ -411,16 +428,56 @@ class FlexibleManipulator:
         omega = np.concatenate([[0.0], np.sqrt(lam)])
         return omega, phi
 
+    def _modal_damping(self, omega: np.ndarray) -> np.ndarray:
+        """``2 zeta_k w_k`` of each mode at the frequencies `omega` (rad/s,
+        the rigid mode's 0 first): zero for the rigid mode."""
+        out = 2.0 * self.damping_ratio * omega
+        if self.mass_damping or self.stiffness_damping:
+            # Rayleigh's alpha M + beta K in modal coordinates (mass-
+            # normalised modes): alpha + beta w^2, on the flexible modes.
+            out = out + self.mass_damping + self.stiffness_damping * omega**2
+            out[0] = 0.0
+        return out
+
+    def mode_damping(self, n: int | None = None) -> np.ndarray:
+        """Damping ratio of each flexible mode, ascending in frequency:
+        ``damping_ratio + mass_damping / (2 w_k) + stiffness_damping w_k /
+        2``.
+
+        Parameters
+        ----------
+        n : int, optional
+            Return only the first ``n`` (at most ``2 n_elements``); default
+            all ``2 n_elements``.
+
+        Returns
+        -------
+        ndarray
+
+        Examples
+        --------
+        >>> rig = FlexibleManipulator(damping_ratio=0.0, stiffness_damping=1e-4)
+        >>> np.round(rig.mode_damping(2), 4)  # beta w_k / 2
+        array([0.0042, 0.011 ])
+        """
+        w = 2.0 * math.pi * self.modes(n)
+        return (
+            self.damping_ratio
+            + self.mass_damping / (2.0 * w)
+            + (self.stiffness_damping * w / 2.0)
+        )
+
     @property
     def damping_matrix(self) -> np.ndarray:
         """Damping matrix: modal damping of the flexible modes plus hub friction.
 
-        ``C = M Phi diag(2 zeta w_i) Phi^T M + c_h e_theta e_theta^T`` with
-        the rigid mode's entry zero, so only friction damps the rigid motion.
+        ``C = M Phi diag(2 zeta_i w_i) Phi^T M + c_h e_theta e_theta^T`` with
+        the rigid mode's entry zero, so only friction damps the rigid motion
+        (``zeta_i`` of :meth:`mode_damping`).
         """
         omega, phi = self._modal
         mp = self.mass_matrix @ phi
-        C = (mp * (2.0 * self.damping_ratio * omega)) @ mp.T
+        C = (mp * self._modal_damping(omega)) @ mp.T
         C[0, 0] += self.hub_friction
         return C
 
@@ -658,9 +715,7 @@ class FlexibleManipulator:
         g = phi[0]  # hub torque's modal participation
         # The input's participation: the torque's, or the force's load.
         gi = g if force_at is None else phi.T @ self.load_vector(force_at)
-        cm = np.diag(2.0 * self.damping_ratio * omega) + self.hub_friction * np.outer(
-            g, g
-        )
+        cm = np.diag(self._modal_damping(omega)) + self.hub_friction * np.outer(g, g)
         A = np.zeros((2 * n, 2 * n))
         A[:n, n:] = np.diag(scale)
         A[n:, :n] = -np.diag(omega**2 / scale)
