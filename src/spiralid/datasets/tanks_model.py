@@ -30,6 +30,11 @@ one parameter the form adds), of the surplus. The upper level is never
 measured: its scale is the model's choice, fixed by :data:`UPPER_TOP`, or
 the record could not tell the pump's gain from the upper tank's size.
 
+:func:`tanks_hybrid` adds a learned correction of a fitted grey box's
+output (a second model, trained on the grey box's free-run error and run
+free beside it), the "grey box plus learned residual" form of the
+published grey boxes.
+
 Why here and not in an example: ``model.json`` names the model's functions
 by import path, and an example's functions live in ``__main__`` when it
 runs; shipped with the package, a fitted tanks model saves and loads
