@@ -30,6 +30,11 @@ one parameter the form adds), of the surplus. The upper level is never
 measured: its scale is the model's choice, fixed by :data:`UPPER_TOP`, or
 the record could not tell the pump's gain from the upper tank's size.
 
+:func:`tanks_hybrid` adds a learned correction of a fitted grey box's
+output (a second model, trained on the grey box's free-run error and run
+free beside it), the "grey box plus learned residual" form of the
+published grey boxes.
+
 Why here and not in an example: ``model.json`` names the model's functions
 by import path, and an example's functions live in ``__main__`` when it
 runs; shipped with the package, a fitted tanks model saves and loads
@@ -40,9 +45,12 @@ tens of times slower: ``benchmarks/greybox_speed.py``).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numba
 import numpy as np
 
+from spiralid.sysid import IOData, identify
 from spiralid.sysid.models.greybox import GreyBox, Parameter
 
 __all__ = [
@@ -51,11 +59,13 @@ __all__ = [
     "SURPLUS_SHARE",
     "TANKS_PARAMETERS",
     "UPPER_TOP",
+    "TanksHybrid",
     "tanks_f",
     "tanks_f_inflow",
     "tanks_f_mixed",
     "tanks_g",
     "tanks_greybox",
+    "tanks_hybrid",
 ]
 
 #: The upper tank's overflow level, in the model's volts.
@@ -224,4 +234,136 @@ def tanks_greybox(
         ]
     return GreyBox(
         params, f=OVERFLOWS[overflow], g=tanks_g, n_states=2, x0=x0, substeps=substeps
+    )
+
+
+@dataclass(eq=False)
+class TanksHybrid:
+    """A fitted tanks grey box plus a learned correction of its output
+    (:func:`tanks_hybrid`): ``min(y_gb + r_hat, 10)``, both in free run.
+
+    Attributes
+    ----------
+    greybox : GreyBoxModel
+        The fitted grey box; ``y_gb`` is its free run.
+    correction : FittedModel or None
+        The correction: a model of the residual ``y - y_gb`` whose input is
+        ``y_gb`` (or ``u`` and ``y_gb``), shifted by `offsets`; None where
+        the residual was constant on the record (its mean, in `offsets`,
+        is then the whole correction).
+    with_input : bool
+        Whether the correction sees the input ``u`` beside ``y_gb``.
+    offsets : tuple of (ndarray, float)
+        The means removed from the correction's inputs and output on the
+        record it was fitted on (:meth:`IOData.detrend`).
+    """
+
+    greybox: object
+    correction: object
+    with_input: bool
+    offsets: tuple
+
+    def correct(self, u, y_gb) -> np.ndarray:
+        """The correction's free run ``r_hat`` (from rest, its own past
+        outputs simulated) over the input `u` and the grey box's run `y_gb`.
+
+        Parameters
+        ----------
+        u, y_gb : array_like, shape (N,)
+        """
+        y_gb = np.ravel(y_gb)
+        u_offset, y_offset = self.offsets
+        if self.correction is None:
+            return np.full(y_gb.size, y_offset)
+        inputs = _correction_inputs(np.ravel(u), y_gb, self.with_input)
+        return np.ravel(self.correction.simulate(inputs - u_offset)) + y_offset
+
+    def simulate(self, u) -> np.ndarray:
+        """The hybrid's free run over `u` (an ``IOData`` gives its ``u``),
+        shape (N,): the grey box's run plus the correction's, saturating
+        as the sensor does.
+
+        Parameters
+        ----------
+        u : array_like or IOData
+        """
+        u = np.ravel(u.u if isinstance(u, IOData) else u).astype(float)
+        y_gb = np.ravel(self.greybox.simulate(u))
+        return np.minimum(y_gb + self.correct(u, y_gb), SENSOR_MAX)
+
+
+def _correction_inputs(u, y_gb, with_input: bool) -> np.ndarray:
+    # One list of the correction's input columns: y_gb, after u when asked.
+    return np.column_stack([u, y_gb]) if with_input else y_gb
+
+
+def tanks_hybrid(
+    greybox,
+    data: IOData,
+    correction,
+    *,
+    with_input: bool = False,
+    method: str = "oe",
+    rng=None,
+) -> TanksHybrid:
+    """The fitted grey box `greybox` plus a correction of structure
+    `correction` trained on its free-run error on `data` (a two-stage
+    hybrid: the grey box stays as fitted).
+
+    The residual ``r = y - y_gb`` of the grey box's free run ``y_gb`` on
+    `data` becomes the output of a record whose input is ``y_gb`` (and
+    ``u``), shifted by its means; ``identify(record, correction,
+    method=method, rng=rng)`` fits it. The correction runs free too (its
+    past outputs simulated, never measured), so the hybrid needs only the
+    input: see :class:`TanksHybrid`.
+
+    Parameters
+    ----------
+    greybox : GreyBoxModel
+        A fitted tanks grey box (``identify(data, tanks_greybox())``).
+    data : IOData
+        The record to learn the correction on (one input, one output):
+        the grey box's own estimation record, or a part of it.
+    correction : structure
+        Any one-output structure :func:`~spiralid.sysid.identify` fits:
+        ``NeuralStateSpace(1, hidden=(8,))``, ``NARX(...)`` (one input),
+        ``ARX(2, 2, 0)`` (a shared denominator with `with_input`).
+    with_input : bool, default False
+        Give the correction ``u`` beside ``y_gb`` (two inputs: the
+        families that take several).
+    method : str, default "oe"
+        The correction's estimation method.
+    rng : int, numpy.random.Generator or None
+        The correction's randomness (its initial weights).
+
+    Returns
+    -------
+    TanksHybrid
+    """
+    if not isinstance(data, IOData):
+        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
+    if not isinstance(with_input, bool):
+        raise TypeError(f"`with_input` must be a bool; got {type(with_input).__name__}")
+    if not callable(getattr(greybox, "simulate", None)):
+        raise TypeError(
+            f"`greybox` must be a fitted model; got {type(greybox).__name__}"
+        )
+    if data.n_inputs != 1 or data.n_outputs != 1:
+        raise ValueError(
+            f"`data` must have one input and one output; got {data.n_inputs} "
+            f"and {data.n_outputs}"
+        )
+    u = np.ravel(data.u)
+    y_gb = np.ravel(greybox.simulate(u))
+    inputs = _correction_inputs(u, y_gb, with_input)
+    record = IOData(inputs, np.ravel(data.y) - y_gb, ts=data.ts).detrend()
+    # A residual that is constant on the record leaves nothing to learn
+    # (identify refuses an all-zero output): its mean alone corrects it.
+    fitted = np.any(record.y != 0.0)
+    model = identify(record, correction, method=method, rng=rng) if fitted else None
+    return TanksHybrid(
+        greybox,
+        model,
+        with_input,
+        (np.asarray(record.u_offset, dtype=float), float(record.y_offset)),
     )
