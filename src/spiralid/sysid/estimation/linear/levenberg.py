@@ -250,8 +250,13 @@ def levenberg_marquardt(
         r = residual(x)
         return float(r @ r), r
 
+    # The last point linearised and its Jacobian: where the polish ends
+    # there (a cap or a stop among rejected trials), the result's Jacobian.
+    last = [None, None]
+
     def linearise(x, cost, r):
         jac = jacobian(x)
+        last[:] = [x, jac]
         scale = np.linalg.norm(jac, axis=0)
         scale[scale == 0.0] = 1.0
         q, upper = linalg.qr(jac / scale, mode="economic", check_finite=False)
@@ -304,7 +309,7 @@ def levenberg_marquardt(
     )
     status = {"cap": 0, "stationary": 1, "no decrease": 4}.get(out["stop"], out["stop"])
     x, r = out["x"], out["state"]
-    jac = jacobian(x)
+    jac = last[1] if last[0] is x else jacobian(x)
     return OptimiserResult(
         x=x,
         cost=0.5 * out["cost"],

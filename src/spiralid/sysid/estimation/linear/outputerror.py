@@ -137,21 +137,21 @@ def error_functions(
     (:mod:`spiralid.sysid.estimation.core.uncertainty`) use the same pair.
     """
     na, t0 = arx.na, arx.max_lag
-    if predictor == "simulation" and initial == "rest":
+    if predictor != "simulation":
+        phi = arx.regressors(data)[t0:]
+        yv = data.y[t0:]
+        return (lambda x: phi @ x - yv), (lambda x: phi)
+    u, y = data.u, data.y
+    if initial == "rest":
         # From rest is the measured-past problem on the record preceded by
         # t0 zeros: the "measured" past is then the zero state, the input
         # before t = 0 is zero, and the residual covers all N samples.
         pad = np.zeros(t0)
-        data = IOData(np.r_[pad, data.u], np.r_[pad, data.y], ts=data.ts)
-    y = data.y
+        u, y = np.r_[pad, u], np.r_[pad, y]
     yv = y[t0:]
     n_k = yv.size
-    phi = arx.regressors(data)[t0:]
-    ulags = arx.input_lags(data.u)[:, t0:]
+    ulags = arx.input_lags(u)[:, t0:]
     past = y[t0 - na : t0][::-1]
-
-    if predictor != "simulation":
-        return (lambda x: phi @ x - yv), (lambda x: phi)
 
     def simulate(a, b):
         xs = b @ ulags
@@ -165,7 +165,7 @@ def error_functions(
         return simulate(x[:na], x[na:]) - yv
 
     if initial == "rest":
-        upad = data.u
+        upad = u
         nk = arx.nk
 
         def jacobian(x):
