@@ -9,8 +9,10 @@ get the same budget of simulations (``--budget``, default 1,000, the
 default fit's search budget):
 
 - ``spiral``: the default fit's search itself (``method="spiral"``'s
-  search part: the learned-metric spiral, 20 points, seeded with ``z0``,
-  trial points clipped onto the box), seeded with the seed;
+  search part: the learned-metric spiral, its first run a population run
+  centred at ``z0`` with step ``1 / sqrt(12)``, its restarts alternating
+  around the best point so far and over the box, trial points clipped onto
+  the box), seeded with the seed;
 - ``cma``: pycma's ``CMAEvolutionStrategy`` from ``z0`` with bounds
   ``[0, 1]`` (its default boundary handling), its default population
   (``4 + 3 ln n``) and ``sigma0 = 1 / sqrt(12)``, the spread of the uniform

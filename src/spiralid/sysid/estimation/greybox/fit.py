@@ -2,11 +2,13 @@
 (:data:`~spiralid.sysid.estimation.core.families.ESTIMATORS`):
 
 - ``"spiral"`` (default): the learned-metric spiral
-  (:func:`spiralid.optim.minimize` with ``method="learned-metric"``) over
-  the free parameters in their unit box (log-scaled where a parameter has a
-  log scale), seeded with the initial values, restarting once a run's steps
-  are below a hundredth of the box (``_RESTARTS``), then Levenberg-Marquardt
-  on the simulation error from the best point, projected into the box;
+  (:func:`spiralid.optim.minimize` with a
+  :class:`~spiralid.optim.LearnedMetricSpiral`, ``_SPIRAL``) over the free
+  parameters in their unit box (log-scaled where a parameter has a log
+  scale), starting with a population run centred at the initial values,
+  restarting once a run's steps are below a hundredth of the box
+  (``_RESTARTS``), then Levenberg-Marquardt on the simulation error from
+  the best point, projected into the box;
 - ``"oe"``: that Levenberg-Marquardt alone, from the initial values;
 - both beside a second fit over growing horizons (``horizons``, shares of
   the record): the search on the first share, the polish on each longer
