@@ -50,6 +50,7 @@ BLAS runs on one thread unless set (as the command line does). Seconds
 are the machine's and indicative.
 
     python benchmarks/greybox_cmaes.py --seeds 0-9 --problems tanks rig4
+    python benchmarks/greybox_cmaes.py --searches spiral-x0 cma
 """
 
 from __future__ import annotations
