@@ -34,9 +34,9 @@ def test_the_first_run_is_a_population_around_x0_mirrored_about_it():
     points = np.array(seen[1:9])
     half = len(points) // 2
     # Mirrored pairs x0 + s and x0 - s: each pair's midpoint is x0.
-    np.testing.assert_allclose(
-        (points[:half] + points[half:]) / 2, x0[None, :] + 0 * points[:half], atol=1e-12
-    )
+    assert len(seen) == 10  # the start, 8 points, their weighted mean
+    midpoints = (points[:half] + points[half:]) / 2
+    np.testing.assert_allclose(midpoints, np.tile(x0, (half, 1)), atol=1e-12)
     # The steps are on the scale of sigma times the box's width (10).
     spread = np.abs(points - x0).max()
     assert 0.05 < spread < 5.0, spread
