@@ -1,6 +1,7 @@
 """The grey box's default search (``"spiral"``'s, with its restarts) on a
 lightly damped oscillator struck once: one generator gives one search,
-every point it simulates lies in the parameters' bounds, and once the
+every point it simulates lies in the parameters' bounds, the initial
+values are simulated first, and once the
 first poll's steps are below a hundredth of the box it draws points anew
 where the poll alone would stay around its centre."""
 
@@ -60,6 +61,9 @@ def test_one_generator_gives_one_search_and_every_point_is_in_the_bounds():
     z_again, asked_again = search(5)
     assert np.array_equal(z, z_again) and np.array_equal(asked, asked_again)
     assert np.all((asked >= 0.0) & (asked <= 1.0))
+    # The initial values are simulated first (the first poll's population
+    # holds them).
+    np.testing.assert_array_equal(asked[0], problem().z0)
     assert np.all((z >= 0.0) & (z <= 1.0))
     # The last half of the budget: new runs over the box with the restarts,
     # the one poll's neighbourhood of its centre without.

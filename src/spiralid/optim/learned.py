@@ -219,7 +219,16 @@ class LearnedMetricSearch(SearchBase):
             (self._polled[2 * j : 2 * j + 2], self._signed[2 * j : 2 * j + 2])
             for j in range(n)
         ]
-        self._start_poll(seed_points(x0, self._lo, self._hi, m), m)
+        self._local_next = True
+        seeds = seed_points(x0, self._lo, self._hi, m)
+        if method.first_sigma is None:
+            self._start_poll(seeds, m)
+        else:
+            # A population run from x0 (first_sigma): no first draw, its
+            # centre evaluated first; `m` stays what a restart's poll grows.
+            self._m = m
+            centre = seeds[0] if len(seeds) else None
+            self._start_population(self._population, centre, method.first_sigma)
         self.initial_nonfinite = not math.isfinite(self._f)
         self.history = Trace(self.fun)
         self._mean_step = Trace()
@@ -290,15 +299,19 @@ class LearnedMetricSearch(SearchBase):
         self._trail = []
         self._crawled = False
 
-    def _start_population(self, size: int) -> None:
-        """Start a population run of `size` points around a uniform centre."""
+    def _start_population(
+        self, size: int, centre: np.ndarray | None = None, sigma: float = _SIGMA0
+    ) -> None:
+        """Start a population run of `size` points around `centre` (a
+        uniform one if None) with step `sigma` (of the unit cube)."""
         n = self._lo.size
-        u = self._rng.uniform(size=n)
-        self._c = self._lo + u * self._width
+        if centre is None:
+            centre = self._lo + self._rng.uniform(size=n) * self._width
+        self._c = np.array(centre, dtype=float)
         self._f = self._evaluate_one(self._c[None, :])
         self._lambda = size
         self._population_runs += 1
-        self._sigma = _SIGMA0
+        self._sigma = sigma
         self._path = np.zeros(n)
         self._encoding = AdaptiveEncoding.for_population(n, size // 2)
         self._encoding.eigen_every = self.rule.eigen_every(self._encoding)
@@ -346,7 +359,13 @@ class LearnedMetricSearch(SearchBase):
         """BIPOP's rule: the regime whose runs have spent fewer evaluations."""
         if self.rule.populations and self._spent["population"] <= self._spent["poll"]:
             self._population *= 2
-            self._start_population(self._population)
+            local = self.rule.local_sigma
+            if local is not None and self._local_next:
+                # BIPOP's local regime: around the best so far, not anew.
+                self._start_population(self._population, self.x, local)
+            else:
+                self._start_population(self._population)
+            self._local_next = not self._local_next
         else:
             self._start_poll(np.empty((0, self._lo.size)), m)
 

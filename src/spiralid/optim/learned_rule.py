@@ -149,6 +149,20 @@ class LearnedMetricSpiral:
         carries a coordinate found good elsewhere on the front and steps
         past the front's ends (WFG2's outer pieces). The single-objective
         search refuses any other value than the default.
+    first_sigma : float or None
+        None (default): the search starts with a poll from the best of its
+        ``n_points`` first points. A step in (0, 1] of the unit cube: it
+        starts instead with a population run centred at ``x0`` (its first
+        row; a uniform point without ``x0``) with this step, as CMA-ES run
+        from ``x0`` with ``sigma0`` does; the ``n_points`` first points are
+        not drawn. For a start that carries information (a model's initial
+        values); :func:`~spiralid.optim.minimize` only.
+    local_sigma : float or None
+        None (default): a population restart is centred at a uniform point
+        with step 0.2 of the unit cube. A step in (0, 1]: population
+        restarts alternate between one centred at the best point so far
+        with this step (BIPOP-CMA-ES's local regime) and a uniform one, the
+        local first. :func:`~spiralid.optim.minimize` only.
 
     Examples
     --------
@@ -178,6 +192,8 @@ class LearnedMetricSpiral:
     shrink: float = 0.5
     delta: float = 1e-3
     crossover: float = 0.5
+    first_sigma: float | None = None
+    local_sigma: float | None = None
 
     def __post_init__(self):
         for name in (
@@ -224,6 +240,14 @@ class LearnedMetricSpiral:
         if isinstance(self.crossover, bool) or not 0.0 <= crossover <= 1.0:
             raise ValueError(f"`crossover` must be in [0, 1]; got {self.crossover!r}")
         object.__setattr__(self, "crossover", crossover)
+        for name in ("first_sigma", "local_sigma"):
+            if getattr(self, name) is not None:
+                value = positive(getattr(self, name), name)
+                if value > 1.0:
+                    raise ValueError(
+                        f"`{name}` must be in (0, 1] or None; got {value!r}"
+                    )
+                object.__setattr__(self, name, value)
 
     def eigen_every(self, encoding) -> int:
         """Updates of `encoding` (an :class:`AdaptiveEncoding`) between two
