@@ -50,9 +50,11 @@ def ljung_box(r: np.ndarray, n: int) -> float:
 
 
 def _autocovariance(e: np.ndarray, lags: int) -> np.ndarray:
-    """The biased (divide by ``N``) autocovariance at lags ``0..lags``."""
-    full = np.correlate(e, e, "full")
-    return full[e.size - 1 : e.size + lags] / e.size
+    """The biased (divide by ``N``) autocovariance at lags ``0..lags`` (zero
+    at a lag beyond the record): one product a lag, not the full
+    correlation's ``N^2`` for the few lags used."""
+    n = e.size
+    return np.array([e[k:] @ e[: n - k] for k in range(lags + 1)]) / n
 
 
 def noise_ar(e: np.ndarray) -> tuple[np.ndarray, float]:
