@@ -20,6 +20,7 @@ from scipy.optimize import least_squares, nnls
 
 from spiralid._checks import generator, integer
 from spiralid.fms.greybox import RigGreyBox
+from spiralid.fms.rig import DAMPING_SHARES
 from spiralid.sysid.models.greybox import Parameter
 from spiralid.sysid.models.greybox_run import lti_run
 
@@ -230,14 +231,6 @@ def _rebuilt(box: RigGreyBox, values: np.ndarray) -> RigGreyBox:
     )
 
 
-# Each damping field's share of a mode's damping ratio at w (rad/s).
-_RAYLEIGH = {
-    "damping_ratio": lambda w: np.ones_like(w),
-    "mass_damping": lambda w: 1.0 / (2.0 * w),
-    "stiffness_damping": lambda w: w / 2.0,
-}
-
-
 def _start_rayleigh(box: RigGreyBox, values, freq, damping) -> None:
     """The free damping fields of `values` (in place) where the modes'
     damping ratios are best matched, in least squares with each field
@@ -246,11 +239,13 @@ def _start_rayleigh(box: RigGreyBox, values, freq, damping) -> None:
     w = 2.0 * np.pi * np.asarray(freq, dtype=float)
     rig = box.rig_at(values)
     names, params = box.names, box.all_parameters
-    free = [n for n in _RAYLEIGH if n in names and params[names.index(n)].free]
+    free = [n for n in DAMPING_SHARES if n in names and params[names.index(n)].free]
     if not free:
         return
-    held = sum(getattr(rig, n) * _RAYLEIGH[n](w) for n in _RAYLEIGH if n not in free)
-    cols = np.column_stack([_RAYLEIGH[n](w) for n in free])
+    held = sum(
+        getattr(rig, n) * DAMPING_SHARES[n](w) for n in DAMPING_SHARES if n not in free
+    )
+    cols = np.column_stack([DAMPING_SHARES[n](w) for n in free])
     # Scaled columns: the fields differ by orders of magnitude.
     size = np.linalg.norm(cols, axis=0)
     coef = nnls(cols / size, np.asarray(damping, dtype=float) - held)[0] / size

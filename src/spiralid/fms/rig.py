@@ -46,6 +46,14 @@ __all__ = ["FlexibleManipulator", "Recording", "nonlinear_rig"]
 
 _OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
 # The rig's inputs: the hub torque, and a shaker's force on the beam.
+#: Each damping field's share of a flexible mode's damping ratio at its
+#: frequency ``w`` (rad/s): the ratio is the fields' sum weighted by these
+#: (the one ``damping_ratio``, then Rayleigh's ``alpha M + beta K``).
+DAMPING_SHARES = {
+    "damping_ratio": lambda w: np.ones_like(w),
+    "mass_damping": lambda w: 1.0 / (2.0 * w),
+    "stiffness_damping": lambda w: w / 2.0,
+}
 _INPUTS = ("torque", "force")
 _INPUT_UNITS = {"torque": "N m", "force": "N"}
 _UNITS = {
@@ -461,10 +469,8 @@ class FlexibleManipulator:
         array([0.0042, 0.011 ])
         """
         w = 2.0 * math.pi * self.modes(n)
-        return (
-            self.damping_ratio
-            + self.mass_damping / (2.0 * w)
-            + (self.stiffness_damping * w / 2.0)
+        return sum(
+            getattr(self, name) * share(w) for name, share in DAMPING_SHARES.items()
         )
 
     @property
