@@ -51,6 +51,7 @@ import numba
 import numpy as np
 
 from spiralid.sysid import IOData, identify
+from spiralid.sysid.data import single_output_record
 from spiralid.sysid.models.greybox import GreyBox, Parameter
 
 __all__ = [
@@ -340,18 +341,12 @@ def tanks_hybrid(
     -------
     TanksHybrid
     """
-    if not isinstance(data, IOData):
-        raise TypeError(f"`data` must be an IOData; got {type(data).__name__}")
+    single_output_record(data, "tanks_hybrid")
     if not isinstance(with_input, bool):
         raise TypeError(f"`with_input` must be a bool; got {type(with_input).__name__}")
     if not callable(getattr(greybox, "simulate", None)):
         raise TypeError(
             f"`greybox` must be a fitted model; got {type(greybox).__name__}"
-        )
-    if data.n_inputs != 1 or data.n_outputs != 1:
-        raise ValueError(
-            f"`data` must have one input and one output; got {data.n_inputs} "
-            f"and {data.n_outputs}"
         )
     u = np.ravel(data.u)
     y_gb = np.ravel(greybox.simulate(u))
