@@ -9,7 +9,8 @@ from scipy import signal
 
 import spiralid as sid
 from spiralid.sysid import GreyBox, Parameter
-from spiralid.sysid.estimation.greybox.fit import _horizon_lengths
+from spiralid.sysid.estimation.greybox import fit
+from spiralid.sysid.estimation.greybox.fit import _horizon_lengths, _search_budget
 
 TS = 0.05
 K, C = 4.0, 0.02  # stiffness (N/m) and damping (N s/m) of a 1 kg mass
@@ -66,3 +67,25 @@ def test_growing_horizons_find_the_frequency_the_whole_record_hides():
     # The whole record's fit is one of the two candidates: never worse.
     assert grown.cost <= alone.cost
     assert grown.nfev > alone.nfev
+
+
+@pytest.mark.parametrize(
+    "share, times", [(1.0, 1), (0.5, 1), (0.25, 1), (0.1, 3), (0.05, 6)]
+)
+def test_a_short_horizon_search_gets_whole_budgets_for_its_samples(share, times):
+    # 30 % of the whole record's search in samples, rounded to whole budgets:
+    # a tenth of the record gets three, a quarter one.
+    assert _search_budget({"max_nfev": 500}, 20, share) == 500 * times
+
+
+def test_the_horizons_search_runs_with_its_budget(monkeypatch):
+    budgets = []
+    real = fit.minimize
+
+    def counted(*args, **kwargs):
+        budgets.append(kwargs["max_nfev"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fit, "minimize", counted)
+    sid.identify(struck(400), box(2.0), max_nfev=40, polish_nfev=2, horizons=(0.1,))
+    assert budgets == [40, 120]  # the whole record's, then its first tenth's
