@@ -46,16 +46,29 @@ Problems (``--problems``):
 - ``tanks``: ``tanks_greybox()`` (8 parameters and the 2 initial levels
   free) on the Cascaded Tanks estimation record.
 
+The default fit's search over the horizons' first tenth has three times
+the whole record's budget (``_search_budget``): ``--budget 3000`` on the
+``-tenth`` problems compares the searches as that fit runs them.
+
+With ``--whole-fit`` (``rig4``, ``rig6``) the whole default fit,
+``identify(est, box, rng=seed)`` (both searches, the horizons, every
+polish), runs once with each search in it at the fit's own budgets, and
+its cost, its validation fit on the record's last third and its
+simulations are printed.
+
 BLAS runs on one thread unless set (as the command line does). Seconds
 are the machine's and indicative.
 
     python benchmarks/greybox_cmaes.py --seeds 0-9 --problems tanks rig4
     python benchmarks/greybox_cmaes.py --searches spiral-x0 cma
+    python benchmarks/greybox_cmaes.py --budget 3000 --problems rig4-tenth
+    python benchmarks/greybox_cmaes.py --whole-fit --problems rig4 rig6
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -72,12 +85,15 @@ from spiralid.datasets import cascaded_tanks
 from spiralid.datasets.tanks_model import tanks_greybox
 from spiralid.fms.greybox import RigGreyBox
 from spiralid.optim import LearnedMetricSpiral, minimize
+from spiralid.sysid import identify, validate
+from spiralid.sysid.estimation.greybox import fit
 from spiralid.sysid.estimation.greybox.fit import (
     _N_POINTS,
     _POLISH_NFEV,
     _RESTARTS,
     _polish,
     _search,
+    _search_budget,
 )
 from spiralid.sysid.estimation.greybox.parallel import ParallelEvaluator
 from spiralid.sysid.estimation.greybox.problem import GreyBoxProblem
@@ -166,6 +182,53 @@ def run(problem: GreyBoxProblem, search, seed: int, budget: int) -> tuple:
     return found, after, spent, time.perf_counter() - t0
 
 
+@contextlib.contextmanager
+def _fit_searching_by(search):
+    """``identify``'s grey-box fit with `search` in place of its own, at the
+    same budgets (three over the horizons' first tenth)."""
+
+    def swapped(problem, method, given, pool, share=1.0):
+        budget = _search_budget(given, _N_POINTS, share)
+        return search(problem, given["rng"], budget, pool)
+
+    own, fit._search = fit._search, swapped
+    try:
+        yield
+    finally:
+        fit._search = own
+
+
+def whole_fits(free: list[str], searches: list[str], seeds: list[int]) -> None:
+    """The default fit (``identify(est, box, rng=seed)``: both searches,
+    the horizons, the polishes) with each search in turn, on the hub
+    record: its cost, validation fit on the last third and simulations."""
+    est, val = _hub_record(0)
+    box = RigGreyBox(free, START, n_modes=MODES)
+    print(f"\n## the default fit, {len(free)} free, each search in it")
+    print(" | ".join(["seed", *(f"{k} cost, val. %, nfev" for k in searches)]))
+    rows = {label: [] for label in searches}
+    for seed in seeds:
+        cells = []
+        for label in searches:
+            with _fit_searching_by(SEARCHES[label]):
+                model = identify(est, box, rng=seed)
+            score = float(validate(model, val, warmup=est).fit_percent)
+            rows[label].append((model.cost, score))
+            cells.append(f"{model.cost:.5g}, {score:.2f}, {model.nfev}")
+        print(" | ".join([f"{seed:4d}", *cells]), flush=True)
+    if "cma" in rows:
+        c = np.array(rows["cma"])
+        for label in [key for key in rows if key != "cma"]:
+            s = np.array(rows[label])
+            print(f"  {label} against cma: median [IQR] over the seeds")
+            _summary("cost", s[:, 0], c[:, 0])
+            print(
+                f"  validation fit %: median {np.median(s[:, 1]):.2f}, lowest "
+                f"{s[:, 1].min():.2f}; cma {np.median(c[:, 1]):.2f}, lowest "
+                f"{c[:, 1].min():.2f}"
+            )
+
+
 def _summary(label: str, a: np.ndarray, b: np.ndarray) -> None:
     def stats(x):
         q1, med, q3 = np.percentile(x, [25, 50, 75])
@@ -185,14 +248,31 @@ def main() -> None:
     parser.add_argument("--seeds", type=seed_list, default=list(range(10)))
     parser.add_argument("--budget", type=int, default=1000)
     parser.add_argument(
-        "--problems", nargs="+", choices=list(PROBLEMS), default=list(PROBLEMS)
+        "--problems",
+        nargs="+",
+        choices=list(PROBLEMS),
+        help="default: every problem (rig4 and rig6 with --whole-fit)",
     )
     # One search alone reruns one side (CMA-ES's runs repeat bit for bit
     # with the seed), half the machine time of a run of both.
     parser.add_argument(
         "--searches", nargs="+", choices=list(SEARCHES), default=list(SEARCHES)
     )
+    parser.add_argument(
+        "--whole-fit",
+        action="store_true",
+        help="the default fit with each search in it (rig4, rig6 only)",
+    )
     args = parser.parse_args()
+    if args.whole_fit:
+        rigs = {"rig4": FREE, "rig6": SIX}
+        args.problems = args.problems or list(rigs)
+        if not set(args.problems) <= set(rigs):
+            parser.error("--whole-fit takes --problems rig4 and rig6 only")
+        for name in args.problems:
+            whole_fits(rigs[name], args.searches, args.seeds)
+        return
+    args.problems = args.problems or list(PROBLEMS)
     print(f"budget {args.budget} simulations, seeds {args.seeds}")
     for name in args.problems:
         problem = PROBLEMS[name]()
