@@ -45,7 +45,6 @@ from spiralid.fms.sensors import Sensors, butterworth_ss, quantise
 __all__ = ["FlexibleManipulator", "Recording", "nonlinear_rig"]
 
 _OUTPUTS = ("hub_angle", "hub_velocity", "end_acceleration", "tip_deflection")
-# The rig's inputs: the hub torque, and a shaker's force on the beam.
 #: Each damping field's share of a flexible mode's damping ratio at its
 #: frequency ``w`` (rad/s): the ratio is the fields' sum weighted by these
 #: (the one ``damping_ratio``, then Rayleigh's ``alpha M + beta K``).
@@ -54,6 +53,7 @@ DAMPING_SHARES = {
     "mass_damping": lambda w: 1.0 / (2.0 * w),
     "stiffness_damping": lambda w: w / 2.0,
 }
+# The rig's inputs: the hub torque, and a shaker's force on the beam.
 _INPUTS = ("torque", "force")
 _INPUT_UNITS = {"torque": "N m", "force": "N"}
 _UNITS = {
@@ -438,13 +438,15 @@ class FlexibleManipulator:
 
     def _modal_damping(self, omega: np.ndarray) -> np.ndarray:
         """``2 zeta_k w_k`` of each mode at the frequencies `omega` (rad/s,
-        the rigid mode's 0 first): zero for the rigid mode."""
-        out = 2.0 * self.damping_ratio * omega
-        if self.mass_damping or self.stiffness_damping:
-            # Rayleigh's alpha M + beta K in modal coordinates (mass-
-            # normalised modes): alpha + beta w^2, on the flexible modes.
-            out = out + self.mass_damping + self.stiffness_damping * omega**2
-            out[0] = 0.0
+        the rigid mode's 0 first): zero for the rigid mode, whose frequency
+        the mass damping's share would divide by."""
+        out = np.zeros_like(omega)
+        flexible = omega[1:]
+        zeta = sum(
+            getattr(self, name) * share(flexible)
+            for name, share in DAMPING_SHARES.items()
+        )
+        out[1:] = 2.0 * flexible * zeta
         return out
 
     def mode_damping(self, n: int | None = None) -> np.ndarray:
