@@ -89,3 +89,30 @@ def test_the_horizons_search_runs_with_its_budget(monkeypatch):
     monkeypatch.setattr(fit, "minimize", counted)
     sid.identify(struck(400), box(2.0), max_nfev=40, polish_nfev=2, horizons=(0.1,))
     assert budgets == [40, 120]  # the whole record's, then its first tenth's
+
+
+def test_spiral_explores_each_shorter_horizon_before_the_next(monkeypatch):
+    # One free parameter: one weakest direction, stepped out four ways, so
+    # four more polishes on the first tenth; none on the whole record.
+    polished = []
+    real = fit._polish
+
+    def counted(stage, *args):
+        polished.append(stage.y.size)
+        return real(stage, *args)
+
+    monkeypatch.setattr(fit, "_polish", counted)
+    given = dict(max_nfev=40, polish_nfev=2, horizons=(0.1,), rng=0)
+    sid.identify(struck(400), box(2.0), **given)
+    assert polished == [400, 40, 40, 40, 40, 40, 400]
+    polished.clear()
+    sid.identify(struck(400), box(2.0), explore=False, **given)
+    assert polished == [400, 40, 400]
+
+
+@pytest.mark.parametrize("value", ["yes", 1, None])
+def test_a_bad_explore_is_refused_in_one_line(value):
+    with pytest.raises(TypeError) as refused:
+        sid.identify(struck(200), box(2.0), max_nfev=40, explore=value)
+    message = str(refused.value)
+    assert "\n" not in message and "`explore`" in message, message

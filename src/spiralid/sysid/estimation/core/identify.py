@@ -296,7 +296,8 @@ def identify(
     ``rng``, ``gain``, ``penalty`` and ``workers`` (its simulations on
     several processes, :mod:`~spiralid.sysid.estimation.greybox.parallel`),
     and: ``"spiral"`` ``n_points``, ``max_nfev``, ``polish_nfev``,
-    ``horizons``, ``restarts``; ``"oe"`` ``polish_nfev``, ``horizons``;
+    ``horizons``, ``restarts``, ``explore``; ``"oe"`` ``polish_nfev``,
+    ``horizons``;
     ``"sda"`` and ``"ebsda"`` ``n_points``, ``max_nfev``.
     ``tests/test_option_contract.py`` checks this table against
     :func:`identify_options` and the command line.

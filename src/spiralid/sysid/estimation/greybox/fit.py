@@ -53,7 +53,7 @@ _COMMON = ("rng", "gain", "penalty", "workers")
 _LOCAL = ("polish_nfev", "horizons")
 #: method -> the options it takes beside identify's common ones.
 GREYBOX_METHODS: dict[str, tuple[str, ...]] = {
-    "spiral": (*_COMMON, "n_points", "max_nfev", *_LOCAL, "restarts"),
+    "spiral": (*_COMMON, "n_points", "max_nfev", *_LOCAL, "restarts", "explore"),
     "oe": (*_COMMON, *_LOCAL),
     "sda": (*_COMMON, "n_points", "max_nfev"),
     "ebsda": (*_COMMON, "n_points", "max_nfev"),
@@ -91,6 +91,15 @@ _HORIZONS = (0.1, 0.25, 0.5)
 # stiction, at about a fifth more processor time a fit (figures in the
 # results).
 _HORIZON_SAMPLES = 0.3
+# spiral's horizons step out of each shorter horizon's minimum along the
+# directions that horizon determines least (its Jacobian's smallest singular
+# vectors), these shares of the unit box each way, and polish from there:
+# a short record leaves basins that the whole one separates nearly level
+# (the stick-slip rig with an unknown payload: a plain Coulomb law with a
+# heavier payload, its breakaway level flat, against the truth's stiction,
+# 0.08 % apart in cost over the first tenth and 15 % over the whole record).
+_EXPLORED_DIRECTIONS = 2
+_EXPLORE_STEPS = (0.25, -0.25, 0.5, -0.5)
 _RULES = {"spiral": "learned-metric", "sda": "sda", "ebsda": "ebsda"}
 # Rounds of reweighting the outputs and polishing again (several outputs).
 _REWEIGHTS = 3
@@ -158,6 +167,29 @@ def _search(
     return np.clip(np.asarray(found.x, dtype=float), 0.0, 1.0)
 
 
+def _explored(
+    stage: GreyBoxProblem,
+    z: np.ndarray,
+    polish_nfev: int,
+    pool: ParallelEvaluator,
+) -> np.ndarray:
+    """The lowest cost on `stage` of `z` and of the polishes from points
+    stepped out of `z` along the ``_EXPLORED_DIRECTIONS`` directions that
+    `stage`'s record determines least (``_EXPLORE_STEPS``)."""
+    jac = stage.jacobian(z, pool.residuals)
+    weakest = np.linalg.svd(jac, full_matrices=False)[2][::-1][:_EXPLORED_DIRECTIONS]
+    best, lowest = z, stage(z)
+    for direction in weakest:
+        for step in _EXPLORE_STEPS:
+            polished = _polish(
+                stage, np.clip(z + step * direction, 0.0, 1.0), polish_nfev, pool
+            )
+            cost = stage(polished)
+            if cost < lowest:
+                best, lowest = polished, cost
+    return best
+
+
 def _horizon_lengths(value, n: int, n_free: int) -> list[int]:
     """The sample counts of `value`'s horizons (increasing shares of the
     record in (0, 1)), those too short for a fit left out, then `n`."""
@@ -183,7 +215,10 @@ def _chain(
     pool: ParallelEvaluator,
 ) -> np.ndarray:
     """The search on the first stage's record, then (``"spiral"``,
-    ``"oe"``) the polish on each stage's in turn from the last result."""
+    ``"oe"``) the polish on each stage's in turn from the last result; with
+    ``explore`` (``"spiral"``), each stage but the last explored
+    (:func:`_explored`) before the next."""
+    explore = method == "spiral" and _explore(given.get("explore", True))
     pool.problem = stages[0]
     share = stages[0].y.size / stages[-1].y.size
     z = _search(stages[0], method, given, pool, share)
@@ -192,7 +227,15 @@ def _chain(
         polished = _polish(stage, z, polish_nfev, pool)
         if stage(polished) <= stage(z):
             z = polished
+        if explore and stage is not stages[-1]:
+            z = _explored(stage, z, polish_nfev, pool)
     return z
+
+
+def _explore(value) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise TypeError(f"`explore` must be True or False; got {value!r}")
+    return bool(value)
 
 
 def _problem(data: IOData, structure: GreyBox, given: dict) -> GreyBoxProblem:
