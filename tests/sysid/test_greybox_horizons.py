@@ -91,9 +91,11 @@ def test_the_horizons_search_runs_with_its_budget(monkeypatch):
     assert budgets == [40, 120]  # the whole record's, then its first tenth's
 
 
-def test_spiral_explores_each_shorter_horizon_before_the_next(monkeypatch):
-    # One free parameter: one weakest direction, stepped out four ways, so
-    # four more polishes on the first tenth; none on the whole record.
+def test_spiral_explores_what_a_shorter_horizon_cannot_determine(monkeypatch):
+    # A third parameter the model ignores: flat on every horizon, so one
+    # undetermined direction, stepped out four ways, four more polishes on
+    # the first tenth; none on the whole record. Where the stiffness alone
+    # is free, every direction is determined and nothing is explored.
     polished = []
     real = fit._polish
 
@@ -101,12 +103,21 @@ def test_spiral_explores_each_shorter_horizon_before_the_next(monkeypatch):
         polished.append(stage.y.size)
         return real(stage, *args)
 
+    def ignoring(p):
+        return oscillator(p[:2])
+
+    ignored = GreyBox(
+        [*box(2.0).parameters, Parameter("ignored", 1.0, (0.0, 2.0))], ss=ignoring
+    )
     monkeypatch.setattr(fit, "_polish", counted)
     given = dict(max_nfev=40, polish_nfev=2, horizons=(0.1,), rng=0)
-    sid.identify(struck(400), box(2.0), **given)
+    sid.identify(struck(400), ignored, **given)
     assert polished == [400, 40, 40, 40, 40, 40, 400]
     polished.clear()
-    sid.identify(struck(400), box(2.0), explore=False, **given)
+    sid.identify(struck(400), ignored, explore=False, **given)
+    assert polished == [400, 40, 400]
+    polished.clear()
+    sid.identify(struck(400), box(2.0), **given)
     assert polished == [400, 40, 400]
 
 

@@ -10,6 +10,8 @@ from scipy import signal
 
 import spiralid as sid
 from spiralid.sysid import GreyBox, Parameter
+from spiralid.sysid.estimation.greybox.intervals import undetermined_directions
+from spiralid.sysid.estimation.greybox.problem import GreyBoxProblem
 
 TS = 0.1
 TRUE = np.array([2.0, 0.5])
@@ -86,3 +88,41 @@ def test_coloured_noise_widens_the_intervals_to_the_exact_sandwich():
     _, rss, *_ = np.linalg.lstsq(x, rec.y, rcond=None)
     white = np.sqrt(float(rss[0]) / (n - 2) * np.diag(inv))
     assert np.all(half > 2 * Z95 * white)
+
+
+def weak_directions(data, ss) -> np.ndarray:
+    """The directions the record cannot determine at the initial values of
+    two gains with equal linear bounds."""
+    params = [Parameter(name, 1.0, (0.0, 4.0)) for name in ("b1", "b2")]
+    problem = GreyBoxProblem(data, GreyBox(params, ss=ss))
+    z = problem.z0
+    return undetermined_directions(problem, problem.residual(z), problem.jacobian(z))
+
+
+def test_the_undetermined_directions_are_the_jacobians_null_space(record):
+    # Both gains on the first channel: the record sees their sum only, so
+    # (1, -1)/sqrt(2) in the unit box is undetermined; on two channels
+    # every direction is determined.
+    def one_channel(p):
+        return two_channels((p[0] + p[1], 0.0))
+
+    weak = weak_directions(record[0], one_channel)
+    assert weak.shape == (1, 2)
+    np.testing.assert_allclose(weak[0] * np.sign(weak[0, 0]), [2**-0.5, -(2**-0.5)])
+    assert weak_directions(record[0], two_channels).shape == (0, 2)
+
+
+def test_a_coloured_error_shorter_than_the_largest_order_is_modelled():
+    # 25 samples of a slow drift fail the whiteness test; the autoregressive
+    # model's order is then at most a tenth of them, the Yule-Walker fit of
+    # order 1 at least as good by Akaike's criterion as none.
+    from spiralid.sysid.estimation.core.coloured import noise_ar
+
+    e = np.sin(np.arange(25) / 6.0) + 0.01 * np.random.default_rng(0).standard_normal(
+        25
+    )
+    a, s2 = noise_ar(e)
+    assert 2 <= a.size <= 3 and 0.0 < s2 < e @ e / e.size
+    r0, r1 = e @ e / e.size, e[1:] @ e[:-1] / e.size
+    if a.size == 2:
+        np.testing.assert_allclose(a, [1.0, -r1 / r0])

@@ -50,9 +50,9 @@ def ljung_box(r: np.ndarray, n: int) -> float:
 
 
 def _autocovariance(e: np.ndarray, lags: int) -> np.ndarray:
-    """The biased (divide by ``N``) autocovariance at lags ``0..lags`` (zero
-    at a lag beyond the record): one product a lag, not the full
-    correlation's ``N^2`` for the few lags used."""
+    """The biased (divide by ``N``) autocovariance at lags ``0..lags``
+    (``lags < N``): one product a lag, not the full correlation's ``N^2``
+    for the few lags used."""
     n = e.size
     return np.array([e[k:] @ e[: n - k] for k in range(lags + 1)]) / n
 
@@ -84,9 +84,10 @@ def noise_ar(e: np.ndarray) -> tuple[np.ndarray, float]:
     if q <= stats.chi2.ppf(LEVEL, lags):
         return np.ones(1), float(e @ e) / n
     # The error as it is, mean and all: the mean is error too.
-    r = _autocovariance(e, MAX_ORDER)
+    top = min(MAX_ORDER, n // 10)
+    r = _autocovariance(e, top)
     best = (n * np.log(r[0]), np.ones(1), r[0])
-    for order in range(1, min(MAX_ORDER, n // 10) + 1):
+    for order in range(1, top + 1):
         a = linalg.solve_toeplitz(r[:order], r[1 : order + 1])
         s2 = r[0] - a @ r[1 : order + 1]
         if s2 <= 0.0:

@@ -11,7 +11,9 @@
 - both beside a second fit over growing horizons (``horizons``, shares of
   the record): the search on the first share (with three times
   ``max_nfev`` over a tenth: a budget in samples, ``_search_budget``), the
-  polish on each longer one in turn; the fit of lower cost on the whole
+  polish on each longer one in turn (``"spiral"`` first steps out of each
+  shorter one's minimum along the directions it cannot determine,
+  ``explore``, :func:`_explored`); the fit of lower cost on the whole
   record is kept;
 - ``"sda"``, ``"ebsda"``: the paper's spiral searches over the same box and
   cost, as printed (no polish).
@@ -43,7 +45,7 @@ from ...data import IOData
 from ...models.greybox import GreyBox
 from ...models.greybox_model import GreyBoxModel, LinearGreyBoxModel
 from ..linear.levenberg import levenberg_marquardt
-from .intervals import parameter_intervals
+from .intervals import parameter_intervals, undetermined_directions
 from .parallel import ParallelEvaluator
 from .problem import GreyBoxProblem
 
@@ -92,14 +94,21 @@ _HORIZONS = (0.1, 0.25, 0.5)
 # results).
 _HORIZON_SAMPLES = 0.3
 # spiral's horizons step out of each shorter horizon's minimum along the
-# directions that horizon determines least (its Jacobian's smallest singular
-# vectors), these shares of the unit box each way, and polish from there:
-# a short record leaves basins that the whole one separates nearly level
-# (the stick-slip rig with an unknown payload: a plain Coulomb law with a
-# heavier payload, its breakaway level flat, against the truth's stiction,
-# 0.08 % apart in cost over the first tenth and 15 % over the whole record).
+# directions that horizon cannot determine (those its intervals would drop,
+# the least determined first, at most this many), these shares of the unit
+# box each way, and polish from there: a short record can leave a parameter
+# flat that the whole one needs (the stick-slip rig with an unknown
+# payload: at a plain Coulomb minimum over the first tenth the breakaway
+# level, below the Coulomb one, moves no sample, and the truth's stiction
+# is 0.08 % lower there but 15 % lower over the whole record; one step
+# length left 2 of 20 realisations in the plain Coulomb basin). Each of
+# those polishes gets this share of `polish_nfev`: it only has to reach a
+# basin and rank it, the next horizon's polish finishes it; with the whole
+# budget, the Cascaded Tanks' and the DaISy arm's fits (whose horizons leave
+# directions undetermined that lead nowhere) took 3-4 times as long.
 _EXPLORED_DIRECTIONS = 2
 _EXPLORE_STEPS = (0.25, -0.25, 0.5, -0.5)
+_EXPLORE_POLISH = 0.25
 _RULES = {"spiral": "learned-metric", "sda": "sda", "ebsda": "ebsda"}
 # Rounds of reweighting the outputs and polishing again (several outputs).
 _REWEIGHTS = 3
@@ -173,17 +182,19 @@ def _explored(
     polish_nfev: int,
     pool: ParallelEvaluator,
 ) -> np.ndarray:
-    """The lowest cost on `stage` of `z` and of the polishes from points
-    stepped out of `z` along the ``_EXPLORED_DIRECTIONS`` directions that
-    `stage`'s record determines least (``_EXPLORE_STEPS``)."""
+    """The lowest cost on `stage` of `z` and of the polishes (a share
+    ``_EXPLORE_POLISH`` of `polish_nfev`) from points
+    stepped out of `z` (``_EXPLORE_STEPS``) along the directions that
+    `stage`'s record cannot determine there (at most
+    ``_EXPLORED_DIRECTIONS``); `z` itself where it determines them all."""
     jac = stage.jacobian(z, pool.residuals)
-    weakest = np.linalg.svd(jac, full_matrices=False)[2][::-1][:_EXPLORED_DIRECTIONS]
+    weak = undetermined_directions(stage, stage.residual(z), jac)
     best, lowest = z, stage(z)
-    for direction in weakest:
+    budget = max(1, round(_EXPLORE_POLISH * polish_nfev))
+    for direction in weak[:_EXPLORED_DIRECTIONS]:
         for step in _EXPLORE_STEPS:
-            polished = _polish(
-                stage, np.clip(z + step * direction, 0.0, 1.0), polish_nfev, pool
-            )
+            start = np.clip(z + step * direction, 0.0, 1.0)
+            polished = _polish(stage, start, budget, pool)
             cost = stage(polished)
             if cost < lowest:
                 best, lowest = polished, cost

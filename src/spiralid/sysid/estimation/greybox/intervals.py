@@ -28,7 +28,7 @@ import numpy as np
 from ..core.coloured import error_gram
 from .problem import GreyBoxProblem
 
-__all__ = ["parameter_intervals"]
+__all__ = ["parameter_intervals", "undetermined_directions"]
 
 _Z95 = 1.959963984540054
 # Singular values below this share of the largest are rounding.
@@ -66,12 +66,7 @@ def parameter_intervals(
     dof = residual.size - z.size
     if not (np.all(np.isfinite(jac)) and np.all(np.isfinite(residual))) or dof < 1:
         return intervals, ["no interval: the fit's Jacobian is not finite"]
-    u, sv, vt = np.linalg.svd(jac, full_matrices=False)
-    gram = _gram(residual, u, problem.n_outputs) * residual.size / dof
-    smax = sv[0] if sv.size else 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        half = _Z95 * np.sqrt(np.diag(gram)) / sv
-    lost = (sv <= _RANK_TOL * smax) | (half > 1.0)
+    sv, vt, gram, lost = _directions(problem, residual, jac)
     undetermined = np.zeros(z.size, dtype=bool)
     notes = []
     for i in np.flatnonzero(lost):
@@ -93,6 +88,32 @@ def parameter_intervals(
         if not undetermined[j]:
             intervals[row] = low[j], high[j]
     return intervals, notes
+
+
+def undetermined_directions(
+    problem: GreyBoxProblem, residual: np.ndarray, jac: np.ndarray
+) -> np.ndarray:
+    """The unit-box directions (rows, the least determined first) that the
+    record cannot determine: those :func:`parameter_intervals` drops."""
+    finite = np.all(np.isfinite(jac)) and np.all(np.isfinite(residual))
+    if residual.size <= jac.shape[1] or not finite:
+        return np.empty((0, jac.shape[1]))
+    _, vt, _, lost = _directions(problem, residual, jac)
+    return vt[lost][::-1]
+
+
+def _directions(problem: GreyBoxProblem, residual: np.ndarray, jac: np.ndarray):
+    """The Jacobian's singular values and directions (``S``, ``V'``), the
+    error's Gram matrix ``G`` in them (per degree of freedom), and which
+    directions are lost: ``S_i`` below rounding, or a 95 % half-width
+    ``1.96 sqrt(G_ii) / S_i`` wider than the box."""
+    u, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    dof = residual.size - jac.shape[1]
+    gram = _gram(residual, u, problem.n_outputs) * residual.size / dof
+    smax = sv[0] if sv.size else 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        half = _Z95 * np.sqrt(np.diag(gram)) / sv
+    return sv, vt, gram, (sv <= _RANK_TOL * smax) | (half > 1.0)
 
 
 def _gram(residual: np.ndarray, u: np.ndarray, n_outputs: int) -> np.ndarray:
