@@ -10,6 +10,7 @@ from scipy import signal
 
 import spiralid as sid
 from spiralid.sysid import GreyBox, Parameter
+from spiralid.sysid.estimation.core.coloured import noise_ar
 from spiralid.sysid.estimation.greybox.intervals import undetermined_directions
 from spiralid.sysid.estimation.greybox.problem import GreyBoxProblem
 
@@ -114,15 +115,12 @@ def test_the_undetermined_directions_are_the_jacobians_null_space(record):
 
 def test_a_coloured_error_shorter_than_the_largest_order_is_modelled():
     # 25 samples of a slow drift fail the whiteness test; the autoregressive
-    # model's order is then at most a tenth of them, the Yule-Walker fit of
-    # order 1 at least as good by Akaike's criterion as none.
-    from spiralid.sysid.estimation.core.coloured import noise_ar
-
-    e = np.sin(np.arange(25) / 6.0) + 0.01 * np.random.default_rng(0).standard_normal(
-        25
-    )
+    # model's order is at most a tenth of them: here 2 by Akaike's
+    # criterion, its coefficients the Yule-Walker equations' solved by hand.
+    noise = 0.01 * np.random.default_rng(0).standard_normal(25)
+    e = np.sin(np.arange(25) / 6.0) + noise
     a, s2 = noise_ar(e)
-    assert 2 <= a.size <= 3 and 0.0 < s2 < e @ e / e.size
-    r0, r1 = e @ e / e.size, e[1:] @ e[:-1] / e.size
-    if a.size == 2:
-        np.testing.assert_allclose(a, [1.0, -r1 / r0])
+    r = np.array([e[k:] @ e[: e.size - k] for k in range(3)]) / e.size
+    coef = np.linalg.solve([[r[0], r[1]], [r[1], r[0]]], r[1:])
+    np.testing.assert_allclose(a, [1.0, *-coef], rtol=1e-10)
+    np.testing.assert_allclose(s2, r[0] - coef @ r[1:], rtol=1e-10)
