@@ -224,12 +224,12 @@ def _chain(
     given: dict,
     polish_nfev: int,
     pool: ParallelEvaluator,
+    explore: bool,
 ) -> np.ndarray:
     """The search on the first stage's record, then (``"spiral"``,
     ``"oe"``) the polish on each stage's in turn from the last result; with
-    ``explore`` (``"spiral"``), each stage but the last explored
-    (:func:`_explored`) before the next."""
-    explore = method == "spiral" and _explore(given.get("explore", True))
+    `explore`, each stage but the last explored (:func:`_explored`) before
+    the next."""
     pool.problem = stages[0]
     share = stages[0].y.size / stages[-1].y.size
     z = _search(stages[0], method, given, pool, share)
@@ -244,6 +244,7 @@ def _chain(
 
 
 def _explore(value) -> bool:
+    """`explore` checked: a bool, or a one-line TypeError."""
     if not isinstance(value, bool | np.bool_):
         raise TypeError(f"`explore` must be True or False; got {value!r}")
     return bool(value)
@@ -325,6 +326,7 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
     """
     problem = _problem(data, structure, given)
     polish_nfev = integer(given.get("polish_nfev", _POLISH_NFEV), "polish_nfev", 1)
+    explore = method == "spiral" and _explore(given.get("explore", True))
     chains = [[problem]]
     if method in ("spiral", "oe"):
         horizons = given.get("horizons", _HORIZONS)
@@ -334,7 +336,10 @@ def fit_greybox(data: IOData, structure: GreyBox, method: str, given: dict):
             chains.append([*shorter, problem])
     with ParallelEvaluator(problem, given.get("workers")) as pool:
         z = min(
-            (_chain(chain, method, given, polish_nfev, pool) for chain in chains),
+            (
+                _chain(chain, method, given, polish_nfev, pool, explore)
+                for chain in chains
+            ),
             key=problem,
         )
         problem.nfev += sum(stage.nfev for chain in chains[1:] for stage in chain[:-1])

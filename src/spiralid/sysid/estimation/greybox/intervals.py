@@ -63,8 +63,7 @@ def parameter_intervals(
     n_all = problem.structure.free.size
     intervals = np.full((n_all, 2), np.nan)
     names = [p.name for p in problem.structure.all_parameters if p.free]
-    dof = residual.size - z.size
-    if not (np.all(np.isfinite(jac)) and np.all(np.isfinite(residual))) or dof < 1:
+    if not _usable(residual, jac):
         return intervals, ["no interval: the fit's Jacobian is not finite"]
     sv, vt, gram, lost = _directions(problem, residual, jac)
     undetermined = np.zeros(z.size, dtype=bool)
@@ -95,11 +94,17 @@ def undetermined_directions(
 ) -> np.ndarray:
     """The unit-box directions (rows, the least determined first) that the
     record cannot determine: those :func:`parameter_intervals` drops."""
-    finite = np.all(np.isfinite(jac)) and np.all(np.isfinite(residual))
-    if residual.size <= jac.shape[1] or not finite:
+    if not _usable(residual, jac):
         return np.empty((0, jac.shape[1]))
     _, vt, _, lost = _directions(problem, residual, jac)
     return vt[lost][::-1]
+
+
+def _usable(residual: np.ndarray, jac: np.ndarray) -> bool:
+    """Whether the fit's error and Jacobian can say what the record
+    determines: both finite, and a degree of freedom left."""
+    finite = np.all(np.isfinite(jac)) and np.all(np.isfinite(residual))
+    return bool(finite) and residual.size > jac.shape[1]
 
 
 def _directions(problem: GreyBoxProblem, residual: np.ndarray, jac: np.ndarray):
